@@ -1,0 +1,22 @@
+//! The library's error type. Every message names what is wrong and where.
+
+/// Errors returned by armcal.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// An inconsistent model (field counts, names, limits, conventions).
+    #[error("model: {0}")]
+    Model(String),
+    /// Bad user input (joint values, data rows, options).
+    #[error("{0}")]
+    Input(String),
+    /// A file could not be read or parsed; the message gives file, line and field.
+    #[error("{file}: {message}")]
+    File { file: String, message: String },
+    /// A conversion between conventions that cannot be done exactly.
+    #[error("conversion: {0}")]
+    Conversion(String),
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+}
+
+pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -1,0 +1,11 @@
+//! armcal: kinematic calibration of industrial robots, from the nominal model to a
+//! calibrated, compensated, proven-accurate robot.
+//!
+//! The two sources are Mooring, Roth & Driels, *Fundamentals of Manipulator Calibration*
+//! (1991) ("book") and Jost, Kudruss, Körkel & Walter (2017), optimum experimental design of
+//! laser-tracker measurement poses ("paper").
+
+pub mod error;
+pub mod model;
+
+pub use error::{Error, Result};

@@ -1,0 +1,366 @@
+//! The kinematic model: instrument frame, base, links with joints, tool, and targets, with
+//! one parameter registry. A [`Model`] is immutable once built and can be shared across
+//! threads; buffers for one evaluation live in [`crate::model::Data`].
+
+use crate::model::link::{Convention, Joint, JointKind, LinkGeometry, Motion};
+use crate::model::registry::{Registry, Segment, Status};
+use crate::Error;
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+/// A link as a user describes it: a name (the prefix of its parameter names), a geometry,
+/// and the joint that drives it (none for fixed links and frames).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LinkSpec {
+    pub name: String,
+    pub geometry: LinkGeometry,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joint: Option<Joint>,
+}
+
+/// Everything needed to build a [`Model`]; also what exports and estimate files store.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ModelSpec {
+    pub name: String,
+    /// Frame of the measuring instrument in the world (e.g. a laser tracker). Measurements
+    /// are expressed in it (paper eq. 3). `None`: measurements are in the world frame.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub instrument: Option<LinkSpec>,
+    /// Base frame, then the links from base to flange, then the tool frame.
+    pub links: Vec<LinkSpec>,
+    /// Points or frames attached to the last chain link (the tool): reflectors, SMRs,
+    /// tooling balls, or a full end-effector frame.
+    #[serde(default)]
+    pub targets: Vec<LinkSpec>,
+}
+
+/// A compiled link: its spec plus where its parameters live in the registry.
+#[derive(Clone, Debug)]
+pub struct Link {
+    pub spec: LinkSpec,
+    /// Index of the joint variable in `q`, if the link has a joint.
+    pub joint: Option<usize>,
+    /// Index of the link's first parameter; its fields follow contiguously.
+    pub first_param: usize,
+}
+
+impl Link {
+    /// Number of parameters of this link.
+    pub fn param_count(&self) -> usize {
+        self.spec.geometry.values.len()
+    }
+
+    /// The link's geometry with values taken from a parameter vector.
+    pub fn geometry_at(&self, params: &[f64]) -> LinkGeometry {
+        let mut g = self.spec.geometry.clone();
+        let n = g.values.len();
+        g.values
+            .copy_from_slice(&params[self.first_param..self.first_param + n]);
+        g
+    }
+}
+
+/// One elementary factor of the kinematic chain, after compilation.
+#[derive(Clone, Debug)]
+pub(crate) enum Step {
+    /// Rotation about / translation along a local axis by `params[param] (+ q[joint])`.
+    Elementary {
+        motion: Motion,
+        param: usize,
+        joint: Option<usize>,
+        /// Fixed unit axis for `RotAxis` / `TransAxis`.
+        axis: Vector3<f64>,
+    },
+    /// Zero-reference screw motion; parameters `first..first+7` are ux, uy, uz, px, py, pz,
+    /// offset.
+    Screw {
+        first: usize,
+        joint: Option<usize>,
+        prismatic: bool,
+    },
+}
+
+/// Immutable kinematic model with its parameter registry.
+#[derive(Clone, Debug)]
+pub struct Model {
+    pub name: String,
+    pub registry: Registry,
+    pub joints: Vec<Joint>,
+    pub instrument: Option<Link>,
+    /// Base frame, links, tool frame, in chain order.
+    pub links: Vec<Link>,
+    pub targets: Vec<Link>,
+    pub(crate) instrument_steps: Vec<Step>,
+    pub(crate) chain_steps: Vec<Step>,
+    /// `chain_step_end[i]`: number of chain steps after which link `i` is complete.
+    pub(crate) chain_step_end: Vec<usize>,
+    pub(crate) target_steps: Vec<Vec<Step>>,
+}
+
+impl Model {
+    /// Builds a model from its spec. Checks field counts, unique names, conventions that
+    /// need or forbid a joint, non-zero ZRP axes and joint limits.
+    pub fn from_spec(spec: &ModelSpec) -> Result<Model, Error> {
+        let mut registry = Registry::new();
+        let mut joints = Vec::new();
+        let mut names = std::collections::HashSet::new();
+        let mut compile = |ls: &LinkSpec,
+                           segment: Segment,
+                           registry: &mut Registry,
+                           joints: &mut Vec<Joint>|
+         -> Result<(Link, Vec<Step>), Error> {
+            if !names.insert(ls.name.clone()) {
+                return Err(Error::Model(format!(
+                    "frame name `{}` is used twice",
+                    ls.name
+                )));
+            }
+            if ls.name.is_empty() || ls.name.contains('.') || ls.name.contains('*') {
+                return Err(Error::Model(format!(
+                    "frame name `{}` must be non-empty and contain no `.` or `*`",
+                    ls.name
+                )));
+            }
+            let g = &ls.geometry;
+            let kind = ls.joint.as_ref().map(|j| j.kind);
+            let fields = g.convention.fields(kind);
+            if fields.len() != g.values.len() {
+                return Err(Error::Model(format!(
+                    "link `{}` ({}) needs {} values ({}), got {}",
+                    ls.name,
+                    g.convention,
+                    fields.len(),
+                    fields.iter().map(|f| f.0).collect::<Vec<_>>().join(", "),
+                    g.values.len()
+                )));
+            }
+            if let Some(v) = g.values.iter().find(|v| !v.is_finite()) {
+                return Err(Error::Model(format!(
+                    "link `{}` has a non-finite value {v}",
+                    ls.name
+                )));
+            }
+            let joint = match &ls.joint {
+                Some(j) => {
+                    if g.convention.joint_field(j.kind).is_none() {
+                        return Err(Error::Model(format!(
+                            "link `{}`: convention {} takes no joint",
+                            ls.name, g.convention
+                        )));
+                    }
+                    if !(j.lower <= j.upper) {
+                        return Err(Error::Model(format!(
+                            "joint `{}`: lower limit {} is above upper limit {}",
+                            j.name, j.lower, j.upper
+                        )));
+                    }
+                    joints.push(j.clone());
+                    Some(joints.len() - 1)
+                }
+                None => None,
+            };
+            let first_param = registry.len();
+            for ((field, unit), &v) in fields.iter().zip(&g.values) {
+                registry.add(format!("{}.{}", ls.name, field), *unit, v, segment)?;
+            }
+            let joint_field = ls
+                .joint
+                .as_ref()
+                .and_then(|j| g.convention.joint_field(j.kind));
+            let mut steps = Vec::new();
+            match g.convention.motions(kind) {
+                Some(motions) => {
+                    let axis = g.axis_vector();
+                    if matches!(g.convention, Convention::Urdf)
+                        && !axis.iter().all(|x| x.is_finite())
+                    {
+                        return Err(Error::Model(format!(
+                            "link `{}`: joint axis must be a non-zero vector",
+                            ls.name
+                        )));
+                    }
+                    for &(motion, field) in motions {
+                        steps.push(Step::Elementary {
+                            motion,
+                            param: first_param + field,
+                            joint: if Some(field) == joint_field {
+                                joint
+                            } else {
+                                None
+                            },
+                            axis,
+                        });
+                    }
+                }
+                None => {
+                    let u = Vector3::new(g.values[0], g.values[1], g.values[2]);
+                    if u.norm() < 1e-9 {
+                        return Err(Error::Model(format!(
+                            "link `{}`: zero-reference axis u must be non-zero",
+                            ls.name
+                        )));
+                    }
+                    steps.push(Step::Screw {
+                        first: first_param,
+                        joint,
+                        prismatic: kind == Some(JointKind::Prismatic),
+                    });
+                }
+            }
+            Ok((
+                Link {
+                    spec: ls.clone(),
+                    joint,
+                    first_param,
+                },
+                steps,
+            ))
+        };
+
+        let (instrument, instrument_steps) = match &spec.instrument {
+            Some(ls) => {
+                if ls.joint.is_some() {
+                    return Err(Error::Model(
+                        "the instrument frame cannot have a joint".into(),
+                    ));
+                }
+                let (l, s) = compile(ls, Segment::Instrument, &mut registry, &mut joints)?;
+                (Some(l), s)
+            }
+            None => (None, Vec::new()),
+        };
+        let mut links = Vec::new();
+        let mut chain_steps = Vec::new();
+        let mut chain_step_end = Vec::new();
+        for ls in &spec.links {
+            let (l, s) = compile(ls, Segment::Chain, &mut registry, &mut joints)?;
+            chain_steps.extend(s);
+            chain_step_end.push(chain_steps.len());
+            links.push(l);
+        }
+        if links.is_empty() {
+            return Err(Error::Model(format!("model `{}` has no links", spec.name)));
+        }
+        let mut targets = Vec::new();
+        let mut target_steps = Vec::new();
+        for (k, ls) in spec.targets.iter().enumerate() {
+            if ls.joint.is_some() {
+                return Err(Error::Model(format!(
+                    "target `{}` cannot have a joint",
+                    ls.name
+                )));
+            }
+            let (l, s) = compile(ls, Segment::Target(k), &mut registry, &mut joints)?;
+            targets.push(l);
+            target_steps.push(s);
+        }
+        Ok(Model {
+            name: spec.name.clone(),
+            registry,
+            joints,
+            instrument,
+            links,
+            targets,
+            instrument_steps,
+            chain_steps,
+            chain_step_end,
+            target_steps,
+        })
+    }
+
+    /// The spec of this model with every value taken from `params` (e.g. an estimate).
+    pub fn spec_at(&self, params: &[f64]) -> ModelSpec {
+        let re = |l: &Link| LinkSpec {
+            geometry: l.geometry_at(params),
+            ..l.spec.clone()
+        };
+        ModelSpec {
+            name: self.name.clone(),
+            instrument: self.instrument.as_ref().map(re),
+            links: self.links.iter().map(re).collect(),
+            targets: self.targets.iter().map(re).collect(),
+        }
+    }
+
+    /// The spec with nominal values.
+    pub fn spec(&self) -> ModelSpec {
+        self.spec_at(&self.registry.nominal())
+    }
+
+    pub fn dof(&self) -> usize {
+        self.joints.len()
+    }
+
+    pub fn param_count(&self) -> usize {
+        self.registry.len()
+    }
+
+    pub fn nominal(&self) -> Vec<f64> {
+        self.registry.nominal()
+    }
+
+    /// Index of a chain link by name.
+    pub fn link_index(&self, name: &str) -> Option<usize> {
+        self.links.iter().position(|l| l.spec.name == name)
+    }
+
+    /// Index of a target by name.
+    pub fn target_index(&self, name: &str) -> Option<usize> {
+        self.targets.iter().position(|l| l.spec.name == name)
+    }
+
+    /// Whether a target measures a full frame (orientation too) or only a point.
+    pub fn target_is_frame(&self, k: usize) -> bool {
+        self.targets[k].spec.geometry.convention != Convention::Point
+    }
+
+    /// Sets the status of every parameter matching `pattern` (see [`Registry::matching`]).
+    pub fn set_status(&mut self, pattern: &str, status: Status) -> Result<(), Error> {
+        for i in self.registry.matching(pattern)? {
+            self.registry.set_status(i, status);
+        }
+        Ok(())
+    }
+
+    /// Checks a joint vector's length and limits; the error names the joint and its range.
+    pub fn check_joints(&self, q: &[f64]) -> Result<(), Error> {
+        if q.len() != self.dof() {
+            return Err(Error::Input(format!(
+                "model `{}` has {} joints, got {} values",
+                self.name,
+                self.dof(),
+                q.len()
+            )));
+        }
+        for (j, (v, joint)) in q.iter().zip(&self.joints).enumerate() {
+            if !v.is_finite() {
+                return Err(Error::Input(format!(
+                    "joint {} (`{}`) is not finite",
+                    j + 1,
+                    joint.name
+                )));
+            }
+            let tol = 1e-9;
+            if *v < joint.lower - tol || *v > joint.upper + tol {
+                let f = joint.kind.unit().display_factor();
+                return Err(Error::Input(format!(
+                    "joint `{}` = {:.4} {} is outside its limits [{:.4}, {:.4}]",
+                    joint.name,
+                    v * f,
+                    joint.kind.unit().display_name(),
+                    joint.lower * f,
+                    joint.upper * f
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Joint limits as (lower, upper) vectors.
+    pub fn joint_limits(&self) -> (Vec<f64>, Vec<f64>) {
+        (
+            self.joints.iter().map(|j| j.lower).collect(),
+            self.joints.iter().map(|j| j.upper).collect(),
+        )
+    }
+}

@@ -1,0 +1,242 @@
+//! Forward kinematics with the world twist of every parameter and joint (book §2.4–2.5:
+//! the differential change of the end pose caused by a change in one link parameter is a
+//! differential transformation about that parameter's axis). One pass over the chain gives
+//! the pose of every frame and all the data the analytic Jacobians need.
+
+use crate::model::chain::{Model, Step};
+use crate::model::link::Motion;
+use crate::model::pose::{rot_axis, Pose, Twist};
+use nalgebra::{convert, RealField, Vector3};
+
+/// Reusable buffers for one evaluation of a [`Model`] (pinocchio's `Data`). Generic over
+/// the scalar so dual numbers can flow through the same code.
+#[derive(Clone, Debug)]
+pub struct Data<T: RealField + Copy> {
+    /// Pose of the instrument frame in the world.
+    pub instrument: Pose<T>,
+    /// World pose at the end of each chain link (base, links, tool).
+    pub frames: Vec<Pose<T>>,
+    /// World pose of each target.
+    pub targets: Vec<Pose<T>>,
+    /// For every parameter, the world-frame twist caused by a unit change of it.
+    pub param_twists: Vec<Twist<T>>,
+    /// For every joint, the world-frame twist caused by a unit change of its variable.
+    pub joint_twists: Vec<Twist<T>>,
+}
+
+impl<T: RealField + Copy> Data<T> {
+    pub fn new(model: &Model) -> Self {
+        Data {
+            instrument: Pose::identity(),
+            frames: vec![Pose::identity(); model.links.len()],
+            targets: vec![Pose::identity(); model.targets.len()],
+            param_twists: vec![Twist::zero(); model.param_count()],
+            joint_twists: vec![Twist::zero(); model.dof()],
+        }
+    }
+
+    /// World pose of the tool frame (the end of the chain).
+    pub fn tool(&self) -> &Pose<T> {
+        self.frames.last().expect("a model has at least one link")
+    }
+}
+
+/// Evaluates the model at parameters `params` (internal units) and joints `q`, filling
+/// `data` with every frame pose and every parameter and joint twist. Allocates nothing.
+pub fn forward_kinematics<T: RealField + Copy>(
+    model: &Model,
+    data: &mut Data<T>,
+    params: &[f64],
+    q: &[T],
+) {
+    debug_assert_eq!(params.len(), model.param_count());
+    debug_assert_eq!(q.len(), model.dof());
+    let mut pose = Pose::identity();
+    for step in &model.instrument_steps {
+        apply_step(step, &mut pose, params, q, data);
+    }
+    data.instrument = pose;
+
+    let mut pose = Pose::identity();
+    let mut link = 0;
+    for (i, step) in model.chain_steps.iter().enumerate() {
+        apply_step(step, &mut pose, params, q, data);
+        while link < model.chain_step_end.len() && model.chain_step_end[link] == i + 1 {
+            data.frames[link] = pose;
+            link += 1;
+        }
+    }
+    // Links without steps cannot exist (every convention has at least one field), but keep
+    // the frames consistent anyway.
+    while link < model.chain_step_end.len() {
+        data.frames[link] = pose;
+        link += 1;
+    }
+    let tool = pose;
+    for (k, steps) in model.target_steps.iter().enumerate() {
+        let mut pose = tool;
+        for step in steps {
+            apply_step(step, &mut pose, params, q, data);
+        }
+        data.targets[k] = pose;
+    }
+}
+
+/// Convenience: world pose of the tool frame at `q` with the given parameters.
+pub fn tool_pose(model: &Model, params: &[f64], q: &[f64]) -> Pose<f64> {
+    let mut data = Data::new(model);
+    forward_kinematics(model, &mut data, params, q);
+    *data.tool()
+}
+
+#[inline]
+fn lift<T: RealField + Copy>(x: f64) -> T {
+    convert(x)
+}
+
+/// Multiplies `pose` by one elementary factor or screw and records the twists of the
+/// factor's parameter(s) and joint.
+#[inline]
+fn apply_step<T: RealField + Copy>(
+    step: &Step,
+    pose: &mut Pose<T>,
+    params: &[f64],
+    q: &[T],
+    data: &mut Data<T>,
+) {
+    match step {
+        Step::Elementary {
+            motion,
+            param,
+            joint,
+            axis,
+        } => {
+            let mut value: T = lift(params[*param]);
+            if let Some(j) = joint {
+                value += q[*j];
+            }
+            let world_axis = match motion {
+                Motion::Rx | Motion::Tx => pose.rot.column(0).into_owned(),
+                Motion::Ry | Motion::Ty => pose.rot.column(1).into_owned(),
+                Motion::Rz | Motion::Tz => pose.rot.column(2).into_owned(),
+                Motion::RotAxis | Motion::TransAxis => pose.rot * axis.map(lift::<T>),
+            };
+            let twist = match motion {
+                Motion::Rx | Motion::Ry | Motion::Rz | Motion::RotAxis => Twist {
+                    w: world_axis,
+                    v: pose.trans.cross(&world_axis),
+                },
+                _ => Twist {
+                    w: Vector3::zeros(),
+                    v: world_axis,
+                },
+            };
+            data.param_twists[*param] = twist;
+            if let Some(j) = joint {
+                data.joint_twists[*j] = twist;
+            }
+            match motion {
+                Motion::Rx => rotate_columns(pose, 1, 2, value),
+                Motion::Ry => rotate_columns(pose, 2, 0, value),
+                Motion::Rz => rotate_columns(pose, 0, 1, value),
+                Motion::RotAxis => pose.rot *= rot_axis(&axis.map(lift::<T>), value),
+                _ => pose.trans += world_axis * value,
+            }
+        }
+        Step::Screw {
+            first,
+            joint,
+            prismatic,
+        } => apply_screw(*first, *joint, *prismatic, pose, params, q, data),
+    }
+}
+
+/// Right-multiplies the rotation by an elementary rotation: columns `a`, `b` turn in their
+/// plane (`Rx`: y,z; `Ry`: z,x; `Rz`: x,y).
+#[inline]
+fn rotate_columns<T: RealField + Copy>(pose: &mut Pose<T>, a: usize, b: usize, angle: T) {
+    let (s, c) = angle.sin_cos();
+    let ca = pose.rot.column(a).into_owned();
+    let cb = pose.rot.column(b).into_owned();
+    pose.rot.set_column(a, &(ca * c + cb * s));
+    pose.rot.set_column(b, &(cb * c - ca * s));
+}
+
+/// Zero-reference screw `T(p) Rot(û, φ) T(−p)`, φ = offset + q, û = u/|u| (book eq. 2.70).
+/// Parameter twists in the screw's input frame:
+/// - offset (and joint): `(û, p × û)`;
+/// - `u_k`: `ω = sin φ dû + (1 − cos φ) û × dû`, `v = p × ω` with `dû = (e_k − û û_k)/|u|`
+///   (the left Jacobian of SO(3) applied to `φ dû`);
+/// - `p_k`: `(0, e_k − Rot e_k)`.
+///
+/// Prismatic: `T(û φ)`; offset `(0, û)`, `u_k` `(0, φ dû)`, `p` has no effect.
+fn apply_screw<T: RealField + Copy>(
+    first: usize,
+    joint: Option<usize>,
+    prismatic: bool,
+    pose: &mut Pose<T>,
+    params: &[f64],
+    q: &[T],
+    data: &mut Data<T>,
+) {
+    let u = Vector3::new(params[first], params[first + 1], params[first + 2]);
+    let norm = u.norm();
+    let uh: Vector3<T> = (u / norm).map(lift::<T>);
+    let p: Vector3<T> =
+        Vector3::new(params[first + 3], params[first + 4], params[first + 5]).map(lift::<T>);
+    let mut phi: T = lift(params[first + 6]);
+    if let Some(j) = joint {
+        phi += q[j];
+    }
+    let inv_norm: T = lift(1.0 / norm);
+    let du = |k: usize| -> Vector3<T> {
+        let mut e = Vector3::zeros();
+        e[k] = T::one();
+        (e - uh * uh[k]) * inv_norm
+    };
+    if prismatic {
+        let offset = pose.adjoint(&Twist {
+            w: Vector3::zeros(),
+            v: uh,
+        });
+        data.param_twists[first + 6] = offset;
+        if let Some(j) = joint {
+            data.joint_twists[j] = offset;
+        }
+        for k in 0..3 {
+            data.param_twists[first + k] = pose.adjoint(&Twist {
+                w: Vector3::zeros(),
+                v: du(k) * phi,
+            });
+            data.param_twists[first + 3 + k] = Twist::zero();
+        }
+        pose.trans += pose.rot * (uh * phi);
+        return;
+    }
+    let rot = rot_axis(&uh, phi);
+    let (s, c) = phi.sin_cos();
+    let offset = pose.adjoint(&Twist {
+        w: uh,
+        v: p.cross(&uh),
+    });
+    data.param_twists[first + 6] = offset;
+    if let Some(j) = joint {
+        data.joint_twists[j] = offset;
+    }
+    for k in 0..3 {
+        let d = du(k);
+        let w = d * s + uh.cross(&d) * (T::one() - c);
+        data.param_twists[first + k] = pose.adjoint(&Twist { w, v: p.cross(&w) });
+        let mut e = Vector3::zeros();
+        e[k] = T::one();
+        data.param_twists[first + 3 + k] = pose.adjoint(&Twist {
+            w: Vector3::zeros(),
+            v: e - rot.column(k),
+        });
+    }
+    let local = Pose {
+        rot,
+        trans: p - rot * p,
+    };
+    *pose = pose.compose(&local);
+}

@@ -1,0 +1,19 @@
+//! Kinematic models: conventions, chain, parameter registry, forward kinematics, exact
+//! Jacobians, identifiability, conversions and URDF.
+
+pub mod chain;
+pub mod jacobian;
+pub mod kinematics;
+pub mod link;
+pub mod pose;
+pub mod registry;
+
+pub use chain::{Link, LinkSpec, Model, ModelSpec};
+pub use jacobian::{
+    identification_jacobian, identification_jacobian_dq, joint_jacobian, observed_pose,
+    observed_position, MixedWorkspace, Observed, Rows,
+};
+pub use kinematics::{forward_kinematics, tool_pose, Data};
+pub use link::{Convention, Joint, JointKind, LinkGeometry, Motion};
+pub use pose::{Pose, Twist};
+pub use registry::{Parameter, Registry, Segment, Status, Unit};

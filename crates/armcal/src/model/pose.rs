@@ -1,0 +1,174 @@
+//! Rigid transforms and twists, generic over the scalar so the same kinematics code runs on
+//! `f64` and on dual numbers (for the mixed derivatives the pose-design gradients need).
+
+use nalgebra::{Matrix3, RealField, Vector3};
+
+/// Rigid transform `x ↦ R x + t` (a homogeneous matrix `[[R, t], [0, 1]]`, book eq. 2.5 with
+/// the (4,4) entry 1 as corrected in the errata).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pose<T: RealField + Copy> {
+    pub rot: Matrix3<T>,
+    pub trans: Vector3<T>,
+}
+
+impl<T: RealField + Copy> Pose<T> {
+    pub fn identity() -> Self {
+        Pose {
+            rot: Matrix3::identity(),
+            trans: Vector3::zeros(),
+        }
+    }
+
+    /// `self · other`.
+    pub fn compose(&self, other: &Pose<T>) -> Pose<T> {
+        Pose {
+            rot: self.rot * other.rot,
+            trans: self.rot * other.trans + self.trans,
+        }
+    }
+
+    pub fn inverse(&self) -> Pose<T> {
+        let rt = self.rot.transpose();
+        Pose {
+            rot: rt,
+            trans: -(rt * self.trans),
+        }
+    }
+
+    pub fn transform_point(&self, p: &Vector3<T>) -> Vector3<T> {
+        self.rot * p + self.trans
+    }
+
+    /// Homogeneous 4×4 matrix, row major, for printing and exports.
+    pub fn to_matrix(&self) -> [[T; 4]; 4] {
+        let z = T::zero();
+        let r = &self.rot;
+        let t = &self.trans;
+        [
+            [r[(0, 0)], r[(0, 1)], r[(0, 2)], t[0]],
+            [r[(1, 0)], r[(1, 1)], r[(1, 2)], t[1]],
+            [r[(2, 0)], r[(2, 1)], r[(2, 2)], t[2]],
+            [z, z, z, T::one()],
+        ]
+    }
+
+    /// Adjoint action on a twist given in this pose's local frame: the same infinitesimal
+    /// motion expressed in the parent frame, `ω' = R ω`, `v' = R v + t × R ω`.
+    pub fn adjoint(&self, local: &Twist<T>) -> Twist<T> {
+        let w = self.rot * local.w;
+        Twist {
+            w,
+            v: self.rot * local.v + self.trans.cross(&w),
+        }
+    }
+}
+
+impl Pose<f64> {
+    /// Translation followed by the fixed-axis roll–pitch–yaw rotation `Rz(yaw) Ry(pitch) Rx(roll)`,
+    /// the URDF `<origin xyz rpy>` convention. Lengths in mm, angles in rad.
+    pub fn from_xyz_rpy(xyz: [f64; 3], rpy: [f64; 3]) -> Pose<f64> {
+        Pose {
+            rot: rot_z(rpy[2]) * rot_y(rpy[1]) * rot_x(rpy[0]),
+            trans: Vector3::from(xyz),
+        }
+    }
+
+    /// Inverse of [`Pose::from_xyz_rpy`]: (xyz, rpy) with pitch in [−π/2, π/2].
+    pub fn to_xyz_rpy(&self) -> ([f64; 3], [f64; 3]) {
+        let r = &self.rot;
+        let pitch = (-r[(2, 0)]).atan2((r[(0, 0)].powi(2) + r[(1, 0)].powi(2)).sqrt());
+        let (roll, yaw) = if pitch.cos().abs() < 1e-12 {
+            // Gimbal lock: put the whole rotation about z into yaw.
+            (0.0, (-r[(0, 1)]).atan2(r[(1, 1)]))
+        } else {
+            (r[(2, 1)].atan2(r[(2, 2)]), r[(1, 0)].atan2(r[(0, 0)]))
+        };
+        (
+            [self.trans[0], self.trans[1], self.trans[2]],
+            [roll, pitch, yaw],
+        )
+    }
+
+    /// Rotation angle (rad) between two orientations.
+    pub fn rotation_angle_to(&self, other: &Pose<f64>) -> f64 {
+        let r = self.rot.transpose() * other.rot;
+        ((r.trace() - 1.0) / 2.0).clamp(-1.0, 1.0).acos()
+    }
+}
+
+/// Infinitesimal rigid motion: angular part `w` and linear part `v`, so that a point `p`
+/// moves with velocity `w × p + v` (book §2.4 differential transformation `δ`, `d`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Twist<T: RealField + Copy> {
+    pub w: Vector3<T>,
+    pub v: Vector3<T>,
+}
+
+impl<T: RealField + Copy> Twist<T> {
+    pub fn zero() -> Self {
+        Twist {
+            w: Vector3::zeros(),
+            v: Vector3::zeros(),
+        }
+    }
+
+    /// Velocity of the point `p` under this twist: `w × p + v`.
+    pub fn point_velocity(&self, p: &Vector3<T>) -> Vector3<T> {
+        self.w.cross(p) + self.v
+    }
+}
+
+pub fn rot_x<T: RealField + Copy>(a: T) -> Matrix3<T> {
+    let (s, c) = a.sin_cos();
+    let (o, z) = (T::one(), T::zero());
+    Matrix3::new(o, z, z, z, c, -s, z, s, c)
+}
+
+pub fn rot_y<T: RealField + Copy>(a: T) -> Matrix3<T> {
+    let (s, c) = a.sin_cos();
+    let (o, z) = (T::one(), T::zero());
+    Matrix3::new(c, z, s, z, o, z, -s, z, c)
+}
+
+pub fn rot_z<T: RealField + Copy>(a: T) -> Matrix3<T> {
+    let (s, c) = a.sin_cos();
+    let (o, z) = (T::one(), T::zero());
+    Matrix3::new(c, -s, z, s, c, z, z, z, o)
+}
+
+/// Rotation by `angle` about the unit axis `u` (Rodrigues' formula, book eq. 2.58).
+pub fn rot_axis<T: RealField + Copy>(u: &Vector3<T>, angle: T) -> Matrix3<T> {
+    let (s, c) = angle.sin_cos();
+    let k = u.cross_matrix();
+    Matrix3::identity() + k * s + k * k * (T::one() - c)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn xyz_rpy_round_trip() {
+        let p = Pose::from_xyz_rpy([1.0, -2.0, 3.0], [0.3, -1.1, 2.5]);
+        let (xyz, rpy) = p.to_xyz_rpy();
+        let q = Pose::from_xyz_rpy(xyz, rpy);
+        assert!((p.rot - q.rot).norm() < 1e-12);
+        assert!((p.trans - q.trans).norm() < 1e-12);
+    }
+
+    #[test]
+    fn rodrigues_matches_elementary_rotations() {
+        let a = 0.7;
+        assert!((rot_axis(&Vector3::x(), a) - rot_x(a)).norm() < 1e-14);
+        assert!((rot_axis(&Vector3::y(), a) - rot_y(a)).norm() < 1e-14);
+        assert!((rot_axis(&Vector3::z(), a) - rot_z(a)).norm() < 1e-14);
+    }
+
+    #[test]
+    fn inverse_composes_to_identity() {
+        let p = Pose::from_xyz_rpy([10.0, 20.0, -5.0], [0.1, 0.2, 0.3]);
+        let i = p.compose(&p.inverse());
+        assert!((i.rot - Matrix3::identity()).norm() < 1e-14);
+        assert!(i.trans.norm() < 1e-12);
+    }
+}

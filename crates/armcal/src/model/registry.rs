@@ -1,0 +1,244 @@
+//! The parameter registry: every scalar of a model has a stable name (`j2.beta`, `base.rz`,
+//! `tracker.x`, `smr1.y`), a unit, a nominal value and a status. Parameter vectors are
+//! indexed through the registry. Internal units are millimetres and radians.
+
+use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
+use std::fmt;
+
+/// Physical unit of a parameter. Internal values are in mm or rad; user-facing values of
+/// angles are shown in degrees.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Unit {
+    /// Length, stored in millimetres.
+    Mm,
+    /// Angle, stored in radians (shown in degrees).
+    Rad,
+    /// Dimensionless (components of a unit axis vector).
+    Unitless,
+}
+
+impl Unit {
+    /// Factor from the internal unit to the display unit (mm, deg, 1).
+    pub fn display_factor(self) -> f64 {
+        match self {
+            Unit::Rad => 180.0 / std::f64::consts::PI,
+            _ => 1.0,
+        }
+    }
+
+    /// Name of the display unit.
+    pub fn display_name(self) -> &'static str {
+        match self {
+            Unit::Mm => "mm",
+            Unit::Rad => "deg",
+            Unit::Unitless => "1",
+        }
+    }
+}
+
+/// Whether a parameter is estimated.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase", tag = "status")]
+pub enum Status {
+    /// Estimated from the data.
+    Free,
+    /// Held at its nominal value.
+    Fixed,
+    /// Estimated, with a Gaussian prior centred on the nominal value (σ in internal units).
+    Prior { sigma: f64 },
+}
+
+impl Status {
+    pub fn is_free(&self) -> bool {
+        !matches!(self, Status::Fixed)
+    }
+}
+
+/// Which part of the measurement chain a parameter belongs to. It decides which targets a
+/// parameter moves and with which sign (instrument parameters enter inverted, paper eq. 3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Segment {
+    /// The instrument frame (e.g. the laser tracker pose in the world).
+    Instrument,
+    /// Base frame, links and tool: moves every target.
+    Chain,
+    /// The offset of one target (reflector, SMR, tool frame) from the tool frame.
+    Target(usize),
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Parameter {
+    /// Stable name, `<frame>.<field>`.
+    pub name: String,
+    pub unit: Unit,
+    /// Nominal value in internal units (mm, rad).
+    pub nominal: f64,
+    pub status: Status,
+    pub segment: Segment,
+}
+
+impl Parameter {
+    /// The part of the name before the dot (`j2` of `j2.beta`).
+    pub fn frame(&self) -> &str {
+        self.name.split('.').next().unwrap_or(&self.name)
+    }
+}
+
+/// Ordered set of named parameters.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct Registry {
+    params: Vec<Parameter>,
+    #[serde(skip)]
+    index: HashMap<String, usize>,
+}
+
+impl Registry {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds a parameter and returns its index. Names must be unique.
+    pub fn add(
+        &mut self,
+        name: String,
+        unit: Unit,
+        nominal: f64,
+        segment: Segment,
+    ) -> Result<usize, crate::Error> {
+        if self.index.contains_key(&name) {
+            return Err(crate::Error::Model(format!(
+                "parameter name `{name}` is used twice; frame names must be unique"
+            )));
+        }
+        let i = self.params.len();
+        self.index.insert(name.clone(), i);
+        self.params.push(Parameter {
+            name,
+            unit,
+            nominal,
+            status: Status::Free,
+            segment,
+        });
+        Ok(i)
+    }
+
+    pub fn len(&self) -> usize {
+        self.params.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.params.is_empty()
+    }
+
+    pub fn get(&self, i: usize) -> &Parameter {
+        &self.params[i]
+    }
+
+    pub fn iter(&self) -> impl Iterator<Item = &Parameter> {
+        self.params.iter()
+    }
+
+    pub fn index_of(&self, name: &str) -> Option<usize> {
+        self.index.get(name).copied()
+    }
+
+    /// Index of a parameter, or an error that lists similar names.
+    pub fn require(&self, name: &str) -> Result<usize, crate::Error> {
+        self.index_of(name).ok_or_else(|| {
+            let frame = name.split('.').next().unwrap_or(name);
+            let similar: Vec<&str> = self
+                .params
+                .iter()
+                .filter(|p| p.frame() == frame)
+                .map(|p| p.name.as_str())
+                .collect();
+            let hint = if similar.is_empty() {
+                let frames: Vec<&str> = self.frames();
+                format!("known frames: {}", frames.join(", "))
+            } else {
+                format!("parameters of `{frame}`: {}", similar.join(", "))
+            };
+            crate::Error::Model(format!("unknown parameter `{name}` ({hint})"))
+        })
+    }
+
+    /// Frame names in order of first appearance.
+    pub fn frames(&self) -> Vec<&str> {
+        let mut out: Vec<&str> = Vec::new();
+        for p in &self.params {
+            if out.last() != Some(&p.frame()) && !out.contains(&p.frame()) {
+                out.push(p.frame());
+            }
+        }
+        out
+    }
+
+    /// Indices of parameters whose name matches a pattern: an exact name, a whole frame
+    /// (`j6` or `j6.*`), or a field across frames (`*.theta`).
+    pub fn matching(&self, pattern: &str) -> Result<Vec<usize>, crate::Error> {
+        let (frame, field) = match pattern.split_once('.') {
+            Some((f, g)) => (f, g),
+            None => (pattern, "*"),
+        };
+        let out: Vec<usize> = self
+            .params
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| {
+                let (pf, pg) = p.name.split_once('.').unwrap_or((&p.name, ""));
+                (frame == "*" || frame == pf) && (field == "*" || field == pg)
+            })
+            .map(|(i, _)| i)
+            .collect();
+        if out.is_empty() {
+            // Produce the helpful error for the exact-name case.
+            self.require(pattern)?;
+        }
+        Ok(out)
+    }
+
+    pub fn set_status(&mut self, i: usize, status: Status) {
+        self.params[i].status = status;
+    }
+
+    pub fn set_nominal(&mut self, i: usize, value: f64) {
+        self.params[i].nominal = value;
+    }
+
+    /// Nominal parameter vector.
+    pub fn nominal(&self) -> Vec<f64> {
+        self.params.iter().map(|p| p.nominal).collect()
+    }
+
+    /// Indices of the parameters whose status is free or prior.
+    pub fn free(&self) -> Vec<usize> {
+        (0..self.len())
+            .filter(|&i| self.params[i].status.is_free())
+            .collect()
+    }
+
+    /// Rebuilds the name index (after deserialisation).
+    pub fn reindex(&mut self) {
+        self.index = self
+            .params
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (p.name.clone(), i))
+            .collect();
+    }
+}
+
+impl fmt::Display for Parameter {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} = {:.6} {}",
+            self.name,
+            self.nominal * self.unit.display_factor(),
+            self.unit.display_name()
+        )
+    }
+}

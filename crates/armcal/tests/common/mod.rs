@@ -1,0 +1,146 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use armcal::model::*;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+pub fn rng(seed: u64) -> ChaCha8Rng {
+    ChaCha8Rng::seed_from_u64(seed)
+}
+
+/// Random values for a convention's fields: lengths in ±400 mm, angles in ±π, ZRP axes
+/// random non-unit vectors.
+pub fn random_geometry(c: Convention, kind: Option<JointKind>, r: &mut ChaCha8Rng) -> LinkGeometry {
+    let fields = c.fields(kind);
+    let values = fields
+        .iter()
+        .map(|(_, u)| match u {
+            Unit::Mm => r.random_range(-400.0..400.0),
+            Unit::Rad => r.random_range(-3.0..3.0),
+            Unit::Unitless => r.random_range(-1.5..1.5),
+        })
+        .collect();
+    let mut g = LinkGeometry::new(c, values);
+    if c == Convention::Urdf {
+        g.axis = Some([
+            r.random_range(-1.0..1.0),
+            r.random_range(-1.0..1.0),
+            r.random_range(0.2..1.0),
+        ]);
+    }
+    g
+}
+
+pub fn joint(name: &str, kind: JointKind) -> Joint {
+    let (lower, upper) = match kind {
+        JointKind::Revolute => (-3.2, 3.2),
+        JointKind::Prismatic => (-500.0, 500.0),
+    };
+    Joint {
+        name: name.into(),
+        kind,
+        lower,
+        upper,
+    }
+}
+
+/// A chain that uses every joint convention once with a revolute and once with a prismatic
+/// joint, plus instrument, base, tool, a point target and a frame target.
+pub fn every_convention_model(seed: u64) -> Model {
+    let mut r = rng(seed);
+    let mut links = vec![LinkSpec {
+        name: "base".into(),
+        geometry: random_geometry(Convention::Frame6, None, &mut r),
+        joint: None,
+    }];
+    let mut n = 0;
+    for c in [
+        Convention::Dh,
+        Convention::Hayati,
+        Convention::Mdh,
+        Convention::SModel,
+        Convention::BookType3,
+        Convention::Urdf,
+        Convention::Zrp,
+    ] {
+        for kind in [JointKind::Revolute, JointKind::Prismatic] {
+            n += 1;
+            links.push(LinkSpec {
+                name: format!("j{n}"),
+                geometry: random_geometry(c, Some(kind), &mut r),
+                joint: Some(joint(&format!("q{n}"), kind)),
+            });
+        }
+    }
+    links.push(LinkSpec {
+        name: "tool".into(),
+        geometry: random_geometry(Convention::Frame6, None, &mut r),
+        joint: None,
+    });
+    let spec = ModelSpec {
+        name: "every-convention".into(),
+        instrument: Some(LinkSpec {
+            name: "tracker".into(),
+            geometry: random_geometry(Convention::Frame6, None, &mut r),
+            joint: None,
+        }),
+        links,
+        targets: vec![
+            LinkSpec {
+                name: "smr1".into(),
+                geometry: random_geometry(Convention::Point, None, &mut r),
+                joint: None,
+            },
+            LinkSpec {
+                name: "tcp".into(),
+                geometry: random_geometry(Convention::BookType3, None, &mut r),
+                joint: None,
+            },
+        ],
+    };
+    Model::from_spec(&spec).expect("valid model")
+}
+
+pub fn random_q(model: &Model, r: &mut ChaCha8Rng) -> Vec<f64> {
+    model
+        .joints
+        .iter()
+        .map(|j| r.random_range(j.lower..j.upper))
+        .collect()
+}
+
+/// Observed position and rotation of `obs` in the instrument frame.
+pub fn measure(model: &Model, params: &[f64], q: &[f64], obs: Observed) -> Pose<f64> {
+    let mut d = Data::new(model);
+    forward_kinematics(model, &mut d, params, q);
+    observed_pose(&d, obs)
+}
+
+/// Central finite difference of the 6-D measurement (position, rotation vector) along
+/// a perturbation applied by `perturb(±h)`.
+pub fn fd_pose(mut eval: impl FnMut(f64) -> Pose<f64>, h: f64) -> [f64; 6] {
+    let p = eval(h);
+    let m = eval(-h);
+    let c = eval(0.0);
+    let dt = (p.trans - m.trans) / (2.0 * h);
+    let dr = (p.rot - m.rot) / (2.0 * h) * c.rot.transpose();
+    [
+        dt[0],
+        dt[1],
+        dt[2],
+        0.5 * (dr[(2, 1)] - dr[(1, 2)]),
+        0.5 * (dr[(0, 2)] - dr[(2, 0)]),
+        0.5 * (dr[(1, 0)] - dr[(0, 1)]),
+    ]
+}
+
+/// |a − b| ≤ tol · max(1, |b|) element-wise, with a message naming the entry.
+pub fn assert_close(a: f64, b: f64, tol: f64, what: &str) {
+    let scale = b.abs().max(1.0);
+    assert!(
+        (a - b).abs() <= tol * scale,
+        "{what}: analytic {a:.12e} vs reference {b:.12e} (rel. error {:.3e})",
+        (a - b).abs() / scale
+    );
+}
