@@ -2,11 +2,14 @@
 //! Jacobians, identifiability, conversions and URDF.
 
 pub mod chain;
+pub mod convert;
+pub mod identifiability;
 pub mod jacobian;
 pub mod kinematics;
 pub mod link;
 pub mod pose;
 pub mod registry;
+pub mod urdf;
 
 pub use chain::{Link, LinkSpec, Model, ModelSpec};
 pub use jacobian::{

@@ -1,0 +1,1 @@
+//! Completeness and identifiability of a model for a measurement type.

@@ -1,0 +1,1 @@
+//! URDF import and export (urdf-rs): joints ↔ general frames.

@@ -1,0 +1,114 @@
+//! Built-in robots: nominal geometry, joint limits, link capsules for collision checks, and
+//! a note on where the numbers come from and what is approximate.
+//!
+//! A robot is a [`ModelSpec`] with base frame, links and tool frame (no instrument and no
+//! targets: those belong to a cell). Lengths in mm, angles in rad, as everywhere inside
+//! armcal.
+
+mod paper;
+
+use crate::model::{Joint, JointKind, LinkGeometry, LinkSpec, ModelSpec};
+use crate::Error;
+use serde::{Deserialize, Serialize};
+
+/// A capsule (segment `a`–`b` swept by a sphere of `radius`) fixed to a chain frame, in that
+/// frame's coordinates (mm).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Capsule {
+    /// Name of the chain frame (`base`, `j1`, …, `tool`) the capsule moves with.
+    pub frame: String,
+    pub a: [f64; 3],
+    pub b: [f64; 3],
+    pub radius: f64,
+}
+
+/// A robot of the library.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Robot {
+    /// Library name (`armcal robots` lists them).
+    pub name: String,
+    /// One line: what the robot is.
+    pub summary: String,
+    /// Where the numbers come from and what is approximate.
+    pub source: String,
+    /// Base frame, links, tool frame; joint limits inside.
+    pub spec: ModelSpec,
+    /// Link capsules for collision checks.
+    pub capsules: Vec<Capsule>,
+}
+
+/// Name and summary of every built-in robot.
+pub fn list() -> Vec<(String, String)> {
+    NAMES
+        .iter()
+        .map(|n| {
+            let r = robot(n).expect("library robots build");
+            (r.name, r.summary)
+        })
+        .collect()
+}
+
+/// Library names (the notional family also answers to `paper-<λ>-<μ>`).
+pub const NAMES: &[&str] = &["paper"];
+
+/// A built-in robot by name.
+pub fn robot(name: &str) -> Result<Robot, Error> {
+    if let Some(rest) = name.strip_prefix("paper-") {
+        let (l, m) = rest.split_once('-').ok_or_else(|| {
+            Error::Input(format!("`{name}`: the notional robot is named paper-<λ mm>-<μ mm>, e.g. paper-650-600"))
+        })?;
+        let parse = |s: &str| {
+            s.parse::<f64>()
+                .map_err(|_| Error::Input(format!("`{name}`: `{s}` is not a length in mm")))
+        };
+        return Ok(paper::notional(parse(l)?, parse(m)?));
+    }
+    match name {
+        "paper" => Ok(paper::notional(650.0, 600.0)),
+        _ => Err(Error::Input(format!(
+            "unknown robot `{name}`; built-in robots: {}",
+            NAMES.join(", ")
+        ))),
+    }
+}
+
+pub(crate) fn deg(x: f64) -> f64 {
+    x.to_radians()
+}
+
+/// A revolute joint with limits in degrees.
+pub(crate) fn revolute(name: &str, lower_deg: f64, upper_deg: f64) -> Joint {
+    Joint {
+        name: name.into(),
+        kind: JointKind::Revolute,
+        lower: deg(lower_deg),
+        upper: deg(upper_deg),
+    }
+}
+
+/// A link spec with a revolute joint `q<i>` named after the link `j<i>`.
+pub(crate) fn joint_link(i: usize, geometry: LinkGeometry, limits_deg: (f64, f64)) -> LinkSpec {
+    LinkSpec {
+        name: format!("j{i}"),
+        geometry,
+        joint: Some(revolute(&format!("q{i}"), limits_deg.0, limits_deg.1)),
+    }
+}
+
+/// A fixed frame link (base, tool) from xyz (mm) and roll-pitch-yaw (deg).
+pub(crate) fn frame_link(name: &str, xyz: [f64; 3], rpy_deg: [f64; 3]) -> LinkSpec {
+    LinkSpec {
+        name: name.into(),
+        geometry: LinkGeometry::frame6(xyz, rpy_deg.map(deg)),
+        joint: None,
+    }
+}
+
+pub(crate) fn capsule(frame: &str, a: [f64; 3], b: [f64; 3], radius: f64) -> Capsule {
+    Capsule {
+        frame: frame.into(),
+        a,
+        b,
+        radius,
+    }
+}
