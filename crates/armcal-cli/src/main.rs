@@ -1,1 +1,39 @@
-fn main() {}
+//! `armcal`: the command-line front end. It parses arguments, calls the library, prints.
+
+mod commands;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(
+    name = "armcal",
+    version,
+    about = "Kinematic calibration of industrial robots: model, plan poses, identify, compensate, prove accuracy"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// List the built-in robots.
+    Robots,
+    /// Parameter table, completeness count and identifiability report of a robot or cell.
+    Model(commands::model::Args),
+    /// Forward kinematics: pose of every frame at a joint configuration.
+    Fk(commands::fk::Args),
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Robots => commands::robots::run(),
+        Command::Model(a) => commands::model::run(&a),
+        Command::Fk(a) => commands::fk::run(&a),
+    };
+    if let Err(e) = result {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}

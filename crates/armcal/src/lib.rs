@@ -5,6 +5,7 @@
 //! (1991) ("book") and Jost, Kudruss, Körkel & Walter (2017), optimum experimental design of
 //! laser-tracker measurement poses ("paper").
 
+pub mod cell;
 pub mod error;
 pub mod model;
 pub mod robots;

@@ -1,1 +1,475 @@
 //! Completeness and identifiability of a model for a measurement type.
+//!
+//! The book's count (book §2.3, eq. 2.49): a complete, minimal model of a serial robot has
+//! `N = 4R + 2P + 6` parameters. What a calibration can identify also depends on what is
+//! measured: a point instead of a full pose loses the tool orientation (3), distances lose
+//! the placement of the robot (6), and special geometry loses more (book Prop. 4.7.3: 25
+//! instead of 27 for the PUMA when the tool origin lies on axis 6).
+//!
+//! The numerical analysis stacks the identification Jacobian over random configurations,
+//! scales every column to unit norm (so mm and rad compare), and
+//! * counts the rank by SVD and by QR with column pivoting;
+//! * picks the minimal identifiable set greedily in a preference order (instrument, targets,
+//!   base, tool, then links from base to tip), keeping a parameter only if its scaled column
+//!   is not in the span of those already kept (Gram–Schmidt with re-orthogonalisation);
+//! * explains every parameter left out by the kept parameters its column is a combination
+//!   of ("`j1.theta` cannot be separated from `tracker.rz`, ...").
+
+use crate::model::chain::Model;
+use crate::model::jacobian::{identification_jacobian, Observed, Rows};
+use crate::model::kinematics::{forward_kinematics, Data};
+use crate::model::link::JointKind;
+use crate::model::registry::{Segment, Status};
+use crate::Error;
+use nalgebra::{DMatrix, DVector};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+/// What the instrument measures, for the identifiability analysis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Measurement {
+    /// Full 6-D pose of the frame targets (or of the tool frame if there are none).
+    Pose,
+    /// Position of every point target (or of the tool origin if there are none).
+    Position,
+    /// Distances between the positions at successive configurations (ball bar, or a
+    /// tracker used as a distance meter): the placement of the robot is not observable.
+    Distance,
+}
+
+impl Measurement {
+    pub fn from_name(s: &str) -> Option<Measurement> {
+        match s {
+            "pose" | "full-pose" => Some(Measurement::Pose),
+            "position" => Some(Measurement::Position),
+            "distance" => Some(Measurement::Distance),
+            _ => None,
+        }
+    }
+}
+
+/// Settings of the analysis.
+#[derive(Clone, Debug)]
+pub struct IdentifiabilityOptions {
+    pub measurement: Measurement,
+    /// Number of random configurations (uniform within the joint limits).
+    pub poses: usize,
+    pub seed: u64,
+    /// A scaled column whose component orthogonal to the kept columns is below this is
+    /// dependent; also the relative singular-value threshold of the rank.
+    pub tolerance: f64,
+}
+
+impl Default for IdentifiabilityOptions {
+    fn default() -> Self {
+        IdentifiabilityOptions {
+            measurement: Measurement::Position,
+            poses: 60,
+            seed: 1,
+            tolerance: 1e-8,
+        }
+    }
+}
+
+/// Why a parameter is not in the identifiable set.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Exclusion {
+    pub name: String,
+    pub reason: String,
+    /// Kept parameters whose combination reproduces this one's effect, with the
+    /// coefficient in column-normalised units, largest first.
+    pub partners: Vec<(String, f64)>,
+}
+
+/// The book's completeness count for the model's joints.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Completeness {
+    pub revolute: usize,
+    pub prismatic: usize,
+    /// `4R + 2P + 6` (book eq. 2.49): parameters of a complete, minimal model of the
+    /// pose of the tool relative to the world.
+    pub complete_pose_model: usize,
+    /// What the measurement type identifies in generic geometry (see [`expected_count`]).
+    pub expected_for_measurement: Option<usize>,
+}
+
+/// Result of the analysis.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Identifiability {
+    pub measurement: Measurement,
+    pub poses: usize,
+    pub completeness: Completeness,
+    /// Parameters analysed (free or with prior).
+    pub candidates: Vec<String>,
+    /// Parameters the user or cell fixed; not analysed.
+    pub fixed: Vec<String>,
+    pub rank_svd: usize,
+    pub rank_qr: usize,
+    /// Singular values of the column-normalised Jacobian of all candidates, descending.
+    pub singular_values: Vec<f64>,
+    /// The minimal identifiable set, in registry order.
+    pub identifiable: Vec<String>,
+    /// Condition number σmax/σmin of the column-normalised Jacobian of the identifiable set.
+    pub condition_number: f64,
+    pub excluded: Vec<Exclusion>,
+}
+
+/// Number of parameters a measurement type can identify for a model in generic geometry,
+/// where the book gives a count: `4R + 2P + 6` for a full pose; `4R + 2P + 3` for the
+/// position of one point (the tool orientation is not measured, book §4.7, Prop. 4.7.3);
+/// `4R + 2P − 3` for distances of one point (the placement of the robot, 6, is lost).
+/// `None` for several points, whose count depends on their layout.
+pub fn expected_count(model: &Model, m: Measurement) -> Option<usize> {
+    let (r, p) = joint_counts(model);
+    let base = 4 * r + 2 * p;
+    let single_point = model.targets.len() <= 1;
+    match m {
+        Measurement::Pose => Some(base + 6),
+        Measurement::Position if single_point => Some(base + 3),
+        Measurement::Distance if single_point => (base + 3).checked_sub(6),
+        _ => None,
+    }
+}
+
+fn joint_counts(model: &Model) -> (usize, usize) {
+    let r = model
+        .joints
+        .iter()
+        .filter(|j| j.kind == JointKind::Revolute)
+        .count();
+    (r, model.dof() - r)
+}
+
+/// Preference rank of a parameter when choosing the identifiable set (lower is kept first).
+fn preference(model: &Model, i: usize) -> (usize, usize) {
+    let p = model.registry.get(i);
+    let last = model.links.len() - 1;
+    let link_of = |i: usize| {
+        model
+            .links
+            .iter()
+            .position(|l| i >= l.first_param && i < l.first_param + l.param_count())
+    };
+    let group = match p.segment {
+        Segment::Instrument => 0,
+        Segment::Target(_) => 1,
+        Segment::Chain => match link_of(i) {
+            Some(0) => 2,
+            Some(l) if l == last => 3,
+            _ => 4,
+        },
+    };
+    (group, i)
+}
+
+/// The observed frames and rows for a measurement type.
+fn observations(model: &Model, m: Measurement) -> Vec<(Observed, Rows)> {
+    let frames: Vec<usize> = (0..model.targets.len())
+        .filter(|&k| model.target_is_frame(k))
+        .collect();
+    let points: Vec<usize> = (0..model.targets.len())
+        .filter(|&k| !model.target_is_frame(k))
+        .collect();
+    match m {
+        Measurement::Pose => {
+            if frames.is_empty() {
+                vec![(Observed::Tool, Rows::Pose)]
+            } else {
+                frames
+                    .into_iter()
+                    .map(|k| (Observed::Target(k), Rows::Pose))
+                    .collect()
+            }
+        }
+        Measurement::Position | Measurement::Distance => {
+            if model.targets.is_empty() {
+                vec![(Observed::Tool, Rows::Position)]
+            } else {
+                points
+                    .into_iter()
+                    .chain(frames)
+                    .map(|k| (Observed::Target(k), Rows::Position))
+                    .collect()
+            }
+        }
+    }
+}
+
+/// Uniform random configurations within the joint limits (seeded).
+pub fn random_configurations(model: &Model, n: usize, seed: u64) -> Vec<Vec<f64>> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    (0..n)
+        .map(|_| {
+            model
+                .joints
+                .iter()
+                .map(|j| {
+                    if j.upper > j.lower {
+                        rng.random_range(j.lower..j.upper)
+                    } else {
+                        j.lower
+                    }
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Stacked identification Jacobian for a measurement type over configurations `qs`, one
+/// column per entry of `columns`.
+pub fn stacked_jacobian(
+    model: &Model,
+    params: &[f64],
+    qs: &[Vec<f64>],
+    m: Measurement,
+    columns: &[usize],
+) -> DMatrix<f64> {
+    let obs = observations(model, m);
+    let per_pose: usize = obs.iter().map(|(_, r)| r.count()).sum();
+    let mut data = Data::new(model);
+    let mut full = DMatrix::zeros(per_pose * qs.len(), columns.len());
+    for (i, q) in qs.iter().enumerate() {
+        forward_kinematics(model, &mut data, params, q);
+        let mut row = i * per_pose;
+        for &(o, r) in &obs {
+            identification_jacobian(model, &data, o, r, columns, &mut full, row);
+            row += r.count();
+        }
+    }
+    if m != Measurement::Distance {
+        return full;
+    }
+    // Distance between the point at pose i and at pose i+1: row = d̂ᵀ (J_i − J_{i+1}).
+    let mut positions = Vec::with_capacity(qs.len());
+    for q in qs {
+        forward_kinematics(model, &mut data, params, q);
+        positions.push(
+            obs.iter()
+                .map(|&(o, _)| crate::model::jacobian::observed_position(&data, o))
+                .collect::<Vec<_>>(),
+        );
+    }
+    let pairs = qs.len().saturating_sub(1);
+    let mut dist = DMatrix::zeros(pairs * obs.len(), columns.len());
+    for i in 0..pairs {
+        for (k, _) in obs.iter().enumerate() {
+            let d = positions[i][k] - positions[i + 1][k];
+            let n = d.norm();
+            if n < 1e-9 {
+                continue;
+            }
+            let dh = d / n;
+            for c in 0..columns.len() {
+                let mut s = 0.0;
+                for a in 0..3 {
+                    s += dh[a]
+                        * (full[(i * per_pose + 3 * k + a, c)]
+                            - full[((i + 1) * per_pose + 3 * k + a, c)]);
+                }
+                dist[(i * obs.len() + k, c)] = s;
+            }
+        }
+    }
+    dist
+}
+
+/// Analyses which free parameters of `model` can be identified at `params` from the given
+/// measurement type.
+pub fn analyze(
+    model: &Model,
+    params: &[f64],
+    opts: &IdentifiabilityOptions,
+) -> Result<Identifiability, Error> {
+    let qs = random_configurations(model, opts.poses.max(2), opts.seed);
+    analyze_at(model, params, &qs, opts)
+}
+
+/// As [`analyze`], at given configurations (e.g. a user's measurement poses).
+pub fn analyze_at(
+    model: &Model,
+    params: &[f64],
+    qs: &[Vec<f64>],
+    opts: &IdentifiabilityOptions,
+) -> Result<Identifiability, Error> {
+    for q in qs {
+        model.check_joints(q)?;
+    }
+    let mut candidates: Vec<usize> = model.registry.free();
+    let fixed: Vec<String> = (0..model.param_count())
+        .filter(|&i| model.registry.get(i).status == Status::Fixed)
+        .map(|i| model.registry.get(i).name.clone())
+        .collect();
+    candidates.sort_by_key(|&i| preference(model, i));
+    let jac = stacked_jacobian(model, params, qs, opts.measurement, &candidates);
+    let name = |i: usize| model.registry.get(i).name.clone();
+
+    // Column scaling to unit norm; zero columns stay zero.
+    let norms: Vec<f64> = (0..jac.ncols()).map(|c| jac.column(c).norm()).collect();
+    let max_norm = norms.iter().cloned().fold(0.0, f64::max);
+    let mut scaled = jac.clone();
+    for (c, &n) in norms.iter().enumerate() {
+        if n > 1e-12 * max_norm.max(1e-300) {
+            scaled.column_mut(c).unscale_mut(n);
+        } else {
+            scaled.column_mut(c).fill(0.0);
+        }
+    }
+
+    let mut sv: Vec<f64> = if scaled.ncols() > 0 {
+        scaled
+            .clone()
+            .svd(false, false)
+            .singular_values
+            .iter()
+            .copied()
+            .collect()
+    } else {
+        Vec::new()
+    };
+    sv.sort_by(|a, b| b.partial_cmp(a).unwrap_or(std::cmp::Ordering::Equal));
+    let smax = sv.first().copied().unwrap_or(0.0);
+    let rank_svd = sv
+        .iter()
+        .filter(|&&s| s > opts.tolerance * smax.max(1e-300))
+        .count();
+    let rank_qr = if scaled.ncols() > 0 && scaled.nrows() > 0 {
+        let r = scaled.clone().col_piv_qr().r();
+        let d0 = r[(0, 0)].abs();
+        (0..r.nrows().min(r.ncols()))
+            .filter(|&i| r[(i, i)].abs() > opts.tolerance * d0.max(1e-300))
+            .count()
+    } else {
+        0
+    };
+
+    // Greedy selection in preference order (Gram–Schmidt, twice for stability).
+    let mut basis: Vec<DVector<f64>> = Vec::new();
+    let mut kept = Vec::new();
+    let mut dropped = Vec::new();
+    for c in 0..scaled.ncols() {
+        let mut v = scaled.column(c).into_owned();
+        if norms[c] <= 1e-12 * max_norm.max(1e-300) {
+            dropped.push(c);
+            continue;
+        }
+        for _ in 0..2 {
+            for b in &basis {
+                let d = b.dot(&v);
+                v.axpy(-d, b, 1.0);
+            }
+        }
+        let n = v.norm();
+        if n > opts.tolerance.sqrt() {
+            basis.push(v / n);
+            kept.push(c);
+        } else {
+            dropped.push(c);
+        }
+    }
+
+    let kept_matrix = DMatrix::from_fn(scaled.nrows(), kept.len(), |r, k| scaled[(r, kept[k])]);
+    let condition_number = if kept.is_empty() {
+        f64::INFINITY
+    } else {
+        let s = kept_matrix.clone().svd(false, false).singular_values;
+        s.max() / s.min()
+    };
+    let qr = kept_matrix.clone().qr();
+    let (q, r) = (qr.q(), qr.r());
+    let mut excluded = Vec::new();
+    for &c in &dropped {
+        let pname = name(candidates[c]);
+        if norms[c] <= 1e-12 * max_norm.max(1e-300) {
+            excluded.push(Exclusion {
+                reason: format!(
+                    "`{pname}` has no effect on the {} measurement",
+                    measurement_name(opts.measurement)
+                ),
+                name: pname,
+                partners: Vec::new(),
+            });
+            continue;
+        }
+        let a = scaled.column(c).into_owned();
+        let coef = r
+            .solve_upper_triangular(&(q.transpose() * &a))
+            .unwrap_or_else(|| DVector::zeros(kept.len()));
+        let mut partners: Vec<(String, f64)> = coef
+            .iter()
+            .enumerate()
+            .filter(|(_, x)| x.abs() > 1e-6)
+            .map(|(k, &x)| (name(candidates[kept[k]]), x))
+            .collect();
+        partners.sort_by(|a, b| {
+            b.1.abs()
+                .partial_cmp(&a.1.abs())
+                .unwrap_or(std::cmp::Ordering::Equal)
+        });
+        let shown: Vec<String> = partners
+            .iter()
+            .take(4)
+            .map(|(n, _)| format!("`{n}`"))
+            .collect();
+        let more = if partners.len() > 4 {
+            format!(" and {} more", partners.len() - 4)
+        } else {
+            String::new()
+        };
+        excluded.push(Exclusion {
+            reason: format!(
+                "`{pname}` cannot be separated from {}{more}: its effect on the {} measurement is a combination of theirs",
+                shown.join(", "),
+                measurement_name(opts.measurement)
+            ),
+            name: pname,
+            partners,
+        });
+    }
+    let mut identifiable: Vec<usize> = kept.iter().map(|&k| candidates[k]).collect();
+    identifiable.sort();
+    let (rv, pr) = joint_counts(model);
+    Ok(Identifiability {
+        measurement: opts.measurement,
+        poses: qs.len(),
+        completeness: Completeness {
+            revolute: rv,
+            prismatic: pr,
+            complete_pose_model: 4 * rv + 2 * pr + 6,
+            expected_for_measurement: expected_count(model, opts.measurement),
+        },
+        candidates: {
+            let mut c = candidates.clone();
+            c.sort();
+            c.into_iter().map(name).collect()
+        },
+        fixed,
+        rank_svd,
+        rank_qr,
+        singular_values: sv,
+        identifiable: identifiable.into_iter().map(name).collect(),
+        condition_number,
+        excluded,
+    })
+}
+
+fn measurement_name(m: Measurement) -> &'static str {
+    match m {
+        Measurement::Pose => "pose",
+        Measurement::Position => "position",
+        Measurement::Distance => "distance",
+    }
+}
+
+impl Identifiability {
+    /// Fixes every excluded parameter of `model` (the free set becomes the minimal
+    /// identifiable set).
+    pub fn apply(&self, model: &mut Model) -> Result<(), Error> {
+        for e in &self.excluded {
+            let i = model.registry.require(&e.name)?;
+            model.registry.set_status(i, Status::Fixed);
+        }
+        Ok(())
+    }
+}

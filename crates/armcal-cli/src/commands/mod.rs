@@ -1,0 +1,5 @@
+//! One module per subcommand.
+
+pub mod fk;
+pub mod model;
+pub mod robots;

@@ -1,0 +1,217 @@
+//! The cell file (TOML): robot, instrument, targets, which parameters are free, working
+//! configurations (the KPI poses), obstacles, and how data-file columns map to joints.
+//! User files are in mm and degrees unless a field's suffix says otherwise (`_m`, `_rad`).
+//! Every error names the file, the line and the field.
+
+mod raw;
+
+use crate::model::identifiability::{self, IdentifiabilityOptions, Measurement};
+use crate::model::{LinkGeometry, LinkSpec, Model, ModelSpec, Status};
+use crate::robots::{self, Capsule, Robot};
+use crate::Error;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// Noise of the instrument's position readings (internal units, mm).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "model", rename_all = "kebab-case")]
+pub enum NoiseModel {
+    /// Independent N(0, σ²) per axis (σ in mm per axis).
+    Constant { sigma: [f64; 3] },
+    /// Laser-tracker style σ = a + b · range (a in mm, b in mm per m of range), per axis.
+    Range { a: f64, b_per_m: f64 },
+    /// σ per measurement, read from the data file.
+    PerMeasurement,
+}
+
+/// The measuring instrument.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Instrument {
+    pub kind: String,
+    pub noise: NoiseModel,
+    /// Largest angle between the target's z axis and the beam to the instrument (rad;
+    /// paper eq. 4), if the targets are reflectors with a limited acceptance angle.
+    pub max_incidence: Option<f64>,
+}
+
+/// A configuration at which the robot works; the pose-design KPI is the TCP there.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct WorkingPose {
+    pub name: String,
+    /// Joint values, internal units (rad, mm).
+    pub q: Vec<f64>,
+    pub weight: f64,
+}
+
+/// An obstacle in the world frame (mm).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum Obstacle {
+    Capsule {
+        name: String,
+        a: [f64; 3],
+        b: [f64; 3],
+        radius: f64,
+    },
+    /// The free side is `normal · x ≥ offset` (normal of unit length).
+    HalfSpace {
+        name: String,
+        normal: [f64; 3],
+        offset: f64,
+    },
+}
+
+/// Which columns of a data file feed which joints, and the unit of each.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DataColumns {
+    /// One column name per model joint, in joint order.
+    pub joints: Vec<String>,
+}
+
+/// A loaded cell.
+#[derive(Clone, Debug)]
+pub struct Cell {
+    pub name: String,
+    /// Where the cell came from (file path or `builtin:<robot>`).
+    pub origin: String,
+    pub robot: Robot,
+    /// The model: robot + instrument + targets, with parameter statuses applied.
+    pub model: Model,
+    pub instrument: Option<Instrument>,
+    pub working: Vec<WorkingPose>,
+    pub obstacles: Vec<Obstacle>,
+    /// Capsules of the robot and of the tool (in chain frames).
+    pub capsules: Vec<Capsule>,
+    pub measurement: Measurement,
+    /// `true`: the free set is reduced to the minimal identifiable set on load.
+    pub auto_free: bool,
+    /// Parameters the cell declared free (or with a prior) before any automatic reduction.
+    pub declared_free: Vec<usize>,
+    pub data_columns: Option<DataColumns>,
+    /// Things the user should know that do not stop the cell from loading.
+    pub warnings: Vec<String>,
+}
+
+impl Cell {
+    /// Reads a cell file.
+    pub fn from_file(path: &Path) -> Result<Cell, Error> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::File {
+            file: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Cell::from_toml(&text, &path.display().to_string(), &dir)
+    }
+
+    /// Parses a cell from TOML text; `file` names it in errors, `dir` resolves relative
+    /// paths (URDF).
+    pub fn from_toml(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
+        raw::parse(text, file, dir)
+    }
+
+    /// A cell with only a library robot: the tool frame is measured as a full pose, all
+    /// parameters free.
+    pub fn from_robot(name: &str) -> Result<Cell, Error> {
+        let robot = robots::robot(name)?;
+        let model = Model::from_spec(&robot.spec)?;
+        let declared_free = model.registry.free();
+        Ok(Cell {
+            name: robot.name.clone(),
+            origin: format!("builtin:{name}"),
+            capsules: robot.capsules.clone(),
+            robot,
+            model,
+            instrument: None,
+            working: Vec::new(),
+            obstacles: Vec::new(),
+            measurement: Measurement::Pose,
+            auto_free: false,
+            declared_free,
+            data_columns: None,
+            warnings: Vec::new(),
+        })
+    }
+
+    /// A cell from a robot name or a cell-file path: a path if it exists or ends in
+    /// `.toml`, a library robot otherwise.
+    pub fn load(name_or_path: &str) -> Result<Cell, Error> {
+        let p = PathBuf::from(name_or_path);
+        if p.exists() || name_or_path.ends_with(".toml") {
+            Cell::from_file(&p)
+        } else {
+            Cell::from_robot(name_or_path)
+        }
+    }
+
+    /// Identifiability of the parameters the cell declared free, with the cell's
+    /// measurement type unless `opts` says otherwise.
+    pub fn identifiability(
+        &self,
+        opts: &IdentifiabilityOptions,
+    ) -> Result<identifiability::Identifiability, Error> {
+        let mut declared = self.model.clone();
+        for &i in &self.declared_free {
+            if !declared.registry.get(i).status.is_free() {
+                declared.registry.set_status(i, Status::Free);
+            }
+        }
+        identifiability::analyze(&declared, &declared.nominal(), opts)
+    }
+
+    /// Default analysis options for this cell (its measurement type).
+    pub fn identifiability_options(&self) -> IdentifiabilityOptions {
+        IdentifiabilityOptions {
+            measurement: self.measurement,
+            ..Default::default()
+        }
+    }
+}
+
+/// Builds the model of a cell: robot links with the cell's base/tool overrides, the
+/// instrument frame and the targets; then applies parameter statuses.
+pub(crate) fn assemble_spec(
+    robot: &Robot,
+    instrument: Option<LinkGeometry>,
+    instrument_name: &str,
+    base: Option<LinkGeometry>,
+    tool: Option<LinkGeometry>,
+    targets: Vec<LinkSpec>,
+) -> ModelSpec {
+    let mut links = robot.spec.links.clone();
+    if let Some(b) = base {
+        links[0].geometry = b;
+    }
+    if let Some(t) = tool {
+        let last = links.len() - 1;
+        links[last].geometry = t;
+    }
+    ModelSpec {
+        name: robot.spec.name.clone(),
+        instrument: instrument.map(|g| LinkSpec {
+            name: instrument_name.into(),
+            geometry: g,
+            joint: None,
+        }),
+        links,
+        targets,
+    }
+}
+
+/// Applies `fixed` patterns, then `free` patterns (which win), then priors.
+pub(crate) fn apply_statuses(
+    model: &mut Model,
+    fixed: &[String],
+    free: &[String],
+    priors: &[(String, f64)],
+) -> Result<(), Error> {
+    for p in fixed {
+        model.set_status(p, Status::Fixed)?;
+    }
+    for p in free {
+        model.set_status(p, Status::Free)?;
+    }
+    for (p, sigma) in priors {
+        model.set_status(p, Status::Prior { sigma: *sigma })?;
+    }
+    Ok(())
+}
