@@ -1,1 +1,74 @@
-fn main() {}
+//! Kinematics benchmarks: FK + position identification Jacobian of the paper cell (6R,
+//! 27 free parameters), the joint Jacobian, and the mixed derivative ∂J/∂q.
+
+use armcal::cell::Cell;
+use armcal::model::*;
+use criterion::{criterion_group, criterion_main, Criterion};
+use nalgebra::DMatrix;
+use std::hint::black_box;
+
+const CELL: &str = include_str!("../../../examples/paper-cell.toml");
+
+fn paper_cell() -> Cell {
+    Cell::from_toml(CELL, "paper-cell.toml", std::path::Path::new(".")).expect("paper cell")
+}
+
+fn kinematics(c: &mut Criterion) {
+    let cell = paper_cell();
+    let model = &cell.model;
+    let params = model.nominal();
+    let columns = model.registry.free();
+    assert_eq!(columns.len(), 27);
+    let q = [0.3, -0.4, 0.9, 0.5, -0.7, 1.1];
+    let mut data = Data::new(model);
+    let mut jac = DMatrix::zeros(3, columns.len());
+    c.bench_function(
+        "fk + position identification jacobian (6R, 27 params)",
+        |b| {
+            b.iter(|| {
+                forward_kinematics(model, &mut data, black_box(&params), black_box(&q));
+                identification_jacobian(
+                    model,
+                    &data,
+                    Observed::Target(0),
+                    Rows::Position,
+                    &columns,
+                    &mut jac,
+                    0,
+                );
+                black_box(&jac);
+            })
+        },
+    );
+    c.bench_function("fk only (6R with tracker and reflector)", |b| {
+        b.iter(|| {
+            forward_kinematics(model, &mut data, black_box(&params), black_box(&q));
+            black_box(&data.targets[0]);
+        })
+    });
+    let mut ws = MixedWorkspace::new(model, Rows::Position, columns.len());
+    let mut value = DMatrix::zeros(3, columns.len());
+    let mut dq = vec![DMatrix::zeros(3, columns.len()); 6];
+    c.bench_function(
+        "mixed derivative dJ/dq (6 joints × 3 × 27, dual numbers)",
+        |b| {
+            b.iter(|| {
+                identification_jacobian_dq(
+                    model,
+                    &mut ws,
+                    &params,
+                    black_box(&q),
+                    Observed::Target(0),
+                    Rows::Position,
+                    &columns,
+                    &mut value,
+                    &mut dq,
+                );
+                black_box(&dq);
+            })
+        },
+    );
+}
+
+criterion_group!(benches, kinematics);
+criterion_main!(benches);

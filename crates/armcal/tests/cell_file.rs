@@ -1,0 +1,160 @@
+//! Cell files: a full inline example loads; every kind of mistake gives file, line and field.
+
+use armcal::cell::{Cell, NoiseModel, Obstacle};
+use armcal::model::Status;
+use std::path::Path;
+
+fn parse(text: &str) -> Result<Cell, String> {
+    Cell::from_toml(text, "cell.toml", Path::new(".")).map_err(|e| e.to_string())
+}
+
+const INLINE: &str = r#"
+name = "two-link"
+
+[robot]
+name = "planar-2r"
+[[robot.links]]
+name = "j1"
+convention = "dh"
+joint = "revolute"
+limits = [-170, 170]
+theta_deg = 0
+d_mm = 400
+a_mm = 500
+alpha_deg = 0
+[[robot.links]]
+name = "j2"
+convention = "mdh"
+joint = "prismatic"
+limits = [0, 300]
+alpha_deg = 90
+a_m = 0.1
+theta_deg = 0
+d_mm = 0
+
+[instrument]
+xyz_m = [2, 0, 0]
+rpy_deg = [0, 0, 180]
+noise = { model = "range", a_mm = 0.015, b_um_per_m = 6 }
+
+[[targets]]
+name = "ball"
+xyz_mm = [0, 0, 50]
+
+[parameters]
+free = ["j1", "j2.a", "tracker", "ball"]
+priors = { "j1.alpha" = { sigma_deg = 0.1 } }
+
+[[working]]
+joints_deg = [10, 150]
+
+[[obstacles]]
+kind = "half-space"
+normal = [0, 0, 2]
+offset_mm = -100
+"#;
+
+#[test]
+fn inline_robot_with_units_loads() {
+    let cell = parse(INLINE).unwrap();
+    let m = &cell.model;
+    assert_eq!(m.dof(), 2);
+    let get = |n: &str| m.registry.get(m.registry.index_of(n).unwrap());
+    assert_eq!(get("j2.a").nominal, 100.0, "0.1 m is 100 mm");
+    assert!((get("j2.alpha").nominal - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+    assert_eq!(get("tracker.x").nominal, 2000.0);
+    assert_eq!(
+        get("j2.alpha").status,
+        Status::Fixed,
+        "not in the free list"
+    );
+    assert_eq!(get("j2.a").status, Status::Free);
+    match get("j1.alpha").status {
+        Status::Prior { sigma } => assert!((sigma - 0.1f64.to_radians()).abs() < 1e-15),
+        s => panic!("expected a prior, got {s:?}"),
+    }
+    // Prismatic working value stays in mm; revolute in degrees → rad.
+    assert!((cell.working[0].q[0] - 10f64.to_radians()).abs() < 1e-15);
+    assert_eq!(cell.working[0].q[1], 150.0);
+    let inst = cell.instrument.as_ref().unwrap();
+    assert_eq!(
+        inst.noise,
+        NoiseModel::Range {
+            a: 0.015,
+            b_per_m: 0.006
+        }
+    );
+    match &cell.obstacles[0] {
+        Obstacle::HalfSpace { normal, offset, .. } => {
+            assert_eq!(*normal, [0.0, 0.0, 1.0]);
+            assert_eq!(*offset, -100.0);
+        }
+        o => panic!("{o:?}"),
+    }
+    assert!(!cell.auto_free);
+}
+
+fn expect_error(text: &str, needles: &[&str]) {
+    let e = parse(text).expect_err("must fail");
+    for n in needles {
+        assert!(e.contains(n), "error `{e}` should mention `{n}`");
+    }
+}
+
+#[test]
+fn errors_name_file_line_and_field() {
+    // Unit suffix missing: the field and the line of the link.
+    let bad = INLINE.replace("a_mm = 500", "a = 500");
+    expect_error(&bad, &["cell.toml", "line 6", "robot.links[0]", "a_mm"]);
+    // Unknown convention.
+    let bad = INLINE.replace("convention = \"mdh\"", "convention = \"dhx\"");
+    expect_error(
+        &bad,
+        &["line 15", "robot.links[1]", "unknown convention `dhx`"],
+    );
+    // Unknown built-in robot.
+    expect_error(
+        "[robot]\nbuiltin = \"kr9000\"\n",
+        &["line 1", "robot.builtin", "kr9000"],
+    );
+    // Typo in a top-level key: toml's own error with line.
+    expect_error(
+        "[robot]\nbuiltin = \"paper\"\n[instrumnet]\n",
+        &["cell.toml", "instrumnet"],
+    );
+    // Wrong number of working joints.
+    let bad = INLINE.replace("joints_deg = [10, 150]", "joints_deg = [10]");
+    expect_error(&bad, &["working[0].joints_deg", "1 values", "2 joints"]);
+    // Unknown parameter pattern.
+    let bad = INLINE.replace("\"j2.a\"", "\"j2.q\"");
+    expect_error(
+        &bad,
+        &["parameters", "unknown parameter `j2.q`", "j2.alpha"],
+    );
+    // Noise model.
+    let bad = INLINE.replace("model = \"range\"", "model = \"gauss\"");
+    expect_error(&bad, &["instrument.noise", "unknown noise model `gauss`"]);
+    // Limits reversed.
+    let bad = INLINE.replace("limits = [-170, 170]", "limits = [170, -170]");
+    expect_error(&bad, &["lower limit"]);
+    // Two robot sources.
+    expect_error(
+        "[robot]\nbuiltin = \"paper\"\nurdf = \"x.urdf\"\n",
+        &["exactly one of"],
+    );
+    // Capsule on a frame the robot does not have.
+    let bad = format!("{INLINE}\n[[tool_capsules]]\nframe = \"j9\"\na_mm = [0,0,0]\nb_mm = [0,0,1]\nradius_mm = 5\n");
+    expect_error(&bad, &["j9"]);
+}
+
+#[test]
+fn working_pose_outside_limits_is_kept_with_a_warning() {
+    let text = INLINE.replace("joints_deg = [10, 150]", "joints_deg = [10, 400]");
+    let cell = parse(&text).unwrap();
+    assert_eq!(cell.warnings.len(), 1);
+    assert!(
+        cell.warnings[0].contains("outside its limits"),
+        "{}",
+        cell.warnings[0]
+    );
+}
