@@ -7,7 +7,10 @@
 
 pub mod cell;
 pub mod error;
+pub mod identify;
+pub mod measure;
 pub mod model;
 pub mod robots;
+pub mod sim;
 
 pub use error::{Error, Result};

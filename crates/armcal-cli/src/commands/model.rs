@@ -73,6 +73,9 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     for (i, p) in model.registry.iter().enumerate() {
         let status = match p.status {
             Status::Free => "free".to_string(),
+            Status::Fixed if report.excluded.iter().any(|e| e.name == p.name) => {
+                "fixed (not identifiable, see below)".to_string()
+            }
             Status::Fixed => "fixed".to_string(),
             Status::Prior { sigma } => format!(
                 "prior σ = {:.4} {}",

@@ -5,24 +5,13 @@
 
 mod raw;
 
+pub use crate::measure::NoiseModel;
 use crate::model::identifiability::{self, IdentifiabilityOptions, Measurement};
 use crate::model::{LinkGeometry, LinkSpec, Model, ModelSpec, Status};
 use crate::robots::{self, Capsule, Robot};
 use crate::Error;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
-
-/// Noise of the instrument's position readings (internal units, mm).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "model", rename_all = "kebab-case")]
-pub enum NoiseModel {
-    /// Independent N(0, σ²) per axis (σ in mm per axis).
-    Constant { sigma: [f64; 3] },
-    /// Laser-tracker style σ = a + b · range (a in mm, b in mm per m of range), per axis.
-    Range { a: f64, b_per_m: f64 },
-    /// σ per measurement, read from the data file.
-    PerMeasurement,
-}
 
 /// The measuring instrument.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

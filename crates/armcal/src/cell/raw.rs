@@ -385,7 +385,14 @@ fn noise(t: &toml::Table) -> Result<NoiseModel, String> {
             if s.iter().any(|x| *x <= 0.0) {
                 return Err("`sigma_mm` must be positive".into());
             }
-            NoiseModel::Constant { sigma: s }
+            let sigma_angle = unit_value(t, "sigma_angle", Unit::Rad, &mut used)?.unwrap_or(1e-3);
+            if sigma_angle <= 0.0 {
+                return Err("`sigma_angle_deg` must be positive".into());
+            }
+            NoiseModel::Constant {
+                sigma: s,
+                sigma_angle,
+            }
         }
         Some("range") => {
             let a = unit_value(t, "a", Unit::Mm, &mut used)?.ok_or("missing `a_mm`")?;
@@ -402,7 +409,13 @@ fn noise(t: &toml::Table) -> Result<NoiseModel, String> {
                 b_per_m: b / 1000.0,
             }
         }
-        Some("per-measurement") => NoiseModel::PerMeasurement,
+        Some("per-measurement") => {
+            let floor = unit_value(t, "floor", Unit::Mm, &mut used)?.unwrap_or(1e-3);
+            if floor <= 0.0 {
+                return Err("`floor_mm` must be positive".into());
+            }
+            NoiseModel::PerMeasurement { floor }
+        }
         Some(m) => {
             return Err(format!(
                 "unknown noise model `{m}`; use constant, range or per-measurement"
@@ -546,7 +559,7 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
             };
             let noise = match &ri.noise {
                 Some(t) => noise(t).map_err(|e| ctx.err(span.clone(), "instrument.noise", e))?,
-                None => NoiseModel::Constant { sigma: [1.0; 3] },
+                None => NoiseModel::default(),
             };
             if let Some(a) = ri.max_incidence_deg {
                 if !(0.0..=180.0).contains(&a) {
@@ -615,9 +628,9 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
     })?;
 
     // Parameters.
-    let mut measurement = if model.targets.is_empty() {
-        Measurement::Pose
-    } else if (0..model.targets.len()).all(|k| model.target_is_frame(k)) {
+    let all_frames = (0..model.targets.len()).all(|k| model.target_is_frame(k));
+    let mut measurement = if all_frames {
+        // No targets (the tool frame is measured) or only frame targets.
         Measurement::Pose
     } else {
         Measurement::Position

@@ -148,7 +148,7 @@ impl Model {
                             ls.name, g.convention
                         )));
                     }
-                    if !(j.lower <= j.upper) {
+                    if j.lower.is_nan() || j.upper.is_nan() || j.lower > j.upper {
                         return Err(Error::Model(format!(
                             "joint `{}`: lower limit {} is above upper limit {}",
                             j.name, j.lower, j.upper

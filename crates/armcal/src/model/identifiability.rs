@@ -348,9 +348,9 @@ pub fn analyze_at(
     let mut basis: Vec<DVector<f64>> = Vec::new();
     let mut kept = Vec::new();
     let mut dropped = Vec::new();
-    for c in 0..scaled.ncols() {
+    for (c, &norm) in norms.iter().enumerate() {
         let mut v = scaled.column(c).into_owned();
-        if norms[c] <= 1e-12 * max_norm.max(1e-300) {
+        if norm <= 1e-12 * max_norm.max(1e-300) {
             dropped.push(c);
             continue;
         }

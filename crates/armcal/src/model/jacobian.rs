@@ -162,13 +162,13 @@ pub fn identification_jacobian_dq(
     value: &mut DMatrix<f64>,
     dq: &mut [DMatrix<f64>],
 ) {
-    for j in 0..model.dof() {
+    for (j, dqj) in dq.iter_mut().enumerate().take(model.dof()) {
         for (i, qi) in ws.q.iter_mut().enumerate() {
             *qi = Dual64::new(q[i], if i == j { 1.0 } else { 0.0 });
         }
         forward_kinematics(model, &mut ws.data, params, &ws.q);
         identification_jacobian(model, &ws.data, obs, rows, columns, &mut ws.jac, 0);
-        for (d, x) in dq[j].iter_mut().zip(ws.jac.iter()) {
+        for (d, x) in dqj.iter_mut().zip(ws.jac.iter()) {
             *d = x.eps;
         }
         if j == 0 {

@@ -5,7 +5,11 @@ use nalgebra::{Matrix3, RealField, Vector3};
 
 /// Rigid transform `x ↦ R x + t` (a homogeneous matrix `[[R, t], [0, 1]]`, book eq. 2.5 with
 /// the (4,4) entry 1 as corrected in the errata).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(bound(
+    serialize = "T: serde::Serialize",
+    deserialize = "T: serde::de::DeserializeOwned"
+))]
 pub struct Pose<T: RealField + Copy> {
     pub rot: Matrix3<T>,
     pub trans: Vector3<T>,
@@ -143,8 +147,73 @@ pub fn rot_axis<T: RealField + Copy>(u: &Vector3<T>, angle: T) -> Matrix3<T> {
     Matrix3::identity() + k * s + k * k * (T::one() - c)
 }
 
+/// Rotation vector φ with `exp([φ]) = R` (|φ| ≤ π), the SO(3) logarithm.
+pub fn rotation_log(r: &Matrix3<f64>) -> Vector3<f64> {
+    let cos = ((r.trace() - 1.0) / 2.0).clamp(-1.0, 1.0);
+    let angle = cos.acos();
+    let w = Vector3::new(
+        r[(2, 1)] - r[(1, 2)],
+        r[(0, 2)] - r[(2, 0)],
+        r[(1, 0)] - r[(0, 1)],
+    );
+    if angle < 1e-6 {
+        // sin θ ≈ θ: φ = vee(R − Rᵀ)/2 to second order.
+        return w * 0.5;
+    }
+    if std::f64::consts::PI - angle < 1e-6 {
+        // Near π: axis from the symmetric part R + I = 2 u uᵀ (θ = π).
+        let b = (r + Matrix3::identity()) * 0.5;
+        let k = (0..3)
+            .max_by(|&i, &j| b[(i, i)].total_cmp(&b[(j, j)]))
+            .unwrap_or(0);
+        let mut u: Vector3<f64> = b.column(k).into_owned() / b[(k, k)].max(1e-300).sqrt();
+        if u.dot(&w) < 0.0 {
+            u = -u;
+        }
+        return u.normalize() * angle;
+    }
+    w * (angle / (2.0 * angle.sin()))
+}
+
+/// Inverse of the left Jacobian of SO(3) at φ: `log(exp([δ]) exp([φ])) ≈ φ + J_l⁻¹(φ) δ`.
+/// `J_l⁻¹ = I − ½[φ] + (1/θ² − (1 + cos θ)/(2θ sin θ)) [φ]²`.
+pub fn left_jacobian_inverse(phi: &Vector3<f64>) -> Matrix3<f64> {
+    let theta = phi.norm();
+    let k = phi.cross_matrix();
+    let c = if theta < 1e-4 {
+        1.0 / 12.0 + theta * theta / 720.0
+    } else {
+        1.0 / (theta * theta) - (1.0 + theta.cos()) / (2.0 * theta * theta.sin())
+    };
+    Matrix3::identity() - k * 0.5 + k * k * c
+}
+
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn log_inverts_rodrigues_and_left_jacobian_is_its_derivative() {
+        for phi in [
+            Vector3::new(0.3, -0.2, 0.5),
+            Vector3::new(1e-8, 2e-8, 0.0),
+            Vector3::new(0.0, 3.1, 0.01),
+        ] {
+            let r = rot_axis(&phi.normalize(), phi.norm());
+            assert!((rotation_log(&r) - phi).norm() < 1e-9, "{phi:?}");
+        }
+        let phi = Vector3::new(0.4, -0.7, 0.2);
+        let jinv = left_jacobian_inverse(&phi);
+        let r = rot_axis(&phi.normalize(), phi.norm());
+        let h = 1e-6;
+        for k in 0..3 {
+            let mut d = Vector3::zeros();
+            d[k] = h;
+            let rp = rot_axis(&d.normalize(), h) * r;
+            let rm = rot_axis(&(-d).normalize(), h) * r;
+            let fd = (rotation_log(&rp) - rotation_log(&rm)) / (2.0 * h);
+            assert!((fd - jinv.column(k)).norm() < 1e-7, "{k}");
+        }
+    }
+
     use super::*;
 
     #[test]

@@ -5,7 +5,12 @@
 //! targets: those belong to a cell). Lengths in mm, angles in rad, as everywhere inside
 //! armcal.
 
+mod irb120;
+mod kuka;
+mod motoman;
 mod paper;
+pub mod puma560;
+mod ur10;
 
 use crate::model::{Joint, JointKind, LinkGeometry, LinkSpec, ModelSpec};
 use crate::Error;
@@ -49,13 +54,26 @@ pub fn list() -> Vec<(String, String)> {
 }
 
 /// Library names (the notional family also answers to `paper-<λ>-<μ>`).
-pub const NAMES: &[&str] = &["paper"];
+pub const NAMES: &[&str] = &[
+    "paper",
+    "puma560",
+    "puma560-zrp",
+    "kr15",
+    "kr300",
+    "kr500",
+    "irb120",
+    "ur10",
+    "motoman-right",
+    "motoman-left",
+];
 
 /// A built-in robot by name.
 pub fn robot(name: &str) -> Result<Robot, Error> {
     if let Some(rest) = name.strip_prefix("paper-") {
         let (l, m) = rest.split_once('-').ok_or_else(|| {
-            Error::Input(format!("`{name}`: the notional robot is named paper-<λ mm>-<μ mm>, e.g. paper-650-600"))
+            Error::Input(format!(
+                "`{name}`: the notional robot is named paper-<λ mm>-<μ mm>, e.g. paper-650-600"
+            ))
         })?;
         let parse = |s: &str| {
             s.parse::<f64>()
@@ -65,6 +83,15 @@ pub fn robot(name: &str) -> Result<Robot, Error> {
     }
     match name {
         "paper" => Ok(paper::notional(650.0, 600.0)),
+        "puma560" => Ok(puma560::puma560()),
+        "puma560-zrp" => Ok(puma560::puma560_zrp()),
+        "kr15" => Ok(kuka::kr15()),
+        "kr300" => Ok(kuka::kr300()),
+        "kr500" => Ok(kuka::kr500()),
+        "irb120" => Ok(irb120::irb120()),
+        "ur10" => Ok(ur10::ur10()),
+        "motoman-right" => Ok(motoman::motoman(motoman::Arm::Right)),
+        "motoman-left" => Ok(motoman::motoman(motoman::Arm::Left)),
         _ => Err(Error::Input(format!(
             "unknown robot `{name}`; built-in robots: {}",
             NAMES.join(", ")
@@ -96,7 +123,7 @@ pub(crate) fn joint_link(i: usize, geometry: LinkGeometry, limits_deg: (f64, f64
 }
 
 /// A fixed frame link (base, tool) from xyz (mm) and roll-pitch-yaw (deg).
-pub(crate) fn frame_link(name: &str, xyz: [f64; 3], rpy_deg: [f64; 3]) -> LinkSpec {
+pub fn frame_link(name: &str, xyz: [f64; 3], rpy_deg: [f64; 3]) -> LinkSpec {
     LinkSpec {
         name: name.into(),
         geometry: LinkGeometry::frame6(xyz, rpy_deg.map(deg)),
@@ -111,4 +138,21 @@ pub(crate) fn capsule(frame: &str, a: [f64; 3], b: [f64; 3], radius: f64) -> Cap
         b,
         radius,
     }
+}
+
+/// Capsules along the two segments of a DH link `Rz(θ+q) Tz(d) Tx(a) Rx(α)`: from the
+/// previous frame's origin along `z_{i−1}` by `d`, then along `x_i` by `a`. In the frame at the
+/// end of the link those points are `(−a, −d sin α, −d cos α)`, `(−a, 0, 0)` and the origin
+/// (θ and q do not enter). Zero-length segments are left out.
+pub(crate) fn dh_capsules(frame: &str, d: f64, a: f64, alpha: f64, radius: f64) -> Vec<Capsule> {
+    let start = [-a, -d * alpha.sin(), -d * alpha.cos()];
+    let corner = [-a, 0.0, 0.0];
+    let mut out = Vec::new();
+    if d != 0.0 {
+        out.push(capsule(frame, start, corner, radius));
+    }
+    if a != 0.0 {
+        out.push(capsule(frame, corner, [0.0; 3], radius));
+    }
+    out
 }

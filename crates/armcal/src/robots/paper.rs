@@ -15,11 +15,27 @@ pub fn notional(lambda: f64, mu: f64) -> Robot {
     let links = vec![
         frame_link("base", [0.0; 3], [0.0; 3]),
         joint_link(1, LinkGeometry::dh(0.0, 0.0, 350.0, d(90.0)), (-82.0, 82.0)),
-        joint_link(2, LinkGeometry::hayati(0.0, lambda, 0.0, 0.0), (-77.0, 31.0)),
-        joint_link(3, LinkGeometry::dh(d(-90.0), 0.0, 145.0, d(90.0)), (-13.0, 154.0)),
-        joint_link(4, LinkGeometry::dh(0.0, -mu, 0.0, d(-90.0)), (-347.0, 347.0)),
+        joint_link(
+            2,
+            LinkGeometry::hayati(0.0, lambda, 0.0, 0.0),
+            (-77.0, 31.0),
+        ),
+        joint_link(
+            3,
+            LinkGeometry::dh(d(-90.0), 0.0, 145.0, d(90.0)),
+            (-13.0, 154.0),
+        ),
+        joint_link(
+            4,
+            LinkGeometry::dh(0.0, -mu, 0.0, d(-90.0)),
+            (-347.0, 347.0),
+        ),
         joint_link(5, LinkGeometry::dh(0.0, 0.0, 0.0, d(90.0)), (-87.0, 87.0)),
-        joint_link(6, LinkGeometry::dh(d(180.0), -170.0, 0.0, d(180.0)), (-347.0, 347.0)),
+        joint_link(
+            6,
+            LinkGeometry::dh(d(180.0), -170.0, 0.0, d(180.0)),
+            (-347.0, 347.0),
+        ),
         frame_link("tool", [0.0; 3], [0.0; 3]),
     ];
     // Capsules (not published; chosen for a KUKA-like arm of this size and kept the same

@@ -1,0 +1,142 @@
+//! Recursive estimation / Kalman filter (book §4.3.3, §4.5.4): the parameter vector is a
+//! constant state, every measurement block an observation `r_i + J_i Δ ≈ 0` with unit
+//! covariance (rows are whitened). One pass processes the blocks one at a time:
+//!
+//! `K = P J_iᵀ (J_i P J_iᵀ + I)⁻¹`, `Δ ← Δ − K (r_i + J_i Δ)`, `P ← (I − K J_i) P (I − K J_i)ᵀ + K Kᵀ`
+//! (Joseph form). Passes repeat with the model re-linearised at the new estimate (an
+//! iterated extended Kalman filter) and a diffuse prior `P₀` re-centred at each pass; at
+//! the fixed point `Jᵀ r = 0`, so the filter reaches the batch least-squares estimate, and
+//! its final `P` is the covariance `(JᵀJ + P₀⁻¹)⁻¹ ≈ C_p`.
+
+use super::problem::Problem;
+use super::solver::{Observer, Solution, Status, Tolerances};
+use crate::model::Unit;
+use crate::Error;
+use nalgebra::{DMatrix, DVector};
+use std::time::Instant;
+
+/// Settings of [`kalman_filter`].
+#[derive(Clone, Debug)]
+pub struct KalmanSettings {
+    pub tolerances: Tolerances,
+    /// Prior standard deviation of length parameters (mm) and of angles (rad).
+    pub prior_length: f64,
+    pub prior_angle: f64,
+}
+
+impl Default for KalmanSettings {
+    fn default() -> Self {
+        KalmanSettings {
+            tolerances: Tolerances {
+                max_iterations: 50,
+                ..Tolerances::default()
+            },
+            prior_length: 1e3,
+            prior_angle: 1.0,
+        }
+    }
+}
+
+pub struct KalmanSolution {
+    pub solution: Solution,
+    /// Covariance of the free parameters after the last pass.
+    pub covariance: DMatrix<f64>,
+}
+
+pub fn kalman_filter(
+    problem: &Problem,
+    start: &[f64],
+    settings: &KalmanSettings,
+    observer: &mut dyn Observer,
+) -> Result<KalmanSolution, Error> {
+    let t0 = Instant::now();
+    let (m, n) = (problem.rows(), problem.columns());
+    let mut ws = problem.workspace();
+    let mut params = start.to_vec();
+    let mut r = DVector::zeros(m);
+    let mut j = DMatrix::zeros(m, n);
+    problem.evaluate(&mut ws, &params, &mut r, Some(&mut j));
+    let mut history = vec![0.5 * r.norm_squared()];
+    let p0 = DMatrix::from_diagonal(&DVector::from_iterator(
+        n,
+        problem
+            .free
+            .iter()
+            .map(|&i| match problem.model.registry.get(i).unit {
+                Unit::Mm => settings.prior_length.powi(2),
+                _ => settings.prior_angle.powi(2),
+            }),
+    ));
+    // Block boundaries: one block per measurement, then one per prior row.
+    let mut blocks: Vec<(usize, usize)> = problem
+        .row_of
+        .iter()
+        .zip(&problem.data.measurements)
+        .map(|(&row, meas)| (row, meas.kind.rows()))
+        .collect();
+    blocks.extend((problem.data_rows()..m).map(|row| (row, 1)));
+    let tol = &settings.tolerances;
+    let mut status = Status::MaxIterations;
+    let mut iterations = 0;
+    let mut p = p0.clone();
+    let identity_n = DMatrix::<f64>::identity(n, n);
+    while iterations < tol.max_iterations {
+        iterations += 1;
+        let mut delta = DVector::zeros(n);
+        p.copy_from(&p0);
+        for &(row, k) in &blocks {
+            let ji = j.rows(row, k);
+            let innovation = -(r.rows(row, k) + ji * &delta);
+            let pjt = &p * ji.transpose();
+            let s = ji * &pjt + DMatrix::identity(k, k);
+            let s_inv = s
+                .try_inverse()
+                .ok_or_else(|| Error::Input("Kalman innovation covariance is singular".into()))?;
+            let gain = &pjt * s_inv;
+            delta += &gain * innovation;
+            let a = &identity_n - &gain * ji;
+            p = &a * &p * a.transpose() + &gain * gain.transpose();
+        }
+        let x = problem.free_values(&params);
+        problem.set_free(&mut params, &(&x + &delta));
+        problem.evaluate(&mut ws, &params, &mut r, Some(&mut j));
+        let cost = 0.5 * r.norm_squared();
+        history.push(cost);
+        observer.iteration(iterations, cost, 0.0);
+        if !cost.is_finite() {
+            status = Status::Diverged {
+                reason: "non-finite residual after a filter pass".into(),
+            };
+            break;
+        }
+        // Relative step in units of the posterior standard deviations.
+        let rel = (0..n)
+            .map(|k| delta[k].abs() / p[(k, k)].sqrt().max(1e-300))
+            .fold(0.0, f64::max);
+        if rel <= 1e-7 {
+            status = Status::Converged {
+                criterion: "filter pass changed no parameter by more than 1e-7 σ".into(),
+            };
+            break;
+        }
+        let previous = history[history.len() - 2];
+        if iterations > 2 && (previous - cost).abs() <= tol.ftol * cost.max(f64::MIN_POSITIVE) {
+            status = Status::Converged {
+                criterion: format!("relative cost change ≤ {:e}", tol.ftol),
+            };
+            break;
+        }
+    }
+    Ok(KalmanSolution {
+        solution: Solution {
+            params,
+            status,
+            iterations,
+            history,
+            time: t0.elapsed(),
+            residual: r,
+            jacobian: j,
+        },
+        covariance: p,
+    })
+}

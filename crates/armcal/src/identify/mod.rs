@@ -1,0 +1,389 @@
+//! Parameter identification with honest uncertainty (book ch. 4, paper eqs. 5–6, 13–19):
+//! Levenberg–Marquardt, Gauss–Newton, recursive (Kalman) estimation, robust IRLS, priors
+//! (MAP), parameter and TCP covariances, observability indices, held-out validation.
+
+pub mod gauss_newton;
+pub mod kalman;
+pub mod lm;
+pub mod problem;
+pub mod robust;
+pub mod solver;
+pub mod uncertainty;
+
+pub use gauss_newton::gauss_newton;
+pub use kalman::{kalman_filter, KalmanSettings};
+pub use lm::{levenberg_marquardt, LmSettings};
+pub use problem::Problem;
+pub use robust::{robust_fit, Loss, Outlier};
+pub use solver::{Observer, Silent, Solution, Status, Tolerances};
+pub use uncertainty::{ErrorStats, Observability, ParameterUncertainty, TcpCovariance};
+
+use crate::cell::Cell;
+use crate::measure::{Dataset, MeasurementKind};
+use crate::model::{Model, ModelSpec, Segment, Status as ParamStatus};
+use crate::Error;
+use nalgebra::{DVector, Matrix3};
+use rand::seq::SliceRandom;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+/// Which solver.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    Lm,
+    GaussNewton,
+    Kalman,
+}
+
+impl Method {
+    pub fn from_name(s: &str) -> Option<Method> {
+        match s {
+            "lm" => Some(Method::Lm),
+            "gn" | "gauss-newton" => Some(Method::GaussNewton),
+            "kalman" => Some(Method::Kalman),
+            _ => None,
+        }
+    }
+}
+
+/// Settings of [`identify`].
+#[derive(Clone, Debug)]
+pub struct IdentifyOptions {
+    pub method: Method,
+    pub robust: Option<Loss>,
+    /// Fraction of configurations held out for validation (0: none).
+    pub holdout: f64,
+    pub seed: u64,
+    pub lm: LmSettings,
+}
+
+impl Default for IdentifyOptions {
+    fn default() -> Self {
+        IdentifyOptions {
+            method: Method::Lm,
+            robust: None,
+            holdout: 0.0,
+            seed: 1,
+            lm: LmSettings::default(),
+        }
+    }
+}
+
+/// One parameter in the estimate report (display units: mm, deg).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ParameterEstimate {
+    pub name: String,
+    pub unit: String,
+    pub nominal: f64,
+    pub estimate: f64,
+    /// Standard deviation (display unit); `None` for fixed parameters.
+    pub sigma: Option<f64>,
+    pub free: bool,
+}
+
+/// Solver statistics.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct SolverReport {
+    pub method: Method,
+    pub robust: Option<Loss>,
+    pub status: Status,
+    pub iterations: usize,
+    pub time_ms: f64,
+    pub history: Vec<f64>,
+}
+
+/// Residual statistics per axis (mm) of the position-bearing measurements.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ResidualReport {
+    pub x: ErrorStats,
+    pub y: ErrorStats,
+    pub z: ErrorStats,
+    /// Euclidean position error per measurement (scalar error for distances and planes).
+    pub norm: ErrorStats,
+}
+
+/// Held-out validation (position error on configurations not used in the fit, mm).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Validation {
+    pub train_configurations: usize,
+    pub test_configurations: usize,
+    /// Nominal model, nothing fitted.
+    pub nominal: ErrorStats,
+    /// Nominal robot with only the base, tool, instrument and target frames fitted.
+    pub frames_only: ErrorStats,
+    /// Full calibration.
+    pub calibrated: ErrorStats,
+}
+
+/// Everything an identification produced: what `estimate.json` holds.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Estimate {
+    pub cell: String,
+    pub data: String,
+    /// The identified model (internal units: mm, rad), for predict / compensate / export.
+    pub model: ModelSpec,
+    pub parameters: Vec<ParameterEstimate>,
+    /// Why each parameter not estimated was left out (identifiability analysis).
+    pub fixed_reasons: Vec<(String, String)>,
+    pub solver: SolverReport,
+    pub uncertainty: ParameterUncertainty,
+    /// Names of the free parameters, the order of C_p.
+    pub free: Vec<String>,
+    pub strong_correlations: Vec<(String, String, f64)>,
+    /// C_s = G C_p Gᵀ at each working configuration.
+    pub tcp: Vec<TcpCovariance>,
+    /// C_s by the constrained formulation (paper eq. 19), same order.
+    pub tcp_constrained: Vec<Matrix3<f64>>,
+    pub observability: Observability,
+    pub residuals: ResidualReport,
+    pub outliers: Vec<Outlier>,
+    pub robust_scale: Option<f64>,
+    pub validation: Option<Validation>,
+    pub measurements: usize,
+    pub configurations: usize,
+}
+
+/// Runs one solver on a problem.
+pub fn solve(
+    problem: &mut Problem,
+    start: &[f64],
+    opts: &IdentifyOptions,
+    observer: &mut dyn Observer,
+) -> Result<(Solution, Vec<Outlier>, Option<f64>), Error> {
+    problem.check_determined()?;
+    if let Some(loss) = opts.robust {
+        let r = robust_fit(problem, start, loss, &opts.lm, observer)?;
+        return Ok((r.solution, r.outliers, Some(r.scale)));
+    }
+    let s = match opts.method {
+        Method::Lm => levenberg_marquardt(problem, start, &opts.lm, observer)?,
+        Method::GaussNewton => gauss_newton(problem, start, &opts.lm.tolerances, observer)?,
+        Method::Kalman => {
+            kalman_filter(problem, start, &KalmanSettings::default(), observer)?.solution
+        }
+    };
+    Ok((s, Vec::new(), None))
+}
+
+/// Whether a parameter belongs to the frames a "frames only" fit adjusts: instrument,
+/// targets, the base (first chain link) and the tool (last chain link).
+pub fn is_frame_parameter(model: &Model, i: usize) -> bool {
+    match model.registry.get(i).segment {
+        Segment::Instrument | Segment::Target(_) => true,
+        Segment::Chain => {
+            let first = &model.links[0];
+            let last = &model.links[model.links.len() - 1];
+            let within =
+                |l: &crate::model::Link| i >= l.first_param && i < l.first_param + l.param_count();
+            within(first) || within(last)
+        }
+    }
+}
+
+/// A copy of the model whose free set is restricted to the frame parameters.
+pub fn frames_only(model: &Model) -> Model {
+    let mut m = model.clone();
+    for i in 0..m.param_count() {
+        if m.registry.get(i).status.is_free() && !is_frame_parameter(&m, i) {
+            m.registry.set_status(i, ParamStatus::Fixed);
+        }
+    }
+    m
+}
+
+/// Splits configurations into (train, test) with a seeded shuffle.
+pub fn holdout_split(n: usize, fraction: f64, seed: u64) -> (Vec<usize>, Vec<usize>) {
+    let mut idx: Vec<usize> = (0..n).collect();
+    idx.shuffle(&mut ChaCha8Rng::seed_from_u64(seed));
+    let test = ((n as f64) * fraction).round() as usize;
+    let (t, tr) = idx.split_at(test.min(n));
+    let (mut train, mut test) = (tr.to_vec(), t.to_vec());
+    train.sort();
+    test.sort();
+    (train, test)
+}
+
+fn residual_report(problem: &Problem, params: &[f64]) -> ResidualReport {
+    let mut ws = problem.workspace();
+    let n = problem.rows();
+    let mut r = DVector::zeros(n);
+    problem.evaluate(&mut ws, params, &mut r, None);
+    let (mut x, mut y, mut z) = (Vec::new(), Vec::new(), Vec::new());
+    for (i, m) in problem.data.measurements.iter().enumerate() {
+        if let MeasurementKind::Position { .. } | MeasurementKind::Pose { .. } = m.kind {
+            let row = problem.row_of[i];
+            // Undo whitening (and robust weights) to get mm.
+            let un = |k: usize| {
+                let w = problem.row_weights[row + k].sqrt() / problem.sigmas[row + k];
+                r[row + k] / w
+            };
+            x.push(un(0));
+            y.push(un(1));
+            z.push(un(2));
+        }
+    }
+    ResidualReport {
+        x: ErrorStats::of(&x),
+        y: ErrorStats::of(&y),
+        z: ErrorStats::of(&z),
+        norm: ErrorStats::of(&problem.errors(&mut ws, params)),
+    }
+}
+
+/// Identifies the cell's free parameters from a dataset: fit (optionally on a training
+/// split), covariance, TCP covariance at the working configurations, diagnostics, and
+/// held-out validation against the nominal and frames-only models.
+pub fn identify(
+    cell: &Cell,
+    data: &Dataset,
+    opts: &IdentifyOptions,
+    observer: &mut dyn Observer,
+) -> Result<Estimate, Error> {
+    let model = &cell.model;
+    let noise = cell
+        .instrument
+        .as_ref()
+        .map(|i| i.noise.clone())
+        .unwrap_or_default();
+    let (train_idx, test_idx) = if opts.holdout > 0.0 {
+        if opts.holdout >= 1.0 || opts.holdout.is_nan() {
+            return Err(Error::Input(format!(
+                "--holdout {} must be in [0, 1)",
+                opts.holdout
+            )));
+        }
+        holdout_split(data.configurations.len(), opts.holdout, opts.seed)
+    } else {
+        ((0..data.configurations.len()).collect(), Vec::new())
+    };
+    let train = data.subset(&train_idx);
+    let mut problem = Problem::new(model, &train, &noise)?;
+    let nominal = model.nominal();
+    let (sol, outliers, robust_scale) = solve(&mut problem, &nominal, opts, observer)?;
+    let names: Vec<String> = problem
+        .free
+        .iter()
+        .map(|&i| model.registry.get(i).name.clone())
+        .collect();
+    // Covariance from the unweighted whitened Jacobian (robust weights only pick data).
+    let unc = uncertainty::parameter_uncertainty(&sol.jacobian, &sol.residual, &names)?;
+    let working: Vec<Vec<f64>> = cell.working.iter().map(|w| w.q.clone()).collect();
+    let wnames: Vec<String> = cell.working.iter().map(|w| w.name.clone()).collect();
+    let (tcp, tcp_constrained) = if working.is_empty() {
+        (Vec::new(), Vec::new())
+    } else {
+        let g = uncertainty::tcp_jacobian(model, &sol.params, &problem.free, &working);
+        let cs = uncertainty::tcp_covariance(&g, &unc.covariance, &wnames);
+        let cc = uncertainty::tcp_covariance_constrained(&sol.jacobian, &g)?;
+        let blocks = (0..working.len())
+            .map(|i| cc.fixed_view::<3, 3>(3 * i, 3 * i).into_owned())
+            .collect();
+        (cs, blocks)
+    };
+    let observability =
+        uncertainty::observability(&sol.jacobian.rows(0, problem.data_rows()).into_owned());
+    let residuals = residual_report(&problem, &sol.params);
+    let validation = if test_idx.is_empty() {
+        None
+    } else {
+        Some(validate(
+            cell,
+            data,
+            &train_idx,
+            &test_idx,
+            &sol.params,
+            opts,
+            &noise,
+        )?)
+    };
+    let free_set: std::collections::HashSet<usize> = problem.free.iter().copied().collect();
+    let parameters = (0..model.param_count())
+        .map(|i| {
+            let p = model.registry.get(i);
+            let f = p.unit.display_factor();
+            let col = problem.free.iter().position(|&c| c == i);
+            ParameterEstimate {
+                name: p.name.clone(),
+                unit: p.unit.display_name().into(),
+                nominal: p.nominal * f,
+                estimate: sol.params[i] * f,
+                sigma: col.map(|c| unc.sigma[c] * f),
+                free: free_set.contains(&i),
+            }
+        })
+        .collect();
+    let reasons = if cell.auto_free {
+        cell.identifiability(&cell.identifiability_options())?
+            .excluded
+            .into_iter()
+            .map(|e| (e.name, e.reason))
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let strong = unc
+        .strong_correlations
+        .iter()
+        .map(|&(a, b, rho)| (names[a].clone(), names[b].clone(), rho))
+        .collect();
+    Ok(Estimate {
+        cell: cell.name.clone(),
+        data: data.source.clone(),
+        model: model.spec_at(&sol.params),
+        parameters,
+        fixed_reasons: reasons,
+        solver: SolverReport {
+            method: opts.method,
+            robust: opts.robust,
+            status: sol.status.clone(),
+            iterations: sol.iterations,
+            time_ms: sol.time.as_secs_f64() * 1e3,
+            history: sol.history.clone(),
+        },
+        free: names,
+        strong_correlations: strong,
+        uncertainty: unc,
+        tcp,
+        tcp_constrained,
+        observability,
+        residuals,
+        outliers,
+        robust_scale,
+        validation,
+        measurements: train.measurements.len(),
+        configurations: train.configurations.len(),
+    })
+}
+
+/// Held-out errors of the nominal model, the frames-only fit and the full calibration.
+fn validate(
+    cell: &Cell,
+    data: &Dataset,
+    train_idx: &[usize],
+    test_idx: &[usize],
+    calibrated: &[f64],
+    opts: &IdentifyOptions,
+    noise: &crate::measure::NoiseModel,
+) -> Result<Validation, Error> {
+    let train = data.subset(train_idx);
+    let test = data.subset(test_idx);
+    let frames_model = frames_only(&cell.model);
+    let mut frames_problem = Problem::new(&frames_model, &train, noise)?;
+    let (frames_sol, _, _) = solve(
+        &mut frames_problem,
+        &cell.model.nominal(),
+        opts,
+        &mut Silent,
+    )?;
+    let eval = Problem::new(&cell.model, &test, noise)?;
+    let mut ws = eval.workspace();
+    Ok(Validation {
+        train_configurations: train.configurations.len(),
+        test_configurations: test.configurations.len(),
+        nominal: ErrorStats::of(&eval.errors(&mut ws, &cell.model.nominal())),
+        frames_only: ErrorStats::of(&eval.errors(&mut ws, &frames_sol.params)),
+        calibrated: ErrorStats::of(&eval.errors(&mut ws, calibrated)),
+    })
+}

@@ -1,0 +1,97 @@
+//! What every identification solver reports, and the observer that receives progress.
+
+use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
+use std::time::Duration;
+
+/// How a solver ended.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "status", rename_all = "kebab-case")]
+pub enum Status {
+    /// A convergence criterion was met; `criterion` says which.
+    Converged { criterion: String },
+    /// The iteration limit was reached before convergence.
+    MaxIterations,
+    /// The iteration failed (non-finite values, or no step reduces the cost).
+    Diverged { reason: String },
+}
+
+impl Status {
+    pub fn is_converged(&self) -> bool {
+        matches!(self, Status::Converged { .. })
+    }
+}
+
+/// Result of a solver run.
+#[derive(Clone, Debug)]
+pub struct Solution {
+    /// Full parameter vector at the end.
+    pub params: Vec<f64>,
+    pub status: Status,
+    pub iterations: usize,
+    /// Cost ½‖r‖² after each iteration (index 0: the start).
+    pub history: Vec<f64>,
+    pub time: Duration,
+    /// Whitened residual and Jacobian at the solution.
+    pub residual: DVector<f64>,
+    pub jacobian: DMatrix<f64>,
+}
+
+impl Solution {
+    pub fn cost(&self) -> f64 {
+        0.5 * self.residual.norm_squared()
+    }
+}
+
+/// Receives progress from solvers (argmin / clarabel style): no solver prints.
+pub trait Observer {
+    /// Called after every accepted or rejected step.
+    fn iteration(&mut self, _iteration: usize, _cost: f64, _damping: f64) {}
+}
+
+/// An observer that ignores everything.
+pub struct Silent;
+
+impl Observer for Silent {}
+
+/// Stopping rules shared by the iterative solvers.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Tolerances {
+    pub max_iterations: usize,
+    /// Relative reduction of the cost (actual and predicted) below which to stop.
+    pub ftol: f64,
+    /// Relative step (in Marquardt-scaled variables) below which to stop.
+    pub xtol: f64,
+    /// Largest cosine between the residual and a Jacobian column (MINPACK's gtol).
+    pub gtol: f64,
+}
+
+impl Default for Tolerances {
+    fn default() -> Self {
+        Tolerances {
+            max_iterations: 200,
+            ftol: 1e-14,
+            xtol: 1e-12,
+            gtol: 1e-12,
+        }
+    }
+}
+
+/// MINPACK's gradient test: max over columns of |Jᵢᵀ r| / (‖Jᵢ‖ ‖r‖).
+pub(crate) fn gradient_cosine(j: &DMatrix<f64>, r: &DVector<f64>) -> f64 {
+    let rn = r.norm();
+    if rn == 0.0 {
+        return 0.0;
+    }
+    (0..j.ncols())
+        .map(|c| {
+            let col = j.column(c);
+            let n = col.norm();
+            if n == 0.0 {
+                0.0
+            } else {
+                (col.dot(r) / (n * rn)).abs()
+            }
+        })
+        .fold(0.0, f64::max)
+}

@@ -1,0 +1,279 @@
+//! Uncertainty of an estimate: parameter covariance C_p, correlations, the a-posteriori
+//! variance factor with its χ² test, and the TCP covariance C_s at working configurations —
+//! by the constrained formulation (paper eq. 19) and by `C_s = G C_p Gᵀ` (paper appendix).
+
+use crate::model::{forward_kinematics, identification_jacobian, Data, Model, Observed, Rows};
+use crate::Error;
+use nalgebra::{DMatrix, DVector, Matrix3};
+use serde::{Deserialize, Serialize};
+use statrs::distribution::{ChiSquared, ContinuousCDF};
+
+/// Parameter covariance and what follows from it.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ParameterUncertainty {
+    /// `C_p = (F₁ᵀF₁)⁻¹` with the whitened Jacobian F₁ (paper §1.1): the covariance implied by
+    /// the stated measurement σ (internal units: mm, rad).
+    pub covariance: DMatrix<f64>,
+    /// √diag(C_p).
+    pub sigma: Vec<f64>,
+    pub correlation: DMatrix<f64>,
+    /// Pairs of free-parameter columns with |ρ| > 0.95, and ρ.
+    pub strong_correlations: Vec<(usize, usize, f64)>,
+    /// A-posteriori variance factor σ̂₀² = rᵀr / (m − n); ≈ 1 if σ and the model are right.
+    pub variance_factor: f64,
+    /// Degrees of freedom m − n.
+    pub dof: usize,
+    /// rᵀr, χ²(m − n)-distributed under the model.
+    pub chi2: f64,
+    /// P(χ² ≥ rᵀr).
+    pub p_value: f64,
+    /// Two-sided test at 5 %: "consistent", "residuals too large", "residuals too small".
+    pub verdict: String,
+}
+
+/// Covariance and tests from the whitened Jacobian `j` and residual `r` at a solution.
+/// Fails, naming the columns, if `jᵀj` is singular.
+pub fn parameter_uncertainty(
+    j: &DMatrix<f64>,
+    r: &DVector<f64>,
+    names: &[String],
+) -> Result<ParameterUncertainty, Error> {
+    let n = j.ncols();
+    let info = j.tr_mul(j);
+    let cov = information_inverse(&info, names)?;
+    let sigma: Vec<f64> = (0..n).map(|k| cov[(k, k)].max(0.0).sqrt()).collect();
+    let correlation =
+        DMatrix::from_fn(n, n, |a, b| cov[(a, b)] / (sigma[a] * sigma[b]).max(1e-300));
+    let mut strong = Vec::new();
+    for a in 0..n {
+        for b in a + 1..n {
+            if correlation[(a, b)].abs() > 0.95 {
+                strong.push((a, b, correlation[(a, b)]));
+            }
+        }
+    }
+    let m = j.nrows();
+    let dof = m.saturating_sub(n);
+    let chi2 = r.norm_squared();
+    let (p_value, verdict) = if dof == 0 {
+        (f64::NAN, "no redundancy (m = n): cannot test".to_string())
+    } else {
+        let d = ChiSquared::new(dof as f64).map_err(|e| Error::Input(e.to_string()))?;
+        let p = 1.0 - d.cdf(chi2);
+        let v = if p < 0.025 {
+            "residuals too large for the stated σ (σ too small, model error, or outliers)"
+        } else if p > 0.975 {
+            "residuals too small for the stated σ (σ too large)"
+        } else {
+            "consistent with the stated σ"
+        };
+        (p, v.to_string())
+    };
+    Ok(ParameterUncertainty {
+        covariance: cov,
+        sigma,
+        correlation,
+        strong_correlations: strong,
+        variance_factor: if dof > 0 { chi2 / dof as f64 } else { f64::NAN },
+        dof,
+        chi2,
+        p_value,
+        verdict,
+    })
+}
+
+/// `(JᵀJ)⁻¹` by Cholesky; if singular, an error naming the parameters in the null space.
+pub fn information_inverse(info: &DMatrix<f64>, names: &[String]) -> Result<DMatrix<f64>, Error> {
+    let n = info.nrows();
+    // Scale to unit diagonal so the test for singularity is unit-free.
+    let d: Vec<f64> = (0..n).map(|k| info[(k, k)].max(0.0).sqrt()).collect();
+    if let Some(k) = d.iter().position(|&x| x == 0.0) {
+        return Err(Error::Input(format!(
+            "parameter `{}` has no effect on the measurements: it cannot be identified (fix it)",
+            names[k]
+        )));
+    }
+    let scaled = DMatrix::from_fn(n, n, |a, b| info[(a, b)] / (d[a] * d[b]));
+    let eig = scaled.clone().symmetric_eigen();
+    let min = eig.eigenvalues.min();
+    let max = eig.eigenvalues.max();
+    if min <= 1e-14 * max {
+        let k = eig.eigenvalues.imin();
+        let v = eig.eigenvectors.column(k);
+        let mut involved: Vec<(usize, f64)> = (0..n)
+            .map(|i| (i, v[i].abs()))
+            .filter(|x| x.1 > 0.05)
+            .collect();
+        involved.sort_by(|a, b| b.1.total_cmp(&a.1));
+        let list: Vec<String> = involved
+            .iter()
+            .map(|(i, _)| format!("`{}`", names[*i]))
+            .collect();
+        return Err(Error::Input(format!(
+            "the parameters are not all identifiable from these measurements: {} move the measurements in the same way (rank deficient; fix one of them or measure more varied poses)",
+            list.join(", ")
+        )));
+    }
+    let inv = scaled
+        .cholesky()
+        .ok_or_else(|| Error::Input("the information matrix is not positive definite".into()))?
+        .inverse();
+    Ok(DMatrix::from_fn(n, n, |a, b| inv[(a, b)] / (d[a] * d[b])))
+}
+
+/// Covariance of the TCP position (tool origin in the instrument frame) at one working
+/// configuration.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct TcpCovariance {
+    pub name: String,
+    /// `C_s = G C_p Gᵀ` (mm²), G = ∂TCP/∂p.
+    pub covariance: Matrix3<f64>,
+    /// (1/3) tr(C_s) (mm²): the paper's KPI criterion φ_A(C_s).
+    pub kpi: f64,
+}
+
+/// `G` rows (3 per working configuration) of the TCP position w.r.t. the free parameters.
+pub fn tcp_jacobian(
+    model: &Model,
+    params: &[f64],
+    free: &[usize],
+    working: &[Vec<f64>],
+) -> DMatrix<f64> {
+    let mut g = DMatrix::zeros(3 * working.len(), free.len());
+    let mut data = Data::new(model);
+    for (i, q) in working.iter().enumerate() {
+        forward_kinematics(model, &mut data, params, q);
+        identification_jacobian(
+            model,
+            &data,
+            Observed::Tool,
+            Rows::Position,
+            free,
+            &mut g,
+            3 * i,
+        );
+    }
+    g
+}
+
+/// `C_s = G C_p Gᵀ` per working configuration (paper appendix).
+pub fn tcp_covariance(g: &DMatrix<f64>, cp: &DMatrix<f64>, names: &[String]) -> Vec<TcpCovariance> {
+    let cs = g * cp * g.transpose();
+    names
+        .iter()
+        .enumerate()
+        .map(|(i, name)| {
+            let c: Matrix3<f64> = cs.fixed_view::<3, 3>(3 * i, 3 * i).into_owned();
+            TcpCovariance {
+                name: name.clone(),
+                kpi: c.trace() / 3.0,
+                covariance: c,
+            }
+        })
+        .collect()
+}
+
+/// The covariance of v = (p, s) by the constrained least-squares formulation of paper
+/// eq. 19: `C_v = [I 0] [[F₁ᵀF₁, F₂ᵀ], [F₂, 0]]⁻¹ [I; 0]` with `F₁ = [J, 0]` and
+/// `F₂ = [G, −I]` (the KPI constraint `TCP(p, q_work) − s = 0`). Returns the `s` block.
+pub fn tcp_covariance_constrained(
+    j: &DMatrix<f64>,
+    g: &DMatrix<f64>,
+) -> Result<DMatrix<f64>, Error> {
+    let (np, ns) = (j.ncols(), g.nrows());
+    let nv = np + ns;
+    let mut kkt = DMatrix::zeros(nv + ns, nv + ns);
+    kkt.view_mut((0, 0), (np, np)).copy_from(&j.tr_mul(j));
+    kkt.view_mut((nv, 0), (ns, np)).copy_from(g);
+    kkt.view_mut((0, nv), (np, ns)).copy_from(&g.transpose());
+    for k in 0..ns {
+        kkt[(nv + k, np + k)] = -1.0;
+        kkt[(np + k, nv + k)] = -1.0;
+    }
+    let inv = kkt
+        .lu()
+        .try_inverse()
+        .ok_or_else(|| Error::Input("the KKT matrix of paper eq. 19 is singular".into()))?;
+    Ok(inv.view((np, np), (ns, ns)).into_owned())
+}
+
+/// Observability indices of a (whitened) identification Jacobian with singular values
+/// σ₁ ≥ … ≥ σₙ and m rows (book §4.5.3, paper eqs. 8–10; Sun & Hollerbach 2008 numbering):
+/// O1 = (σ₁⋯σₙ)^{1/n}/√m (Borm & Menq), O2 = σₙ/σ₁ (inverse condition number),
+/// O3 = σₙ (minimum singular value), O4 = σₙ²/σ₁ (noise amplification index),
+/// O5 = 1/Σ(1/σᵢ). Larger is better for all five. `condition_number` = σ₁/σₙ of the
+/// column-normalised Jacobian (unit-free; book eq. 4.174 corrected: κ of J, not of JᵀJ).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Observability {
+    pub o1: f64,
+    pub o2: f64,
+    pub o3: f64,
+    pub o4: f64,
+    pub o5: f64,
+    pub condition_number: f64,
+    pub singular_values: Vec<f64>,
+}
+
+pub fn observability(j: &DMatrix<f64>) -> Observability {
+    let m = j.nrows() as f64;
+    let mut s: Vec<f64> = j
+        .clone()
+        .svd(false, false)
+        .singular_values
+        .iter()
+        .copied()
+        .collect();
+    s.sort_by(|a, b| b.total_cmp(a));
+    let n = s.len() as f64;
+    let (smax, smin) = (s[0], *s.last().unwrap_or(&0.0));
+    let geo = (s.iter().map(|x| x.max(1e-300).ln()).sum::<f64>() / n).exp();
+    let mut scaled = j.clone();
+    for c in 0..scaled.ncols() {
+        let nn = scaled.column(c).norm();
+        if nn > 0.0 {
+            scaled.column_mut(c).unscale_mut(nn);
+        }
+    }
+    let ss = scaled.svd(false, false).singular_values;
+    Observability {
+        o1: geo / m.sqrt(),
+        o2: smin / smax,
+        o3: smin,
+        o4: smin * smin / smax,
+        o5: 1.0 / s.iter().map(|x| 1.0 / x.max(1e-300)).sum::<f64>(),
+        condition_number: ss.max() / ss.min().max(1e-300),
+        singular_values: s,
+    }
+}
+
+/// Summary statistics of absolute errors (mm).
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct ErrorStats {
+    pub count: usize,
+    pub mean: f64,
+    pub rms: f64,
+    pub max: f64,
+    pub p95: f64,
+}
+
+impl ErrorStats {
+    pub fn of(values: &[f64]) -> ErrorStats {
+        if values.is_empty() {
+            return ErrorStats::default();
+        }
+        let mut v: Vec<f64> = values.iter().map(|x| x.abs()).collect();
+        v.sort_by(f64::total_cmp);
+        let n = v.len() as f64;
+        // 95th percentile by linear interpolation between order statistics.
+        let pos = 0.95 * (n - 1.0);
+        let (lo, hi) = (pos.floor() as usize, pos.ceil() as usize);
+        let p95 = v[lo] + (v[hi] - v[lo]) * (pos - lo as f64);
+        ErrorStats {
+            count: v.len(),
+            mean: v.iter().sum::<f64>() / n,
+            rms: (v.iter().map(|x| x * x).sum::<f64>() / n).sqrt(),
+            max: v[v.len() - 1],
+            p95,
+        }
+    }
+}

@@ -1,0 +1,203 @@
+//! Measurements and their residual blocks (book ch. 3–4, paper eqs. 3 and 5–6).
+//!
+//! A [`Dataset`] holds joint configurations and measurements taken at them. Each
+//! measurement is one residual block with its own covariance (diagonal, σ per row):
+//! a position of a target in the instrument frame (laser tracker, paper eq. 3), a full
+//! 6-D pose (book ch. 6; e.g. from three tooling balls, [`pose_from_three_points`]), the
+//! distance between a target at two configurations (ball bar, two-socket tools), the
+//! distance to a fixed point, or a point on a plane. Blocks of different kinds mix freely
+//! in one least-squares problem.
+
+pub mod csv;
+pub mod noise;
+pub mod residual;
+
+pub use noise::NoiseModel;
+
+use crate::model::{Observed, Pose};
+use nalgebra::{Matrix3, Matrix4, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// What one measurement observed.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum MeasurementKind {
+    /// Position of the observed point in the instrument frame (mm).
+    Position {
+        value: Vector3<f64>,
+        /// σ per axis (mm) from the data file, if it gives one.
+        sigma: Option<Vector3<f64>>,
+    },
+    /// Full pose of the observed frame in the instrument frame: position (mm) and rotation.
+    /// Residual rows: position error, then the rotation vector of `R_model R_measᵀ` (rad).
+    Pose {
+        value: Pose<f64>,
+        /// σ of the 3 position rows (mm) and the 3 rotation rows (rad).
+        sigma: Option<[f64; 6]>,
+    },
+    /// Distance between the observed point at this configuration and at configuration
+    /// `other` (mm): a ball bar or a two-socket tool between two poses.
+    Distance {
+        other: usize,
+        value: f64,
+        sigma: Option<f64>,
+    },
+    /// Distance from the observed point to a fixed point given in the instrument frame (mm):
+    /// a ball bar on a fixed pivot.
+    DistanceToPoint {
+        point: Vector3<f64>,
+        value: f64,
+        sigma: Option<f64>,
+    },
+    /// The observed point lies on the plane `normal · x = offset` (instrument frame, mm).
+    OnPlane {
+        normal: Vector3<f64>,
+        offset: f64,
+        sigma: Option<f64>,
+    },
+}
+
+impl MeasurementKind {
+    /// Number of residual rows.
+    pub fn rows(&self) -> usize {
+        match self {
+            MeasurementKind::Position { .. } => 3,
+            MeasurementKind::Pose { .. } => 6,
+            _ => 1,
+        }
+    }
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            MeasurementKind::Position { .. } => "position",
+            MeasurementKind::Pose { .. } => "pose",
+            MeasurementKind::Distance { .. } => "distance",
+            MeasurementKind::DistanceToPoint { .. } => "distance-to-point",
+            MeasurementKind::OnPlane { .. } => "on-plane",
+        }
+    }
+}
+
+/// One measurement: configuration index, observed frame, what was measured, and where it
+/// came from (for messages).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Measurement {
+    /// Index into [`Dataset::configurations`].
+    pub config: usize,
+    pub observed: Observed,
+    pub kind: MeasurementKind,
+    /// Line in the data file (1-based, header = 1), 0 for synthetic data.
+    pub line: usize,
+}
+
+/// Joint configurations and the measurements taken at them.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Dataset {
+    /// Joint values per configuration, internal units (rad, mm).
+    pub configurations: Vec<Vec<f64>>,
+    /// A user-facing id per configuration (the data file's `pose_id`).
+    pub config_ids: Vec<String>,
+    pub measurements: Vec<Measurement>,
+    /// Where the data came from.
+    pub source: String,
+}
+
+impl Dataset {
+    /// Total number of residual rows.
+    pub fn rows(&self) -> usize {
+        self.measurements.iter().map(|m| m.kind.rows()).sum()
+    }
+
+    /// Adds a configuration and returns its index.
+    pub fn push_configuration(&mut self, id: String, q: Vec<f64>) -> usize {
+        self.configurations.push(q);
+        self.config_ids.push(id);
+        self.configurations.len() - 1
+    }
+
+    /// The dataset restricted to the given configurations (measurements that refer to a
+    /// dropped configuration through `Distance::other` are dropped too).
+    pub fn subset(&self, configs: &[usize]) -> Dataset {
+        let mut map = vec![usize::MAX; self.configurations.len()];
+        let mut out = Dataset {
+            source: self.source.clone(),
+            ..Default::default()
+        };
+        for &c in configs {
+            map[c] =
+                out.push_configuration(self.config_ids[c].clone(), self.configurations[c].clone());
+        }
+        for m in &self.measurements {
+            if map[m.config] == usize::MAX {
+                continue;
+            }
+            let mut m2 = m.clone();
+            m2.config = map[m.config];
+            if let MeasurementKind::Distance { other, .. } = &mut m2.kind {
+                if map[*other] == usize::MAX {
+                    continue;
+                }
+                *other = map[*other];
+            }
+            out.measurements.push(m2);
+        }
+        out
+    }
+}
+
+/// Pose of a body from three measured tooling balls (book §6.2, eqs. 6.35–6.40): with the
+/// ball centres known in the body frame (`body`) and measured in the world (`world`), a
+/// fourth point `r4 = (r2 − r1) × (r3 − r1) + r1` completes each set and
+/// `T = [r1w r2w r3w r4w] [r1b r2b r3b r4b]⁻¹`. Exact for exact data; `None` if the balls
+/// are collinear. The rotation is re-orthonormalised (polar decomposition) for noisy data.
+pub fn pose_from_three_points(
+    body: &[Vector3<f64>; 3],
+    world: &[Vector3<f64>; 3],
+) -> Option<Pose<f64>> {
+    let complete = |r: &[Vector3<f64>; 3]| -> Matrix4<f64> {
+        let r4 = (r[1] - r[0]).cross(&(r[2] - r[0])) + r[0];
+        let mut m = Matrix4::zeros();
+        for (c, v) in [r[0], r[1], r[2], r4].iter().enumerate() {
+            m[(0, c)] = v[0];
+            m[(1, c)] = v[1];
+            m[(2, c)] = v[2];
+            m[(3, c)] = 1.0;
+        }
+        m
+    };
+    let b = complete(body);
+    let t = complete(world) * b.try_inverse()?;
+    let r: Matrix3<f64> = t.fixed_view::<3, 3>(0, 0).into_owned();
+    let svd = r.svd(true, true);
+    let (u, vt) = (svd.u?, svd.v_t?);
+    let rot = u * vt;
+    if rot.determinant() < 0.0 {
+        return None;
+    }
+    Some(Pose {
+        rot,
+        trans: t.fixed_view::<3, 1>(0, 3).into_owned(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn three_tooling_balls_recover_a_rigid_transform() {
+        // Book check 7: exact recovery of a synthetic transform.
+        let truth = Pose::from_xyz_rpy([100.0, -20.0, 300.0], [0.3, -0.2, 1.1]);
+        let body = [
+            Vector3::new(50.0, 0.0, 0.0),
+            Vector3::new(0.0, 60.0, 10.0),
+            Vector3::new(-20.0, -30.0, 80.0),
+        ];
+        let world = body.map(|b| truth.transform_point(&b));
+        let t = pose_from_three_points(&body, &world).unwrap();
+        assert!((t.rot - truth.rot).norm() < 1e-12);
+        assert!((t.trans - truth.trans).norm() < 1e-10);
+        let collinear = [Vector3::zeros(), Vector3::x(), Vector3::x() * 2.0];
+        assert!(pose_from_three_points(&collinear, &collinear).is_none());
+    }
+}

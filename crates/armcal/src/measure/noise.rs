@@ -1,0 +1,88 @@
+//! Instrument noise models: the σ of every residual row. Weights are the inverse
+//! covariance (paper eq. 5: `f1 = Σ⁻¹(η − h)` with Σ diagonal here).
+
+use crate::measure::{Measurement, MeasurementKind};
+use crate::Error;
+use serde::{Deserialize, Serialize};
+
+/// Noise of the instrument's readings, internal units (mm, rad).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "model", rename_all = "kebab-case")]
+pub enum NoiseModel {
+    /// Independent N(0, σ²) per position axis (mm); `sigma_angle` (rad) for the rotation
+    /// rows of pose measurements. One-row blocks (distances, planes) use σ of the x axis.
+    Constant { sigma: [f64; 3], sigma_angle: f64 },
+    /// Laser-tracker style σ = a + b · range per axis: `a` in mm, `b_per_m` in mm per metre
+    /// of distance from the instrument (e.g. 0.015 mm + 0.006 mm/m).
+    Range { a: f64, b_per_m: f64 },
+    /// σ per measurement, read from the data file; values below `floor` (mm) are raised to
+    /// it (a stated uncertainty of 0 would give an infinite weight).
+    PerMeasurement { floor: f64 },
+}
+
+impl Default for NoiseModel {
+    fn default() -> Self {
+        NoiseModel::Constant {
+            sigma: [1.0; 3],
+            sigma_angle: 1e-3,
+        }
+    }
+}
+
+impl NoiseModel {
+    /// σ of each residual row of `m` (first `m.kind.rows()` entries). `range` is the
+    /// distance of the observed point from the instrument (mm), for the range model.
+    pub fn sigmas(&self, m: &Measurement, range: f64) -> Result<[f64; 6], Error> {
+        let rows = m.kind.rows();
+        let mut out = [0.0; 6];
+        // σ the data file gives for this measurement, if any.
+        let given: Option<[f64; 6]> = match &m.kind {
+            MeasurementKind::Position { sigma, .. } => {
+                sigma.map(|s| [s[0], s[1], s[2], 0.0, 0.0, 0.0])
+            }
+            MeasurementKind::Pose { sigma, .. } => *sigma,
+            MeasurementKind::Distance { sigma, .. }
+            | MeasurementKind::DistanceToPoint { sigma, .. }
+            | MeasurementKind::OnPlane { sigma, .. } => sigma.map(|s| [s, 0.0, 0.0, 0.0, 0.0, 0.0]),
+        };
+        match self {
+            NoiseModel::Constant { sigma, sigma_angle } => match &m.kind {
+                MeasurementKind::Position { .. } => out[..3].copy_from_slice(sigma),
+                MeasurementKind::Pose { .. } => {
+                    out[..3].copy_from_slice(sigma);
+                    out[3..].fill(*sigma_angle);
+                }
+                _ => out[0] = sigma[0],
+            },
+            NoiseModel::Range { a, b_per_m } => {
+                if matches!(m.kind, MeasurementKind::Pose { .. }) {
+                    return Err(Error::Input(format!(
+                        "line {}: the range noise model has no σ for the rotation rows of a pose measurement; give σ in the data file or use the constant model",
+                        m.line
+                    )));
+                }
+                let s = a + b_per_m * range / 1000.0;
+                out[..rows].fill(s);
+            }
+            NoiseModel::PerMeasurement { floor } => {
+                let g = given.ok_or_else(|| {
+                    Error::Input(format!(
+                        "line {}: the noise model is per-measurement but this {} measurement has no σ columns",
+                        m.line,
+                        m.kind.name()
+                    ))
+                })?;
+                for (o, s) in out.iter_mut().zip(g).take(rows) {
+                    *o = s.max(*floor);
+                }
+            }
+        }
+        if let Some(bad) = out[..rows].iter().find(|s| !(s.is_finite() && **s > 0.0)) {
+            return Err(Error::Input(format!(
+                "line {}: σ = {bad} is not a positive number",
+                m.line
+            )));
+        }
+        Ok(out)
+    }
+}

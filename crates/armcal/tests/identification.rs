@@ -1,0 +1,197 @@
+//! Identification against known truth in simulation: exact recovery, agreement of the
+//! solvers, honest covariance (Monte Carlo), both C_s formulas.
+
+mod common;
+use armcal::cell::Cell;
+use armcal::identify::*;
+use armcal::model::identifiability::random_configurations;
+use armcal::sim::{perturbed_truth, simulate, Perturbation};
+use nalgebra::{DVector, Matrix3, Vector3};
+use rayon::prelude::*;
+use std::path::Path;
+
+fn paper_cell() -> Cell {
+    Cell::from_file(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-cell.toml"))
+        .unwrap()
+}
+
+#[test]
+fn noise_free_identification_recovers_the_truth() {
+    let cell = paper_cell();
+    let model = &cell.model;
+    let truth = perturbed_truth(model, &Perturbation::default(), 11);
+    let qs = random_configurations(model, 60, 5);
+    let data = simulate(model, &truth, &qs, None, 0).unwrap();
+    let noise = cell.instrument.as_ref().unwrap().noise.clone();
+    for method in [Method::Lm, Method::GaussNewton, Method::Kalman] {
+        let mut problem = Problem::new(model, &data, &noise).unwrap();
+        let opts = IdentifyOptions {
+            method,
+            ..Default::default()
+        };
+        let (sol, _, _) = solve(&mut problem, &model.nominal(), &opts, &mut Silent).unwrap();
+        assert!(sol.status.is_converged(), "{method:?}: {:?}", sol.status);
+        for &i in &problem.free {
+            let (est, tru) = (sol.params[i], truth[i]);
+            assert!(
+                (est - tru).abs() <= 1e-8 * tru.abs().max(1.0),
+                "{method:?} {}: {est} vs truth {tru}",
+                model.registry.get(i).name
+            );
+        }
+    }
+}
+
+#[test]
+fn gauss_newton_kalman_and_lm_agree_on_noisy_data() {
+    let cell = paper_cell();
+    let model = &cell.model;
+    let truth = perturbed_truth(model, &Perturbation::default(), 3);
+    let qs = random_configurations(model, 60, 8);
+    let noise = cell.instrument.as_ref().unwrap().noise.clone();
+    let data = simulate(model, &truth, &qs, Some(&noise), 21).unwrap();
+    let run = |method| {
+        let mut problem = Problem::new(model, &data, &noise).unwrap();
+        let opts = IdentifyOptions {
+            method,
+            ..Default::default()
+        };
+        let (sol, _, _) = solve(&mut problem, &model.nominal(), &opts, &mut Silent).unwrap();
+        assert!(sol.status.is_converged(), "{method:?}: {:?}", sol.status);
+        (problem.free.clone(), sol.params)
+    };
+    let (free, lm) = run(Method::Lm);
+    let (_, gn) = run(Method::GaussNewton);
+    let (_, kf) = run(Method::Kalman);
+    let problem = Problem::new(model, &data, &noise).unwrap();
+    let sol_sigma = {
+        let mut ws = problem.workspace();
+        let mut r = DVector::zeros(problem.rows());
+        let mut j = nalgebra::DMatrix::zeros(problem.rows(), problem.columns());
+        problem.evaluate(&mut ws, &lm, &mut r, Some(&mut j));
+        let names: Vec<String> = free
+            .iter()
+            .map(|&i| model.registry.get(i).name.clone())
+            .collect();
+        uncertainty::parameter_uncertainty(&j, &r, &names)
+            .unwrap()
+            .sigma
+    };
+    for (c, &i) in free.iter().enumerate() {
+        // Agreement to a tiny fraction of the parameter's standard deviation.
+        assert!(
+            (lm[i] - gn[i]).abs() < 1e-6 * sol_sigma[c],
+            "GN {}",
+            model.registry.get(i).name
+        );
+        assert!(
+            (lm[i] - kf[i]).abs() < 1e-4 * sol_sigma[c],
+            "Kalman {}",
+            model.registry.get(i).name
+        );
+    }
+}
+
+#[test]
+fn constrained_tcp_covariance_equals_propagated_covariance() {
+    // Paper eq. 19 (KKT form) against C_s = G C_p Gᵀ (paper appendix).
+    let cell = paper_cell();
+    let model = &cell.model;
+    let qs = random_configurations(model, 60, 2);
+    let data = simulate(model, &model.nominal(), &qs, None, 0).unwrap();
+    let noise = cell.instrument.as_ref().unwrap().noise.clone();
+    let problem = Problem::new(model, &data, &noise).unwrap();
+    let mut ws = problem.workspace();
+    let mut r = DVector::zeros(problem.rows());
+    let mut j = nalgebra::DMatrix::zeros(problem.rows(), problem.columns());
+    problem.evaluate(&mut ws, &model.nominal(), &mut r, Some(&mut j));
+    let names: Vec<String> = problem
+        .free
+        .iter()
+        .map(|&i| model.registry.get(i).name.clone())
+        .collect();
+    let cp = uncertainty::parameter_uncertainty(&j, &r, &names)
+        .unwrap()
+        .covariance;
+    let work: Vec<Vec<f64>> = cell.working.iter().map(|w| w.q.clone()).collect();
+    let g = uncertainty::tcp_jacobian(model, &model.nominal(), &problem.free, &work);
+    let cs = uncertainty::tcp_covariance(&g, &cp, &["w".into()]);
+    let cc = uncertainty::tcp_covariance_constrained(&j, &g).unwrap();
+    let diff = (cs[0].covariance - cc.fixed_view::<3, 3>(0, 0)).abs().max();
+    assert!(
+        diff < 1e-9 * cs[0].covariance.abs().max(),
+        "eq. 19 vs G C_p Gᵀ differ by {diff}"
+    );
+    // The paper's KPI for 60 random poses lands near its heuristic figures (0.5–0.8 mm²).
+    assert!(
+        cs[0].kpi > 0.2 && cs[0].kpi < 2.0,
+        "(1/3) tr C_s = {}",
+        cs[0].kpi
+    );
+}
+
+#[test]
+fn predicted_tcp_covariance_matches_monte_carlo() {
+    // 300 seeded re-identifications from noisy data at the same 60 random poses.
+    let cell = paper_cell();
+    let model = &cell.model;
+    let truth = perturbed_truth(model, &Perturbation::default(), 4);
+    let qs = random_configurations(model, 60, 17);
+    let noise = cell.instrument.as_ref().unwrap().noise.clone();
+    let work = cell.working[0].q.clone();
+    let tcp_at = |params: &[f64]| -> Vector3<f64> {
+        let mut d = armcal::model::Data::new(model);
+        armcal::model::forward_kinematics(model, &mut d, params, &work);
+        armcal::model::observed_position(&d, armcal::model::Observed::Tool)
+    };
+    let estimates: Vec<Vector3<f64>> = (0..300u64)
+        .into_par_iter()
+        .map(|seed| {
+            let data = simulate(model, &truth, &qs, Some(&noise), 1000 + seed).unwrap();
+            let mut problem = Problem::new(model, &data, &noise).unwrap();
+            let (sol, _, _) = solve(
+                &mut problem,
+                &model.nominal(),
+                &IdentifyOptions::default(),
+                &mut Silent,
+            )
+            .unwrap();
+            assert!(sol.status.is_converged());
+            tcp_at(&sol.params)
+        })
+        .collect();
+    let n = estimates.len() as f64;
+    let mean = estimates.iter().fold(Vector3::zeros(), |a, b| a + b) / n;
+    let emp = estimates.iter().fold(Matrix3::zeros(), |a, e| {
+        a + (e - mean) * (e - mean).transpose()
+    }) / (n - 1.0);
+    // Prediction at the truth.
+    let data = simulate(model, &truth, &qs, None, 0).unwrap();
+    let problem = Problem::new(model, &data, &noise).unwrap();
+    let mut ws = problem.workspace();
+    let mut r = DVector::zeros(problem.rows());
+    let mut j = nalgebra::DMatrix::zeros(problem.rows(), problem.columns());
+    problem.evaluate(&mut ws, &truth, &mut r, Some(&mut j));
+    let names: Vec<String> = problem
+        .free
+        .iter()
+        .map(|&i| model.registry.get(i).name.clone())
+        .collect();
+    let cp = uncertainty::parameter_uncertainty(&j, &r, &names)
+        .unwrap()
+        .covariance;
+    let g = uncertainty::tcp_jacobian(model, &truth, &problem.free, std::slice::from_ref(&work));
+    let cs = uncertainty::tcp_covariance(&g, &cp, &["w".into()]);
+    let ratio = emp.trace() / cs[0].covariance.trace();
+    eprintln!(
+        "Monte Carlo: empirical (1/3) tr = {:.4} mm², predicted {:.4} mm², ratio {ratio:.3}",
+        emp.trace() / 3.0,
+        cs[0].kpi
+    );
+    assert!(
+        (0.85..=1.15).contains(&ratio),
+        "empirical / predicted trace = {ratio:.3} (emp {:.4}, pred {:.4})",
+        emp.trace(),
+        cs[0].covariance.trace()
+    );
+}
