@@ -23,6 +23,12 @@ enum Command {
     Model(commands::model::Args),
     /// Forward kinematics: pose of every frame at a joint configuration.
     Fk(commands::fk::Args),
+    /// Simulate a measurement campaign on a perturbed virtual robot.
+    Simulate(commands::simulate::Args),
+    /// Identify the cell's parameters from a data file.
+    Identify(commands::identify::Args),
+    /// Predict what the instrument measures at given joint configurations.
+    Predict(commands::predict::Args),
 }
 
 fn main() {
@@ -31,6 +37,9 @@ fn main() {
         Command::Robots => commands::robots::run(),
         Command::Model(a) => commands::model::run(&a),
         Command::Fk(a) => commands::fk::run(&a),
+        Command::Simulate(a) => commands::simulate::run(&a),
+        Command::Identify(a) => commands::identify::run(&a),
+        Command::Predict(a) => commands::predict::run(&a),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

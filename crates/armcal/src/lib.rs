@@ -7,6 +7,7 @@
 
 pub mod cell;
 pub mod error;
+pub mod evaluate;
 pub mod identify;
 pub mod measure;
 pub mod model;

@@ -103,6 +103,95 @@ fn kuka_reach_matches_datasheets() {
     }
 }
 
+/// Distance between the segments `p1 q1` and `p2 q2` (Ericson, *Real-Time Collision
+/// Detection*, §5.1.9: closest points with both parameters clamped to [0, 1]).
+fn segment_distance(p1: Vector3<f64>, q1: Vector3<f64>, p2: Vector3<f64>, q2: Vector3<f64>) -> f64 {
+    let (d1, d2, r) = (q1 - p1, q2 - p2, p1 - p2);
+    let (a, e, f) = (d1.dot(&d1), d2.dot(&d2), d2.dot(&r));
+    let (s, t) = if a < 1e-12 && e < 1e-12 {
+        (0.0, 0.0)
+    } else if a < 1e-12 {
+        (0.0, (f / e).clamp(0.0, 1.0))
+    } else {
+        let c = d1.dot(&r);
+        if e < 1e-12 {
+            ((-c / a).clamp(0.0, 1.0), 0.0)
+        } else {
+            let b = d1.dot(&d2);
+            let denom = a * e - b * b;
+            let mut s = if denom > 1e-12 {
+                ((b * f - c * e) / denom).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let mut t = (b * s + f) / e;
+            if t < 0.0 {
+                t = 0.0;
+                s = (-c / a).clamp(0.0, 1.0);
+            } else if t > 1.0 {
+                t = 1.0;
+                s = ((b - c) / a).clamp(0.0, 1.0);
+            }
+            (s, t)
+        }
+    };
+    ((p1 + d1 * s) - (p2 + d2 * t)).norm()
+}
+
+/// At poses a real robot takes without touching itself (KUKA HOME and the study's working
+/// pose, the IRB 120 calibration pose, the UR10 upright home), capsules on chain frames at
+/// least three links apart do not intersect, nor does the pedestal (on `base`) touch the
+/// upper arm. Closer frames share a joint and may overlap.
+#[test]
+fn capsules_are_clear_at_home_poses() {
+    let d = f64::to_radians;
+    let kuka_home = vec![0.0, d(-90.0), d(90.0), 0.0, 0.0, 0.0];
+    let work = vec![0.0, d(-30.0), d(30.0), 0.0, d(-90.0), 0.0];
+    let cases = [
+        ("kr15", vec![kuka_home.clone(), work.clone()]),
+        ("kr300", vec![kuka_home.clone(), work.clone()]),
+        ("kr500", vec![kuka_home, work]),
+        ("irb120", vec![vec![0.0; 6]]),
+        ("ur10", vec![vec![0.0, d(-90.0), 0.0, d(-90.0), 0.0, 0.0]]),
+    ];
+    for (name, poses) in cases {
+        let robot = robots::robot(name).unwrap();
+        let model = Model::from_spec(&robot.spec).unwrap();
+        for q in poses {
+            model.check_joints(&q).unwrap();
+            let mut data: Data<f64> = Data::new(&model);
+            forward_kinematics(&model, &mut data, &model.nominal(), &q);
+            let world: Vec<(usize, Vector3<f64>, Vector3<f64>, f64)> = robot
+                .capsules
+                .iter()
+                .map(|c| {
+                    let i = model.link_index(&c.frame).unwrap();
+                    let f = &data.frames[i];
+                    let (a, b) = (Vector3::from(c.a), Vector3::from(c.b));
+                    (i, f.transform_point(&a), f.transform_point(&b), c.radius)
+                })
+                .collect();
+            for (k, x) in world.iter().enumerate() {
+                for y in &world[k + 1..] {
+                    // the pedestal (on `base`) must clear the upper arm as well
+                    let apart = if x.0.min(y.0) == 0 { 2 } else { 3 };
+                    if x.0.abs_diff(y.0) < apart {
+                        continue;
+                    }
+                    let gap = segment_distance(x.1, x.2, y.1, y.2) - x.3 - y.3;
+                    assert!(
+                        gap > 0.0,
+                        "{name} at {q:?}: capsules on `{}` and `{}` overlap by {:.1} mm",
+                        model.links[x.0].spec.name,
+                        model.links[y.0].spec.name,
+                        -gap
+                    );
+                }
+            }
+        }
+    }
+}
+
 fn assert_pose(name: &str, q: &[f64], trans: [f64; 3], rot: nalgebra::Matrix3<f64>) {
     let model = Model::from_spec(&robots::robot(name).unwrap().spec).unwrap();
     let pose = tool_pose(&model, &model.nominal(), q);

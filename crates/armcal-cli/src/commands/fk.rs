@@ -1,7 +1,6 @@
 //! `armcal fk <robot-or-cell> --joints ...`
 
 use anyhow::{bail, Context};
-use armcal::cell::Cell;
 use armcal::model::{forward_kinematics, observed_pose, Data, JointKind, Observed, Pose};
 
 #[derive(clap::Args)]
@@ -29,10 +28,7 @@ fn pose_json(p: &Pose<f64>) -> serde_json::Value {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
-    let cell = Cell::load(&a.target)?;
-    for w in &cell.warnings {
-        eprintln!("warning: {w}");
-    }
+    let cell = super::output::load_cell(&a.target)?;
     let model = &cell.model;
     let values: Vec<f64> = a
         .joints

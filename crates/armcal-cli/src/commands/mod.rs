@@ -1,5 +1,9 @@
 //! One module per subcommand.
 
 pub mod fk;
+pub mod identify;
 pub mod model;
+pub mod output;
+pub mod predict;
 pub mod robots;
+pub mod simulate;

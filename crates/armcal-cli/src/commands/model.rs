@@ -1,6 +1,5 @@
 //! `armcal model <robot-or-cell>`: parameters, completeness and identifiability.
 
-use armcal::cell::Cell;
 use armcal::model::identifiability::{IdentifiabilityOptions, Measurement};
 use armcal::model::Status;
 
@@ -23,10 +22,7 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
-    let cell = Cell::load(&a.target)?;
-    for w in &cell.warnings {
-        eprintln!("warning: {w}");
-    }
+    let cell = super::output::load_cell(&a.target)?;
     let model = &cell.model;
     let measurement = a
         .measurement
@@ -67,8 +63,8 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     println!("{} ({})", cell.name, cell.origin);
     println!("source: {}\n", cell.robot.source);
     println!(
-        "{:<4} {:<14} {:>14} {:<4} {}",
-        "#", "parameter", "nominal", "unit", "status"
+        "{:<4} {:<14} {:>14} {:<4} status",
+        "#", "parameter", "nominal", "unit"
     );
     for (i, p) in model.registry.iter().enumerate() {
         let status = match p.status {

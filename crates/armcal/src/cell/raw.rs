@@ -427,14 +427,6 @@ fn noise(t: &toml::Table) -> Result<NoiseModel, String> {
     Ok(n)
 }
 
-#[allow(non_snake_case)]
-fn TODO_URDF(p: &Path, _tip: Option<&str>) -> Result<ModelSpec, Error> {
-    Err(Error::Input(format!(
-        "URDF import pending: {}",
-        p.display()
-    )))
-}
-
 pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
     let ctx = Ctx { file, text };
     let raw: RawCell = toml::from_str(text).map_err(|e| Error::File {
@@ -459,8 +451,8 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
         robots::robot(b).map_err(|e| ctx.err(rspan.clone(), "robot.builtin", e))?
     } else if let Some(u) = &rr.urdf {
         let path = dir.join(u);
-        let spec: ModelSpec = TODO_URDF(&path, rr.tip.as_deref())
-            .map_err(|e: Error| ctx.err(rspan.clone(), "robot.urdf", e))?;
+        let spec = crate::model::urdf::read_urdf(&path, rr.tip.as_deref())
+            .map_err(|e| ctx.err(rspan.clone(), "robot.urdf", e))?;
         Robot {
             name: rr.name.clone().unwrap_or_else(|| spec.name.clone()),
             summary: format!("imported from {u}"),

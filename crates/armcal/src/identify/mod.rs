@@ -145,6 +145,82 @@ pub struct Estimate {
     pub configurations: usize,
 }
 
+/// The cell's model with its free set for `data`, and the reason for every parameter left
+/// out. With `free = "auto"` the free set is the minimal identifiable set *at the data's
+/// configurations*; parameters these data cannot identify although the cell could (e.g. a
+/// joint that never moves, or all poses alike) are marked "from these data". Too few
+/// residual rows for the cell's identifiable set is an error.
+pub fn identifiable_model(
+    cell: &Cell,
+    data: &Dataset,
+) -> Result<(Model, Vec<(String, String)>), Error> {
+    if !cell.auto_free {
+        return Ok((cell.model.clone(), Vec::new()));
+    }
+    let generic = cell.identifiability(&cell.identifiability_options())?;
+    let rows = data.rows();
+    if rows < generic.identifiable.len() {
+        return Err(Error::Input(format!(
+            "{rows} residual rows from {} measurements cannot determine the {} parameters cell `{}` identifies; measure at least {} configurations",
+            data.measurements.len(),
+            generic.identifiable.len(),
+            cell.name,
+            generic.identifiable.len().div_ceil(data.rows().max(1) / data.configurations.len().max(1))
+        )));
+    }
+    let mut declared = cell.model.clone();
+    for &i in &cell.declared_free {
+        if !declared.registry.get(i).status.is_free() {
+            declared.registry.set_status(i, ParamStatus::Free);
+        }
+    }
+    let report = crate::model::identifiability::analyze_at(
+        &declared,
+        &declared.nominal(),
+        &data.configurations,
+        &cell.identifiability_options(),
+    )?;
+    report.apply(&mut declared)?;
+    let generic_excluded: std::collections::HashSet<&str> =
+        generic.excluded.iter().map(|e| e.name.as_str()).collect();
+    let reasons = report
+        .excluded
+        .into_iter()
+        .map(|e| {
+            let reason = if generic_excluded.contains(e.name.as_str()) {
+                e.reason
+            } else {
+                format!("from these data: {}", e.reason)
+            };
+            (e.name, reason)
+        })
+        .collect();
+    Ok((declared, reasons))
+}
+
+/// Starting point of the full fit: the nominal robot with the instrument, target, base and
+/// tool frames fitted first (a two-stage fit). A tracker placed only roughly in the cell, or
+/// not at all, is then no obstacle for the full calibration.
+pub fn frames_first_start(
+    model: &Model,
+    data: &Dataset,
+    noise: &crate::measure::NoiseModel,
+    opts: &IdentifyOptions,
+) -> Result<Vec<f64>, Error> {
+    let frames = frames_only(model);
+    let mut problem = Problem::new(&frames, data, noise)?;
+    if problem.free.is_empty() || problem.free.len() == model.registry.free().len() {
+        return Ok(model.nominal());
+    }
+    let stage = IdentifyOptions {
+        robust: opts.robust,
+        method: Method::Lm,
+        ..opts.clone()
+    };
+    let (sol, _, _) = solve(&mut problem, &model.nominal(), &stage, &mut Silent)?;
+    Ok(sol.params)
+}
+
 /// Runs one solver on a problem.
 pub fn solve(
     problem: &mut Problem,
@@ -241,7 +317,6 @@ pub fn identify(
     opts: &IdentifyOptions,
     observer: &mut dyn Observer,
 ) -> Result<Estimate, Error> {
-    let model = &cell.model;
     let noise = cell
         .instrument
         .as_ref()
@@ -259,9 +334,13 @@ pub fn identify(
         ((0..data.configurations.len()).collect(), Vec::new())
     };
     let train = data.subset(&train_idx);
+    // With `free = "auto"` the free set is the minimal identifiable set *for these
+    // configurations*: parameters the data cannot separate are fixed, with their reason.
+    let (fitted_model, reasons) = identifiable_model(cell, &train)?;
+    let model = &fitted_model;
     let mut problem = Problem::new(model, &train, &noise)?;
-    let nominal = model.nominal();
-    let (sol, outliers, robust_scale) = solve(&mut problem, &nominal, opts, observer)?;
+    let start = frames_first_start(model, &train, &noise, opts)?;
+    let (sol, outliers, robust_scale) = solve(&mut problem, &start, opts, observer)?;
     let names: Vec<String> = problem
         .free
         .iter()
@@ -289,7 +368,7 @@ pub fn identify(
         None
     } else {
         Some(validate(
-            cell,
+            model,
             data,
             &train_idx,
             &test_idx,
@@ -314,15 +393,6 @@ pub fn identify(
             }
         })
         .collect();
-    let reasons = if cell.auto_free {
-        cell.identifiability(&cell.identifiability_options())?
-            .excluded
-            .into_iter()
-            .map(|e| (e.name, e.reason))
-            .collect()
-    } else {
-        Vec::new()
-    };
     let strong = unc
         .strong_correlations
         .iter()
@@ -359,7 +429,7 @@ pub fn identify(
 
 /// Held-out errors of the nominal model, the frames-only fit and the full calibration.
 fn validate(
-    cell: &Cell,
+    model: &Model,
     data: &Dataset,
     train_idx: &[usize],
     test_idx: &[usize],
@@ -369,21 +439,76 @@ fn validate(
 ) -> Result<Validation, Error> {
     let train = data.subset(train_idx);
     let test = data.subset(test_idx);
-    let frames_model = frames_only(&cell.model);
-    let mut frames_problem = Problem::new(&frames_model, &train, noise)?;
-    let (frames_sol, _, _) = solve(
-        &mut frames_problem,
-        &cell.model.nominal(),
-        opts,
-        &mut Silent,
-    )?;
-    let eval = Problem::new(&cell.model, &test, noise)?;
+    let frames = frames_first_start(model, &train, noise, opts)?;
+    let eval = Problem::new(model, &test, noise)?;
     let mut ws = eval.workspace();
     Ok(Validation {
         train_configurations: train.configurations.len(),
         test_configurations: test.configurations.len(),
-        nominal: ErrorStats::of(&eval.errors(&mut ws, &cell.model.nominal())),
-        frames_only: ErrorStats::of(&eval.errors(&mut ws, &frames_sol.params)),
+        nominal: ErrorStats::of(&eval.errors(&mut ws, &model.nominal())),
+        frames_only: ErrorStats::of(&eval.errors(&mut ws, &frames)),
         calibrated: ErrorStats::of(&eval.errors(&mut ws, calibrated)),
     })
+}
+
+impl Estimate {
+    /// Reads an `estimate.json`.
+    pub fn from_file(path: &std::path::Path) -> Result<Estimate, Error> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::File {
+            file: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        serde_json::from_str(&text).map_err(|e| Error::File {
+            file: path.display().to_string(),
+            message: format!("not an armcal estimate: {e}"),
+        })
+    }
+
+    /// The full parameter vector of `model` from this estimate (by parameter name). An
+    /// estimate of a different robot or cell is an error that names the mismatch.
+    pub fn params_for(&self, model: &Model) -> Result<Vec<f64>, Error> {
+        let by_name: std::collections::HashMap<&str, &ParameterEstimate> = self
+            .parameters
+            .iter()
+            .map(|p| (p.name.as_str(), p))
+            .collect();
+        let missing: Vec<&str> = model
+            .registry
+            .iter()
+            .filter(|p| !by_name.contains_key(p.name.as_str()))
+            .map(|p| p.name.as_str())
+            .collect();
+        let extra: Vec<&str> = self
+            .parameters
+            .iter()
+            .filter(|p| model.registry.index_of(&p.name).is_none())
+            .map(|p| p.name.as_str())
+            .collect();
+        if !missing.is_empty() || !extra.is_empty() {
+            return Err(Error::Input(format!(
+                "the estimate (cell `{}`) does not belong to model `{}`: {}{}",
+                self.cell,
+                model.name,
+                if missing.is_empty() {
+                    String::new()
+                } else {
+                    format!("the estimate lacks {}", missing.join(", "))
+                },
+                if extra.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        "{}the model has no {}",
+                        if missing.is_empty() { "" } else { "; " },
+                        extra.join(", ")
+                    )
+                },
+            )));
+        }
+        Ok(model
+            .registry
+            .iter()
+            .map(|p| by_name[p.name.as_str()].estimate / p.unit.display_factor())
+            .collect())
+    }
 }

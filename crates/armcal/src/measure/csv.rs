@@ -70,38 +70,15 @@ fn err(file: &str, msg: String) -> Error {
     }
 }
 
-/// Reads a data file for `model`. `joint_columns`: the column names feeding the joints
-/// (from the cell), or `None` for `q1…qn` with unit suffixes.
-pub fn read(
-    path: &Path,
+/// The column of every joint, with its unit factor; marks the columns used.
+fn joint_layout(
+    header: &[String],
     model: &Model,
     joint_columns: Option<&[String]>,
-) -> Result<(Dataset, ReadReport), Error> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| err(&path.display().to_string(), e.to_string()))?;
-    read_str(&text, &path.display().to_string(), model, joint_columns)
-}
-
-/// As [`read`], from text; `file` names it in errors.
-pub fn read_str(
-    text: &str,
     file: &str,
-    model: &Model,
-    joint_columns: Option<&[String]>,
-) -> Result<(Dataset, ReadReport), Error> {
-    let mut rdr = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_reader(text.as_bytes());
-    let header: Vec<String> = rdr
-        .headers()
-        .map_err(|e| err(file, format!("header: {e}")))?
-        .iter()
-        .map(str::to_string)
-        .collect();
+    used: &mut [bool],
+) -> Result<Vec<Column>, Error> {
     let find = |name: &str| header.iter().position(|h| h == name);
-    let mut used = vec![false; header.len()];
-
-    // Joint columns.
     let mut joints = Vec::new();
     for (j, joint) in model.joints.iter().enumerate() {
         let col = match joint_columns {
@@ -155,6 +132,138 @@ pub fn read_str(
             factor,
         });
     }
+
+    Ok(joints)
+}
+
+/// Parses the joint values of one record (internal units), with line and column in errors.
+fn record_joints(
+    record: &csv::StringRecord,
+    joints: &[Column],
+    header: &[String],
+    model: &Model,
+    file: &str,
+    line: usize,
+) -> Result<Vec<f64>, Error> {
+    joints
+        .iter()
+        .zip(&model.joints)
+        .map(|(c, j)| cell_value(record, c, header, file, line, &j.name))
+        .collect()
+}
+
+/// One numeric field: missing, unparsable and non-finite values are errors naming line
+/// and column.
+fn cell_value(
+    record: &csv::StringRecord,
+    c: &Column,
+    header: &[String],
+    file: &str,
+    line: usize,
+    what: &str,
+) -> Result<f64, Error> {
+    let s = record.get(c.index).unwrap_or("");
+    if s.is_empty() {
+        return Err(err(
+            file,
+            format!("line {line}: `{}` ({what}) is missing", header[c.index]),
+        ));
+    }
+    let v: f64 = s.parse().map_err(|_| {
+        err(
+            file,
+            format!("line {line}: `{}` = `{s}` is not a number", header[c.index]),
+        )
+    })?;
+    if !v.is_finite() {
+        return Err(err(
+            file,
+            format!("line {line}: `{}` = `{s}` is not finite", header[c.index]),
+        ));
+    }
+    Ok(v * c.factor)
+}
+
+/// Reads joint configurations (a pose list or a joint program): `pose_id` (optional) and
+/// one column per joint as in data files; other columns are ignored.
+pub fn read_configurations(
+    path: &Path,
+    model: &Model,
+    joint_columns: Option<&[String]>,
+) -> Result<Vec<(String, Vec<f64>)>, Error> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| err(&file, e.to_string()))?;
+    read_configurations_str(&text, &file, model, joint_columns)
+}
+
+/// As [`read_configurations`], from text.
+pub fn read_configurations_str(
+    text: &str,
+    file: &str,
+    model: &Model,
+    joint_columns: Option<&[String]>,
+) -> Result<Vec<(String, Vec<f64>)>, Error> {
+    let mut rdr = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    let header: Vec<String> = rdr
+        .headers()
+        .map_err(|e| err(file, format!("header: {e}")))?
+        .iter()
+        .map(str::to_string)
+        .collect();
+    let mut used = vec![false; header.len()];
+    let joints = joint_layout(&header, model, joint_columns, file, &mut used)?;
+    let id_col = header.iter().position(|h| h == "pose_id");
+    let mut out = Vec::new();
+    for (r, record) in rdr.records().enumerate() {
+        let line = r + 2;
+        let record = record.map_err(|e| err(file, format!("line {line}: {e}")))?;
+        let q = record_joints(&record, &joints, &header, model, file, line)?;
+        let id = id_col
+            .and_then(|c| record.get(c))
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("{}", r + 1));
+        out.push((id, q));
+    }
+    if out.is_empty() {
+        return Err(err(file, "no rows".into()));
+    }
+    Ok(out)
+}
+
+/// Reads a data file for `model`. `joint_columns`: the column names feeding the joints
+/// (from the cell), or `None` for `q1…qn` with unit suffixes.
+pub fn read(
+    path: &Path,
+    model: &Model,
+    joint_columns: Option<&[String]>,
+) -> Result<(Dataset, ReadReport), Error> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| err(&path.display().to_string(), e.to_string()))?;
+    read_str(&text, &path.display().to_string(), model, joint_columns)
+}
+
+/// As [`read`], from text; `file` names it in errors.
+pub fn read_str(
+    text: &str,
+    file: &str,
+    model: &Model,
+    joint_columns: Option<&[String]>,
+) -> Result<(Dataset, ReadReport), Error> {
+    let mut rdr = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    let header: Vec<String> = rdr
+        .headers()
+        .map_err(|e| err(file, format!("header: {e}")))?
+        .iter()
+        .map(str::to_string)
+        .collect();
+    let find = |name: &str| header.iter().position(|h| h == name);
+    let mut used = vec![false; header.len()];
+
+    let joints = joint_layout(&header, model, joint_columns, file, &mut used)?;
 
     // Named value columns with unit checks.
     let mut named = |base: &str, length: bool, aliases: &[&str]| -> Result<Option<Column>, Error> {
@@ -246,33 +355,8 @@ pub fn read_str(
     for (r, record) in rdr.records().enumerate() {
         let line = r + 2;
         let record = record.map_err(|e| err(file, format!("line {line}: {e}")))?;
-        let value = |c: &Column, what: &str| -> Result<f64, Error> {
-            let s = record.get(c.index).unwrap_or("");
-            if s.is_empty() {
-                return Err(err(
-                    file,
-                    format!("line {line}: `{}` ({what}) is missing", header[c.index]),
-                ));
-            }
-            let v: f64 = s.parse().map_err(|_| {
-                err(
-                    file,
-                    format!("line {line}: `{}` = `{s}` is not a number", header[c.index]),
-                )
-            })?;
-            if !v.is_finite() {
-                return Err(err(
-                    file,
-                    format!("line {line}: `{}` = `{s}` is not finite", header[c.index]),
-                ));
-            }
-            Ok(v * c.factor)
-        };
-        let q: Vec<f64> = joints
-            .iter()
-            .zip(&model.joints)
-            .map(|(c, j)| value(c, &j.name))
-            .collect::<Result<_, _>>()?;
+        let value = |c: &Column, what: &str| cell_value(&record, c, &header, file, line, what);
+        let q = record_joints(&record, &joints, &header, model, file, line)?;
         let id = pose_col
             .and_then(|c| record.get(c))
             .map(str::to_string)
@@ -297,32 +381,33 @@ pub fn read_str(
                 c
             }
         };
-        let observed =
-            match target_col.and_then(|c| record.get(c)) {
-                Some(name) if !name.is_empty() => {
-                    let k = targets.iter().position(|t| *t == name).ok_or_else(|| {
-                        err(
-                            file,
-                            format!(
-                                "line {line}: unknown target `{name}` (the cell has: {})",
-                                targets.join(", ")
-                            ),
-                        )
-                    })?;
-                    Observed::Target(k)
-                }
-                _ => match targets.len() {
-                    0 => Observed::Tool,
-                    1 => Observed::Target(0),
-                    _ => return Err(err(
+        let observed = match target_col.and_then(|c| record.get(c)) {
+            Some(name) if !name.is_empty() => {
+                let k = targets.iter().position(|t| *t == name).ok_or_else(|| {
+                    err(
+                        file,
+                        format!(
+                            "line {line}: unknown target `{name}` (the cell has: {})",
+                            targets.join(", ")
+                        ),
+                    )
+                })?;
+                Observed::Target(k)
+            }
+            _ => match targets.len() {
+                0 => Observed::Tool,
+                1 => Observed::Target(0),
+                _ => {
+                    return Err(err(
                         file,
                         format!(
                             "line {line}: the cell has several targets ({}); add a `target` column",
                             targets.join(", ")
                         ),
-                    )),
-                },
-            };
+                    ))
+                }
+            },
+        };
         let v3 = |cols: &[Option<Column>; 3], what: &str| -> Result<Vector3<f64>, Error> {
             Ok(Vector3::new(
                 value(cols[0].as_ref().expect("checked"), what)?,

@@ -18,14 +18,18 @@
 //! and tool frames are the identity.
 //!
 //! Joint variables and ranges: the paper's Table 4 ranges for its notional robot are a subset
-//! of KUKA datasheet axis ranges taken with KUKA's signs (e.g. q2 ≤ 31° against A2 ≤ 35°,
-//! q3 ≤ 154° = A3 max), so here `q_i` is the KUKA axis angle `A_i` and the limits are the
-//! datasheet ranges unchanged. With this DH, KUKA's signs (A1, A4, A6 turn mathematically
-//! negative about the upward/forward axes, A2, A3, A5 positive about the horizontal axis)
-//! put the physical robot's z0 pointing down; armcal reads z0 as up, like the paper robot
-//! and its capsules (pedestal below frame 0). The model therefore moves like the physical arm
-//! turned 180° about x0. That changes neither identifiability nor the pose-design criteria;
-//! a physically upright robot is obtained with the base frame `rx = 180°`.
+//! of KUKA datasheet axis ranges taken with KUKA's signs (q2 ≤ 31° against A2 ≤ +35°,
+//! q3 ≤ 154° = A3 max, q5 ±87° within A5 ±130°), so here `q_i` is the KUKA axis angle `A_i`
+//! and the limits are the datasheet ranges unchanged; the study's working pose
+//! (0, −30°, 30°, 0, −90°, 0) lies inside all three. KUKA turns A1, A4, A6 mathematically
+//! negative about the upward / forward axes and A2, A3, A5 positive about the horizontal
+//! axis; with this DH that makes frame 0 KUKA's DH base frame: at shoulder height, x forward,
+//! **z pointing down** (q2 > 0 moves the upper arm towards +z0, i.e. down). The capsules are
+//! placed accordingly: the pedestal runs from the floor at z0 = +h1 up towards the shoulder,
+//! and a3 > 0 puts the forearm axis above the upper-arm line at A = 0 (as in the
+//! KR 300 R2700-2 CAD-based model; not checked for the KR 15/2 and KR 500). A cell that wants
+//! z up mounts the robot with base `rx = 180°`; without it the robot hangs like a ceiling
+//! mount, reaching towards −z0 as the paper robot does with its Table 4 ranges.
 
 use super::{capsule, dh_capsules, frame_link, joint_link, Capsule, Robot};
 use crate::model::{LinkGeometry, ModelSpec};
@@ -35,7 +39,7 @@ struct Kr {
     name: &'static str,
     summary: &'static str,
     source: &'static str,
-    /// Base height: floor to the axis-2 height at A2 = 0 (only used by the pedestal capsule).
+    /// Base height: floor to axis 2 (only used by the pedestal capsule).
     h1: f64,
     a1: f64,
     a2: f64,
@@ -62,10 +66,12 @@ fn build(k: Kr) -> Robot {
         frame_link("tool", [0.0; 3], [0.0; 3]),
     ];
     let [r_ped, r_sh, r_ua, r_el, r_fa, r_wr] = k.radii;
-    let mut capsules: Vec<Capsule> = vec![
-        // pedestal and rotating column, from the floor up to a radius below the shoulder
-        capsule("base", [0.0, 0.0, -k.h1], [0.0, 0.0, -r_ped], r_ped),
-    ];
+    // Pedestal and rotating column, from the floor (z0 = +h1, z0 points down) up to where its
+    // cap clears the upper-arm capsule at the axis-2 point (a1, 0, 0) by 20 mm; the A2
+    // gearbox above it is the shoulder capsule.
+    let top = ((r_ped + r_ua + 20.0).powi(2) - k.a1 * k.a1).sqrt();
+    let mut capsules: Vec<Capsule> =
+        vec![capsule("base", [0.0, 0.0, top], [0.0, 0.0, k.h1], r_ped)];
     capsules.extend(dh_capsules("j1", 0.0, k.a1, d(90.0), r_sh));
     capsules.extend(dh_capsules("j2", 0.0, k.a2, 0.0, r_ua));
     capsules.extend(dh_capsules("j3", 0.0, k.a3, d(90.0), r_el));
@@ -88,10 +94,10 @@ fn build(k: Kr) -> Robot {
 const COMMON: &str = "Link structure of the paper's notional robot (Table 2: DH, joint 2 \
      Hayati, d4 = −forearm, joint 6 DH(180°, −d6, 0, 180°)); frame 0 at shoulder height, \
      identity base and tool. q_i = KUKA axis angle A_i with the datasheet ranges (the paper's \
-     Table 4 uses KUKA's signs); with this DH the physical robot's z0 points down, armcal \
-     reads it up as for `paper` (set base rx = 180° for an upright robot). The side of the \
-     elbow offset a3 follows the paper (a3 > 0). Capsule radii are armcal's choice, sized \
-     from the datasheet outline drawings; the pedestal capsule runs from the floor (−h1) up.";
+     Table 4 uses KUKA's signs), which makes z0 point down (mount with base rx = 180° for z \
+     up). a3 > 0 puts the forearm axis above the upper arm at A = 0. Capsule radii are \
+     armcal's choice, sized from the datasheet outline drawings; the pedestal capsule runs \
+     from the floor at z0 = +h1 to just below the shoulder.";
 
 /// KUKA KR 15/2 (15 kg, reach 1570 mm).
 pub fn kr15() -> Robot {
@@ -147,7 +153,7 @@ pub fn kr300() -> Robot {
             (-125.0, 125.0),
             (-350.0, 350.0),
         ],
-        radii: [450.0, 400.0, 250.0, 280.0, 220.0, 150.0],
+        radii: [350.0, 400.0, 250.0, 280.0, 220.0, 150.0],
     })
 }
 
@@ -175,6 +181,6 @@ pub fn kr500() -> Robot {
             (-120.0, 120.0),
             (-350.0, 350.0),
         ],
-        radii: [550.0, 450.0, 300.0, 320.0, 250.0, 170.0],
+        radii: [450.0, 450.0, 300.0, 320.0, 250.0, 170.0],
     })
 }

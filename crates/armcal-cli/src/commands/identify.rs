@@ -1,0 +1,168 @@
+//! `armcal identify`: calibrate the cell's free parameters from a data file.
+
+use super::output::{load_cell, write_new};
+use anyhow::bail;
+use armcal::identify::{identify, Estimate, IdentifyOptions, Loss, Method, Silent};
+use armcal::measure::csv;
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Cell file or built-in robot.
+    #[arg(long)]
+    pub cell: String,
+    /// Data file (CSV).
+    #[arg(long)]
+    pub data: PathBuf,
+    /// Fraction of configurations held out for validation.
+    #[arg(long, default_value_t = 0.0)]
+    pub holdout: f64,
+    /// Robust estimation (IRLS) with this loss.
+    #[arg(long, value_parser = ["huber", "cauchy"])]
+    pub robust: Option<String>,
+    /// Solver.
+    #[arg(long, default_value = "lm", value_parser = ["lm", "gn", "kalman"])]
+    pub method: String,
+    /// Seed of the held-out split.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Output estimate (JSON).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Overwrite an existing output file.
+    #[arg(long)]
+    pub force: bool,
+}
+
+pub fn run(a: &Args) -> anyhow::Result<()> {
+    let cell = load_cell(&a.cell)?;
+    let (data, report) = csv::read(
+        &a.data,
+        &cell.model,
+        cell.data_columns.as_ref().map(|d| d.joints.as_slice()),
+    )?;
+    if !report.ignored.is_empty() {
+        eprintln!("note: ignored columns: {}", report.ignored.join(", "));
+    }
+    let opts = IdentifyOptions {
+        method: Method::from_name(&a.method).expect("clap checked"),
+        robust: a.robust.as_deref().and_then(Loss::from_name),
+        holdout: a.holdout,
+        seed: a.seed,
+        ..Default::default()
+    };
+    if a.out.exists() && !a.force {
+        bail!("{} exists; pass --force to overwrite it", a.out.display());
+    }
+    let est = identify(&cell, &data, &opts, &mut Silent)?;
+    print_summary(&est);
+    write_new(&a.out, &serde_json::to_string_pretty(&est)?, a.force)?;
+    println!("\nestimate → {}", a.out.display());
+    if !est.solver.status.is_converged() {
+        bail!(
+            "the fit did not converge ({:?}); check the cell's nominal model and the data (units, joint columns), or fix weakly identifiable parameters",
+            est.solver.status
+        );
+    }
+    Ok(())
+}
+
+/// The human-readable summary of an estimate.
+pub fn print_summary(e: &Estimate) {
+    println!(
+        "{}: {} measurements at {} configurations from {}",
+        e.cell, e.measurements, e.configurations, e.data
+    );
+    println!(
+        "solver {:?}{}: {:?} after {} iterations, {:.1} ms",
+        e.solver.method,
+        e.solver
+            .robust
+            .map(|l| format!(" + robust {l:?}"))
+            .unwrap_or_default(),
+        e.solver.status,
+        e.solver.iterations,
+        e.solver.time_ms
+    );
+    println!(
+        "\n{:<14} {:>14} {:>14} {:>12} {:>5}",
+        "parameter", "nominal", "estimate", "± σ", "unit"
+    );
+    for p in e.parameters.iter().filter(|p| p.free) {
+        println!(
+            "{:<14} {:>14.5} {:>14.5} {:>12.5} {:>5}",
+            p.name,
+            p.nominal,
+            p.estimate,
+            p.sigma.unwrap_or(f64::NAN),
+            p.unit
+        );
+    }
+    if !e.fixed_reasons.is_empty() {
+        println!("\nfixed (not identifiable):");
+        for (_, r) in &e.fixed_reasons {
+            println!("  - {r}");
+        }
+    }
+    if !e.strong_correlations.is_empty() {
+        println!("\nstrongly correlated pairs (|ρ| > 0.95):");
+        for (a, b, r) in &e.strong_correlations {
+            println!("  {a} ~ {b}: ρ = {r:.3}");
+        }
+    }
+    let u = &e.uncertainty;
+    println!(
+        "\nvariance factor σ̂₀² = {:.3} (χ² = {:.1}, {} dof, p = {:.3}): {}",
+        u.variance_factor, u.chi2, u.dof, u.p_value, u.verdict
+    );
+    let r = &e.residuals;
+    println!("residuals (mm)      RMS        max        p95");
+    for (n, s) in [("x", &r.x), ("y", &r.y), ("z", &r.z), ("|e|", &r.norm)] {
+        println!("  {n:<6} {:>12.4} {:>10.4} {:>10.4}", s.rms, s.max, s.p95);
+    }
+    for (t, c) in e.tcp.iter().zip(&e.tcp_constrained) {
+        println!(
+            "TCP at `{}`: σ = ({:.4}, {:.4}, {:.4}) mm, (1/3) tr C_s = {:.5} mm² (eq. 19: {:.5})",
+            t.name,
+            t.covariance[(0, 0)].sqrt(),
+            t.covariance[(1, 1)].sqrt(),
+            t.covariance[(2, 2)].sqrt(),
+            t.kpi,
+            c.trace() / 3.0
+        );
+    }
+    let o = &e.observability;
+    println!(
+        "observability O1 {:.4e}  O2 {:.4e}  O3 {:.4e}  O4 {:.4e}  O5 {:.4e}; condition number (column-scaled) {:.1}",
+        o.o1, o.o2, o.o3, o.o4, o.o5, o.condition_number
+    );
+    if let Some(s) = e.robust_scale {
+        println!("robust scale of the whitened residuals: {s:.3}");
+    }
+    if !e.outliers.is_empty() {
+        println!("outliers ({}):", e.outliers.len());
+        for o in &e.outliers {
+            println!(
+                "  line {} (pose {}): {:.1} robust σ, weight {:.3}",
+                o.line, o.configuration, o.standardized, o.weight
+            );
+        }
+    }
+    if let Some(v) = &e.validation {
+        println!(
+            "\nheld-out validation: {} configurations (fit on {})",
+            v.test_configurations, v.train_configurations
+        );
+        println!("  model                     mean       RMS       max       p95   (mm)");
+        for (n, s) in [
+            ("nominal", &v.nominal),
+            ("nominal + frames fitted", &v.frames_only),
+            ("calibrated", &v.calibrated),
+        ] {
+            println!(
+                "  {n:<24} {:>8.4} {:>9.4} {:>9.4} {:>9.4}",
+                s.mean, s.rms, s.max, s.p95
+            );
+        }
+    }
+}

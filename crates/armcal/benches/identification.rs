@@ -1,0 +1,37 @@
+//! Identification benchmark: 1000 simulated poses of the paper cell, 27 free parameters,
+//! Levenberg–Marquardt from the nominal model.
+
+use armcal::cell::Cell;
+use armcal::identify::{levenberg_marquardt, LmSettings, Problem, Silent};
+use armcal::model::identifiability::random_configurations;
+use armcal::sim::{perturbed_truth, simulate, Perturbation};
+use criterion::{criterion_group, criterion_main, Criterion};
+
+const CELL: &str = include_str!("../../../examples/paper-cell.toml");
+
+fn identification(c: &mut Criterion) {
+    let cell =
+        Cell::from_toml(CELL, "paper-cell.toml", std::path::Path::new(".")).expect("paper cell");
+    let model = &cell.model;
+    let noise = cell.instrument.as_ref().expect("tracker").noise.clone();
+    let truth = perturbed_truth(model, &Perturbation::default(), 1);
+    let qs = random_configurations(model, 1000, 2);
+    let data = simulate(model, &truth, &qs, Some(&noise), 3).expect("simulate");
+    let problem = Problem::new(model, &data, &noise).expect("problem");
+    assert_eq!(problem.columns(), 27);
+    let start = model.nominal();
+    let mut group = c.benchmark_group("identification");
+    group.sample_size(20);
+    group.bench_function("LM, 1000 poses, 27 parameters", |b| {
+        b.iter(|| {
+            let sol = levenberg_marquardt(&problem, &start, &LmSettings::default(), &mut Silent)
+                .expect("solve");
+            assert!(sol.status.is_converged());
+            sol
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, identification);
+criterion_main!(benches);

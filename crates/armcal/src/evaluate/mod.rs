@@ -1,0 +1,6 @@
+//! Proof of accuracy: statistics of position errors and the ISO 9283 pose characteristics
+//! (book ch. 7).
+
+pub mod iso9283;
+
+pub use crate::identify::ErrorStats;
