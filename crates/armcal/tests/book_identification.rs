@@ -111,7 +111,7 @@ fn solve_class(
     want: Class,
     r: &mut ChaCha8Rng,
 ) -> Option<Vec<f64>> {
-    for _ in 0..60 {
+    for _ in 0..20 {
         let target = Pose {
             rot: random_rot(r),
             trans: pos,
@@ -136,32 +136,21 @@ fn explore() {
     let p = m.nominal();
     let _ = rot_axis(&Vector3::x(), 0.0);
     let mut r = ChaCha8Rng::seed_from_u64(1);
-    for &(cx, cy, cz) in &[
-        (-6.0, 10.0, 20.0),
-        (-6.0, 14.0, 16.0),
-        (0.0, 10.0, 30.0),
-        (-10.0, 6.0, 14.0),
-        (4.0, 14.0, 26.0),
-    ] {
-        let mut ok = 0;
-        for i in 0..3 {
-            for j in 0..2 {
-                for k in 0..2 {
-                    let pos = Vector3::new(
-                        cx + 6.0 * (i as f64 - 1.0),
-                        cy + 6.0 * (j as f64 - 0.5),
-                        cz + 6.0 * (k as f64 - 0.5),
-                    ) * IN;
-                    for right in [false, true] {
-                        for up in [false, true] {
-                            if solve_class(&m, &p, pos, Class { right, up }, &mut r).is_some() {
-                                ok += 1;
-                            }
-                        }
-                    }
-                }
+    let axis1 = Vector3::new(-15.591, 14.681, 32.878);
+    let dirs = [("+x", Vector3::new(1.0, 0.0, 0.0)), ("cmm", Vector3::new(0.428, 0.0, -0.904)), ("-z", Vector3::new(0.0, 0.0, -1.0))];
+    for (dn, dir) in dirs {
+        for rr in [20.0, 24.0, 28.0] {
+            for dy in [-6.0, 0.0, 6.0, 12.0] {
+                let c = axis1 + dir * rr + Vector3::y() * dy;
+                let mut ok = 0;
+                for i in 0..3 { for j in 0..2 { for k in 0..2 {
+                    let pos = (c + Vector3::new(5.0 * (i as f64 - 1.0), 5.0 * (j as f64 - 0.5), 5.0 * (k as f64 - 0.5))) * IN;
+                    for right in [false, true] { for up in [false, true] {
+                        if solve_class(&m, &p, pos, Class { right, up }, &mut r).is_some() { ok += 1; }
+                    }}
+                }}}
+                eprintln!("dir {dn} r {rr} dy {dy}: center {:.1?} {ok}/48", c.as_slice());
             }
         }
-        eprintln!("center ({cx}, {cy}, {cz}): {ok}/48");
     }
 }

@@ -60,7 +60,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     println!("\nestimate → {}", a.out.display());
     if !est.solver.status.is_converged() {
         bail!(
-            "the fit did not converge ({:?}); check the cell's nominal model and the data (units, joint columns), or fix weakly identifiable parameters",
+            "the fit did not converge ({}); check the cell's nominal model and the data (units, joint columns), or fix weakly identifiable parameters",
             est.solver.status
         );
     }
@@ -74,7 +74,7 @@ pub fn print_summary(e: &Estimate) {
         e.cell, e.measurements, e.configurations, e.data
     );
     println!(
-        "solver {:?}{}: {:?} after {} iterations, {:.1} ms",
+        "solver {:?}{}: {} after {} iterations, {:.1} ms",
         e.solver.method,
         e.solver
             .robust

@@ -16,6 +16,16 @@ pub enum Status {
     Diverged { reason: String },
 }
 
+impl std::fmt::Display for Status {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Status::Converged { criterion } => write!(f, "converged ({criterion})"),
+            Status::MaxIterations => f.write_str("stopped at the iteration limit"),
+            Status::Diverged { reason } => write!(f, "diverged: {reason}"),
+        }
+    }
+}
+
 impl Status {
     pub fn is_converged(&self) -> bool {
         matches!(self, Status::Converged { .. })
