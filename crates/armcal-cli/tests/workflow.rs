@@ -1,0 +1,156 @@
+//! `simulate` → `identify` → `predict` through the binary, with the file-safety rules.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn armcal(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_armcal"))
+        .args(args)
+        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+        .output()
+        .expect("run armcal");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn simulate_identify_predict() {
+    let dir = scratch("workflow");
+    let data = dir.join("data.csv");
+    let est = dir.join("estimate.json");
+    let pred = dir.join("pred.csv");
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let sim = [
+        "simulate",
+        "--cell",
+        "examples/paper-cell.toml",
+        "--poses",
+        "examples/paper-poses-random-60.csv",
+        "--seed",
+        "4",
+        "--out",
+        &s(&data),
+    ];
+    let (ok, out, err) = armcal(&sim);
+    assert!(ok, "{err}");
+    assert!(out.contains("simulated 60 measurements"), "{out}");
+    let first = std::fs::read_to_string(&data).unwrap();
+    // Same seed, same file; an existing file is not overwritten without --force.
+    let (ok, _, err) = armcal(&sim);
+    assert!(
+        !ok && err.contains("exists") && err.contains("--force"),
+        "{err}"
+    );
+    let mut forced = sim.to_vec();
+    forced.push("--force");
+    let (ok, _, err) = armcal(&forced);
+    assert!(ok, "{err}");
+    assert_eq!(
+        first,
+        std::fs::read_to_string(&data).unwrap(),
+        "same seed → identical file"
+    );
+
+    let (ok, out, err) = armcal(&[
+        "identify",
+        "--cell",
+        "examples/paper-cell.toml",
+        "--data",
+        &s(&data),
+        "--holdout",
+        "0.3",
+        "--out",
+        &s(&est),
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("converged")
+            && out.contains("held-out validation")
+            && out.contains("(1/3) tr C_s"),
+        "{out}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&est).unwrap()).unwrap();
+    assert_eq!(json["free"].as_array().unwrap().len(), 27);
+    assert!(
+        json["validation"]["calibrated"]["rms"].as_f64().unwrap()
+            < json["validation"]["nominal"]["rms"].as_f64().unwrap()
+    );
+
+    for method in ["gn", "kalman"] {
+        let e2 = dir.join(format!("est-{method}.json"));
+        let (ok, _, err) = armcal(&[
+            "identify",
+            "--cell",
+            "examples/paper-cell.toml",
+            "--data",
+            &s(&data),
+            "--method",
+            method,
+            "--out",
+            &s(&e2),
+        ]);
+        assert!(ok, "{method}: {err}");
+    }
+    let (ok, _, err) = armcal(&[
+        "identify",
+        "--cell",
+        "examples/paper-cell.toml",
+        "--data",
+        &s(&data),
+        "--robust",
+        "huber",
+        "--out",
+        &s(&dir.join("r.json")),
+    ]);
+    assert!(ok, "{err}");
+
+    let (ok, out, err) = armcal(&[
+        "predict",
+        "--cell",
+        "examples/paper-cell.toml",
+        "--estimate",
+        &s(&est),
+        "--joints",
+        "examples/paper-poses-random-60.csv",
+        "--out",
+        &s(&pred),
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("identified model"), "{out}");
+    let header = std::fs::read_to_string(&pred)
+        .unwrap()
+        .lines()
+        .next()
+        .unwrap()
+        .to_string();
+    assert_eq!(
+        header,
+        first.lines().next().unwrap(),
+        "predictions have the columns of a data file"
+    );
+
+    // An estimate of another robot is refused with the mismatch named.
+    let (ok, _, err) = armcal(&[
+        "predict",
+        "--cell",
+        "examples/motoman-right-cell.toml",
+        "--estimate",
+        &s(&est),
+        "--joints",
+        "examples/paper-poses-random-60.csv",
+        "--out",
+        &s(&dir.join("x.csv")),
+    ]);
+    assert!(!ok && err.contains("does not belong to model"), "{err}");
+}
