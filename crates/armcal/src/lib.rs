@@ -6,8 +6,10 @@
 //! laser-tracker measurement poses ("paper").
 
 pub mod cell;
+pub mod design;
 pub mod error;
 pub mod evaluate;
+pub mod geometry;
 pub mod identify;
 pub mod measure;
 pub mod model;

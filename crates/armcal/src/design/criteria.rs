@@ -1,0 +1,199 @@
+//! Design criteria as functions of the information matrix M (C = M⁻¹), each with its
+//! matrix gradient `Φ = ∂φ/∂M`, so that for any configuration variable x
+//! `dφ/dx = tr(Φ dM/dx)` (paper §2.1–2.3; book §4.5 for the observability indices).
+//!
+//! All criteria are minimised:
+//! * `A`: `tr(C)/n_p` on C_p in mm and rad, unscaled — the paper's φ_A(C_p) = tr(C_p)/27
+//!   (the paper does not state a scaling; unscaled reproduces its numbers);
+//!   `Φ = −C C/n_p`;
+//! * `D`: `log det C / n_p`; `Φ = −C/n_p`;
+//! * `E`: `λ_max(C) = 1/λ_min(M)`; `Φ = −v vᵀ/λ_min²`;
+//! * `Kpi`: `Σ_w ω_w (1/3) tr(G_w C G_wᵀ) / Σ_w ω_w`, the TCP position variance at the
+//!   working configurations (paper eq. 24, φ_A(C_s)); `Φ = −C HᵀH C` with `H` the stacked
+//!   `√(ω_w/(3Σω)) G_w`;
+//! * `O1`…`O5`: `−log O_k` of the observability indices (see
+//!   [`crate::identify::Observability`]) written through the eigenvalues λ_i = σ_i² of M:
+//!   O1 ∝ (Π λ_i)^{1/2n}, O2 = (λ_min/λ_max)^{1/2}, O3 = λ_min^{1/2},
+//!   O4 = λ_min/λ_max^{1/2}, O5 = 1/Σ λ_i^{−1/2}; `Φ = Σ_i ∂φ/∂λ_i v_i v_iᵀ` (simple
+//!   eigenvalues).
+
+use crate::design::information::DesignModel;
+use crate::Error;
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+
+/// A design criterion (minimised).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Criterion {
+    A,
+    D,
+    E,
+    Kpi,
+    O1,
+    O2,
+    O3,
+    O4,
+    O5,
+}
+
+impl Criterion {
+    pub fn from_name(s: &str) -> Option<Criterion> {
+        Some(match s {
+            "a" => Criterion::A,
+            "d" => Criterion::D,
+            "e" => Criterion::E,
+            "kpi" => Criterion::Kpi,
+            "o1" => Criterion::O1,
+            "o2" => Criterion::O2,
+            "o3" => Criterion::O3,
+            "o4" => Criterion::O4,
+            "o5" => Criterion::O5,
+            _ => return None,
+        })
+    }
+
+    pub const ALL: [Criterion; 9] = [
+        Criterion::A,
+        Criterion::D,
+        Criterion::E,
+        Criterion::Kpi,
+        Criterion::O1,
+        Criterion::O2,
+        Criterion::O3,
+        Criterion::O4,
+        Criterion::O5,
+    ];
+}
+
+/// Value of a criterion and its gradient w.r.t. the information matrix.
+#[derive(Clone, Debug)]
+pub struct CriterionValue {
+    pub value: f64,
+    /// `Φ = ∂φ/∂M` (symmetric).
+    pub gradient: DMatrix<f64>,
+}
+
+/// Evaluates `criterion` for the information matrix `M = RᵀR`, given its triangular
+/// factor `R` (from a QR decomposition of the stacked whitened Jacobian: C and the
+/// eigenvalues of M then carry the accuracy of J, not of the squared M). Fails if M is
+/// singular (the design does not identify every free parameter).
+pub fn evaluate(criterion: Criterion, r: &DMatrix<f64>, d: &DesignModel) -> Result<CriterionValue, Error> {
+    let n = r.nrows();
+    let nf = n as f64;
+    let singular = || Error::Input("the design's information matrix is singular: it does not identify every free parameter".into());
+    let rmax = r.diagonal().iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    if r.diagonal().iter().any(|x| x.abs() <= 1e-13 * rmax) {
+        return Err(singular());
+    }
+    match criterion {
+        Criterion::A | Criterion::D | Criterion::Kpi => {
+            // C = R⁻¹ R⁻ᵀ.
+            let rinv = r
+                .clone()
+                .solve_upper_triangular(&DMatrix::identity(n, n))
+                .ok_or_else(singular)?;
+            let c = &rinv * rinv.transpose();
+            Ok(match criterion {
+                Criterion::A => CriterionValue {
+                    value: c.trace() / nf,
+                    gradient: -(&c * &c) / nf,
+                },
+                Criterion::D => {
+                    let logdet: f64 = 2.0 * r.diagonal().iter().map(|x| x.abs().ln()).sum::<f64>();
+                    CriterionValue {
+                        value: -logdet / nf,
+                        gradient: -c / nf,
+                    }
+                }
+                _ => {
+                    let h = kpi_matrix(d)?;
+                    let ch = &c * h.transpose();
+                    CriterionValue {
+                        value: (&h * &ch).trace(),
+                        gradient: -(&ch * ch.transpose()),
+                    }
+                }
+            })
+        }
+        _ => {
+            // Eigenpairs of M from the SVD of R: λ_i = σ_i², v_i the right singular vectors.
+            let svd = r.clone().svd(false, true);
+            let vt = svd.v_t.ok_or_else(singular)?;
+            let lam: Vec<f64> = svd.singular_values.iter().map(|s| s * s).collect();
+            let (mut imin, mut imax) = (0, 0);
+            for (i, l) in lam.iter().enumerate() {
+                if *l < lam[imin] {
+                    imin = i;
+                }
+                if *l > lam[imax] {
+                    imax = i;
+                }
+            }
+            let (lmin, lmax) = (lam[imin], lam[imax]);
+            if lmin <= 1e-26 * lmax.max(1e-300) {
+                return Err(singular());
+            }
+            // φ and ∂φ/∂λ_i.
+            let mut dphi = vec![0.0; n];
+            let value = match criterion {
+                Criterion::E => {
+                    dphi[imin] = -1.0 / (lmin * lmin);
+                    1.0 / lmin
+                }
+                Criterion::O1 => {
+                    for (g, l) in dphi.iter_mut().zip(&lam) {
+                        *g = -0.5 / (nf * l);
+                    }
+                    -0.5 * lam.iter().map(|l| l.ln()).sum::<f64>() / nf
+                }
+                Criterion::O2 => {
+                    dphi[imax] += 0.5 / lmax;
+                    dphi[imin] -= 0.5 / lmin;
+                    0.5 * (lmax.ln() - lmin.ln())
+                }
+                Criterion::O3 => {
+                    dphi[imin] = -0.5 / lmin;
+                    -0.5 * lmin.ln()
+                }
+                Criterion::O4 => {
+                    dphi[imin] -= 1.0 / lmin;
+                    dphi[imax] += 0.5 / lmax;
+                    -lmin.ln() + 0.5 * lmax.ln()
+                }
+                Criterion::O5 => {
+                    let s: f64 = lam.iter().map(|l| l.powf(-0.5)).sum();
+                    for (g, l) in dphi.iter_mut().zip(&lam) {
+                        *g = -0.5 * l.powf(-1.5) / s;
+                    }
+                    s.ln()
+                }
+                _ => unreachable!("handled above"),
+            };
+            let mut gradient = DMatrix::zeros(n, n);
+            for (i, g) in dphi.iter().enumerate() {
+                if *g != 0.0 {
+                    let vi = vt.row(i).transpose();
+                    gradient.ger(*g, &vi, &vi, 1.0);
+                }
+            }
+            Ok(CriterionValue { value, gradient })
+        }
+    }
+}
+
+/// `H`: the KPI rows `√(ω_w / (3 Σω)) G_w` stacked.
+pub(crate) fn kpi_matrix(d: &DesignModel) -> Result<DMatrix<f64>, Error> {
+    if d.kpi_weights.is_empty() {
+        return Err(Error::Input(
+            "the KPI criterion needs at least one [[working]] configuration in the cell".into(),
+        ));
+    }
+    let total: f64 = d.kpi_weights.iter().sum();
+    let mut h = d.kpi_rows.clone();
+    for (w, weight) in d.kpi_weights.iter().enumerate() {
+        let s = (weight / (3.0 * total)).sqrt();
+        h.rows_mut(3 * w, 3).scale_mut(s);
+    }
+    Ok(h)
+}

@@ -1,0 +1,220 @@
+//! Candidate-pool exchange (Fedorov 1972; Mitchell's DETMAX style): start from N pool
+//! configurations, then repeatedly remove one design point and put back the pool
+//! configuration that improves the criterion most, until no exchange helps.
+//!
+//! The removal is a rank-r downdate of the covariance and every candidate is scored with a
+//! rank-r update (r = rows per configuration, Woodbury): for A-type criteria
+//! `tr(L C' Lᵀ) = tr(L C Lᵀ) − tr((I + J C Jᵀ)⁻¹ J C LᵀL C Jᵀ)`, for D
+//! `log det M' = log det M + log det(I + J C Jᵀ)`. Criteria without such an update (E, O1–O5)
+//! take the best D-scored candidates and evaluate them exactly.
+
+use crate::design::criteria::{evaluate, kpi_matrix, Criterion};
+use crate::design::information::{DesignModel, InformationWorkspace};
+use crate::design::objective::triangular_factor;
+use crate::Error;
+use nalgebra::DMatrix;
+use rand::seq::SliceRandom;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use std::time::{Duration, Instant};
+
+/// Settings of [`exchange`].
+#[derive(Clone, Debug)]
+pub struct ExchangeSettings {
+    pub max_sweeps: usize,
+    pub seed: u64,
+    /// Relative improvement below which a sweep counts as no progress.
+    pub tolerance: f64,
+    /// Candidates scored exactly per removal for criteria without a rank update.
+    pub exact_shortlist: usize,
+}
+
+impl Default for ExchangeSettings {
+    fn default() -> Self {
+        ExchangeSettings {
+            max_sweeps: 20,
+            seed: 1,
+            tolerance: 1e-9,
+            exact_shortlist: 12,
+        }
+    }
+}
+
+/// Result of an exchange run: indices into the pool.
+#[derive(Clone, Debug)]
+pub struct ExchangeResult {
+    pub chosen: Vec<usize>,
+    pub value: f64,
+    pub sweeps: usize,
+    pub exchanges: usize,
+    pub history: Vec<f64>,
+    pub time: Duration,
+}
+
+/// Whitened Jacobians of every pool configuration, stacked (rows per configuration each).
+pub fn pool_jacobians(d: &DesignModel, pool: &[Vec<f64>]) -> DMatrix<f64> {
+    let rows = d.rows();
+    let mut ws = InformationWorkspace::new(d);
+    let mut out = DMatrix::zeros(rows * pool.len(), d.n());
+    for (i, q) in pool.iter().enumerate() {
+        d.jacobian(&mut ws, q);
+        out.rows_mut(i * rows, rows).copy_from(&ws.jac);
+    }
+    out
+}
+
+/// The criterion of a set of pool points (plus prior rows).
+fn value_of(d: &DesignModel, c: Criterion, jp: &DMatrix<f64>, prior: &DMatrix<f64>, set: &[usize]) -> Result<f64, Error> {
+    let rows = d.rows();
+    let mut a = DMatrix::zeros(prior.nrows() + rows * set.len(), d.n());
+    a.rows_mut(0, prior.nrows()).copy_from(prior);
+    for (k, &i) in set.iter().enumerate() {
+        a.rows_mut(prior.nrows() + k * rows, rows).copy_from(&jp.rows(i * rows, rows));
+    }
+    Ok(evaluate(c, &triangular_factor(a), d)?.value)
+}
+
+/// Runs the exchange for `n_points` configurations from `pool` (with `prior` whitened rows of
+/// already-measured configurations).
+pub fn exchange(
+    d: &DesignModel,
+    criterion: Criterion,
+    pool: &[Vec<f64>],
+    prior: &DMatrix<f64>,
+    n_points: usize,
+    settings: &ExchangeSettings,
+) -> Result<ExchangeResult, Error> {
+    let t0 = Instant::now();
+    if pool.len() < n_points {
+        return Err(Error::Input(format!(
+            "the candidate pool has {} feasible configurations, fewer than the {n_points} poses asked for",
+            pool.len()
+        )));
+    }
+    let rows = d.rows();
+    let n = d.n();
+    let jp = pool_jacobians(d, pool);
+    // Start: a random subset that identifies every parameter (retry a few times).
+    let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
+    let mut idx: Vec<usize> = (0..pool.len()).collect();
+    let mut chosen = Vec::new();
+    let mut value = f64::INFINITY;
+    for _ in 0..20 {
+        idx.shuffle(&mut rng);
+        let trial: Vec<usize> = idx[..n_points].to_vec();
+        if let Ok(v) = value_of(d, criterion, &jp, prior, &trial) {
+            chosen = trial;
+            value = v;
+            break;
+        }
+    }
+    if chosen.is_empty() {
+        return Err(Error::Input(format!(
+            "no random set of {n_points} pool configurations identifies every free parameter; use more poses or a larger pool"
+        )));
+    }
+    // L for A-type criteria: φ = tr(L C Lᵀ).
+    let l: Option<DMatrix<f64>> = match criterion {
+        Criterion::A => Some(DMatrix::identity(n, n) / (n as f64).sqrt()),
+        Criterion::Kpi => Some(kpi_matrix(d)?),
+        _ => None,
+    };
+    let mut history = vec![value];
+    let mut sweeps = 0;
+    let mut exchanges = 0;
+    let in_design = |chosen: &[usize], c: usize| chosen.contains(&c);
+    while sweeps < settings.max_sweeps {
+        sweeps += 1;
+        let start_value = value;
+        for slot in 0..n_points {
+            // Covariance without the point in `slot`.
+            let mut others: Vec<usize> = chosen.clone();
+            others.remove(slot);
+            let m = {
+                let mut m = prior.tr_mul(prior);
+                for &i in &others {
+                    let ji = jp.rows(i * rows, rows);
+                    m.gemm_tr(1.0, &ji, &ji, 1.0);
+                }
+                m
+            };
+            let c = match m.clone().cholesky() {
+                Some(ch) => ch.inverse(),
+                None => continue, // this point is essential; keep it
+            };
+            // Score every candidate by the rank-`rows` update.
+            let jc = &jp * &c; // (rows·pool) × n
+            let a = l.as_ref().map(|l| {
+                let lc = l * &c;
+                lc.tr_mul(&lc)
+            });
+            let mut scores: Vec<(f64, usize)> = Vec::with_capacity(pool.len());
+            for x in 0..pool.len() {
+                if in_design(&others, x) {
+                    continue;
+                }
+                let jx = jp.rows(x * rows, rows);
+                let ux = jc.rows(x * rows, rows);
+                let s = DMatrix::identity(rows, rows) + &ux * jx.transpose();
+                let score = match &a {
+                    Some(a) => {
+                        let t = &jx * a * jx.transpose();
+                        match s.clone().cholesky() {
+                            Some(ch) => -(ch.solve(&t)).trace(),
+                            None => f64::INFINITY,
+                        }
+                    }
+                    None => match s.clone().cholesky() {
+                        Some(ch) => -2.0 * ch.l().diagonal().iter().map(|v| v.ln()).sum::<f64>(),
+                        None => f64::INFINITY,
+                    },
+                };
+                scores.push((score, x));
+            }
+            scores.sort_by(|p, q| p.0.total_cmp(&q.0));
+            let best = if l.is_some() || criterion == Criterion::D {
+                scores.first().map(|s| s.1)
+            } else {
+                // Exact evaluation of a short list.
+                let mut best = None;
+                let mut best_v = f64::INFINITY;
+                for &(_, x) in scores.iter().take(settings.exact_shortlist) {
+                    let mut trial = others.clone();
+                    trial.insert(slot, x);
+                    if let Ok(v) = value_of(d, criterion, &jp, prior, &trial) {
+                        if v < best_v {
+                            best_v = v;
+                            best = Some(x);
+                        }
+                    }
+                }
+                best
+            };
+            if let Some(x) = best {
+                if x != chosen[slot] {
+                    let mut trial = others.clone();
+                    trial.insert(slot, x);
+                    if let Ok(v) = value_of(d, criterion, &jp, prior, &trial) {
+                        if v < value - 1e-15 * value.abs() {
+                            chosen = trial;
+                            value = v;
+                            exchanges += 1;
+                        }
+                    }
+                }
+            }
+        }
+        history.push(value);
+        if start_value - value <= settings.tolerance * value.abs() {
+            break;
+        }
+    }
+    Ok(ExchangeResult {
+        chosen,
+        value,
+        sweeps,
+        exchanges,
+        history,
+        time: t0.elapsed(),
+    })
+}

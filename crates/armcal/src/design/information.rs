@@ -1,0 +1,179 @@
+//! The information a measurement configuration carries: `M(q) = J(q)ᵀ W J(q)` with `J` the
+//! identification Jacobian of the measured target positions w.r.t. the free parameters and
+//! `W = Σ⁻¹` (paper §1.1: `C = (F₁ᵀF₁)⁻¹`), and its derivative w.r.t. q through the mixed
+//! derivative ∂J/∂q of the foundation.
+
+use crate::cell::Cell;
+use crate::measure::NoiseModel;
+use crate::model::{
+    forward_kinematics, identification_jacobian, identification_jacobian_dq, observed_position,
+    Data, MixedWorkspace, Model, Observed, Rows,
+};
+use crate::Error;
+use nalgebra::DMatrix;
+
+/// What the design optimises over: the model at its nominal parameters, the free columns,
+/// the measured targets, row weights, and the KPI rows (TCP at the working configurations).
+#[derive(Clone, Debug)]
+pub struct DesignModel {
+    pub model: Model,
+    pub params: Vec<f64>,
+    /// Parameter index of each column.
+    pub free: Vec<usize>,
+    /// Observed targets (position rows, 3 each).
+    pub observed: Vec<Observed>,
+    /// σ (mm) of each position axis. The range noise model is evaluated at the distance
+    /// from the instrument to the TCP at the first working configuration and then held
+    /// constant, so that the weights do not depend on q.
+    pub sigma: [f64; 3],
+    /// `G`: 3 rows per working configuration, TCP position w.r.t. the free parameters.
+    pub kpi_rows: DMatrix<f64>,
+    /// Weight of each working configuration.
+    pub kpi_weights: Vec<f64>,
+}
+
+impl DesignModel {
+    /// The design model of a cell: its free parameters, point targets (or the tool origin),
+    /// the instrument noise, and its working configurations.
+    pub fn from_cell(cell: &Cell) -> Result<DesignModel, Error> {
+        let model = cell.model.clone();
+        let params = model.nominal();
+        let free = model.registry.free();
+        if free.is_empty() {
+            return Err(Error::Input("the cell has no free parameters to design for".into()));
+        }
+        let observed: Vec<Observed> = if model.targets.is_empty() {
+            vec![Observed::Tool]
+        } else {
+            (0..model.targets.len()).map(Observed::Target).collect()
+        };
+        let working: Vec<Vec<f64>> = cell.working.iter().map(|w| w.q.clone()).collect();
+        let kpi_rows = crate::identify::uncertainty::tcp_jacobian(&model, &params, &free, &working);
+        let noise = cell.instrument.as_ref().map(|i| i.noise.clone()).unwrap_or_default();
+        let sigma = match noise {
+            NoiseModel::Constant { sigma, .. } => sigma,
+            NoiseModel::Range { a, b_per_m } => {
+                let range = match working.first() {
+                    Some(q) => {
+                        let mut d = Data::new(&model);
+                        forward_kinematics(&model, &mut d, &params, q);
+                        observed_position(&d, Observed::Tool).norm()
+                    }
+                    None => 0.0,
+                };
+                [a + b_per_m * range / 1000.0; 3]
+            }
+            NoiseModel::PerMeasurement { .. } => {
+                return Err(Error::Input(
+                    "pose design needs a noise model with known σ (constant or range), not per-measurement".into(),
+                ))
+            }
+        };
+        Ok(DesignModel {
+            model,
+            params,
+            free,
+            observed,
+            sigma,
+            kpi_rows,
+            kpi_weights: cell.working.iter().map(|w| w.weight).collect(),
+        })
+    }
+
+    /// Number of free parameters n_p.
+    pub fn n(&self) -> usize {
+        self.free.len()
+    }
+
+    /// Rows per configuration (3 per observed target).
+    pub fn rows(&self) -> usize {
+        3 * self.observed.len()
+    }
+
+    pub fn dof(&self) -> usize {
+        self.model.dof()
+    }
+}
+
+/// Buffers for per-configuration information and its q-derivative.
+pub struct InformationWorkspace {
+    data: Data<f64>,
+    mixed: MixedWorkspace,
+    /// Whitened Jacobian `W^{1/2} J` of one configuration.
+    pub jac: DMatrix<f64>,
+    /// Its derivatives w.r.t. each joint.
+    pub jac_dq: Vec<DMatrix<f64>>,
+    value: DMatrix<f64>,
+    dq: Vec<DMatrix<f64>>,
+}
+
+impl InformationWorkspace {
+    pub fn new(d: &DesignModel) -> Self {
+        let n = d.n();
+        InformationWorkspace {
+            data: Data::new(&d.model),
+            mixed: MixedWorkspace::new(&d.model, Rows::Position, n),
+            jac: DMatrix::zeros(d.rows(), n),
+            jac_dq: vec![DMatrix::zeros(d.rows(), n); d.dof()],
+            value: DMatrix::zeros(3, n),
+            dq: vec![DMatrix::zeros(3, n); d.dof()],
+        }
+    }
+}
+
+impl DesignModel {
+    /// Whitened Jacobian of one configuration into `ws.jac`.
+    pub fn jacobian(&self, ws: &mut InformationWorkspace, q: &[f64]) {
+        forward_kinematics(&self.model, &mut ws.data, &self.params, q);
+        for (k, &obs) in self.observed.iter().enumerate() {
+            identification_jacobian(&self.model, &ws.data, obs, Rows::Position, &self.free, &mut ws.jac, 3 * k);
+        }
+        self.whiten(&mut ws.jac);
+    }
+
+    /// Whitened Jacobian and its derivative w.r.t. every joint into `ws.jac`, `ws.jac_dq`.
+    pub fn jacobian_dq(&self, ws: &mut InformationWorkspace, q: &[f64]) {
+        for (k, &obs) in self.observed.iter().enumerate() {
+            identification_jacobian_dq(
+                &self.model,
+                &mut ws.mixed,
+                &self.params,
+                q,
+                obs,
+                Rows::Position,
+                &self.free,
+                &mut ws.value,
+                &mut ws.dq,
+            );
+            ws.jac.rows_mut(3 * k, 3).copy_from(&ws.value);
+            for (d, s) in ws.jac_dq.iter_mut().zip(&ws.dq) {
+                d.rows_mut(3 * k, 3).copy_from(s);
+            }
+        }
+        let mut jac = std::mem::take(&mut ws.jac);
+        self.whiten(&mut jac);
+        ws.jac = jac;
+        for j in 0..ws.jac_dq.len() {
+            let mut m = std::mem::take(&mut ws.jac_dq[j]);
+            self.whiten(&mut m);
+            ws.jac_dq[j] = m;
+        }
+    }
+
+    fn whiten(&self, m: &mut DMatrix<f64>) {
+        for r in 0..m.nrows() {
+            m.row_mut(r).unscale_mut(self.sigma[r % 3]);
+        }
+    }
+
+    /// Information matrix `Σ_i J_iᵀ W J_i` of a set of configurations.
+    pub fn information(&self, ws: &mut InformationWorkspace, qs: &[Vec<f64>]) -> DMatrix<f64> {
+        let n = self.n();
+        let mut m = DMatrix::zeros(n, n);
+        for q in qs {
+            self.jacobian(ws, q);
+            m.gemm_tr(1.0, &ws.jac, &ws.jac, 1.0);
+        }
+        m
+    }
+}

@@ -1,0 +1,12 @@
+//! Optimal measurement-pose design (paper §2–3): choose the N configurations that make the
+//! calibrated robot most precise where it works (the KPI method), or that optimise a classic
+//! criterion of the parameter covariance.
+
+pub mod criteria;
+pub mod exchange;
+pub mod information;
+pub mod objective;
+
+pub use criteria::{Criterion, CriterionValue};
+pub use information::{DesignModel, InformationWorkspace};
+pub use objective::{DesignObjective, ObjectiveWorkspace};
