@@ -86,3 +86,74 @@ fn robots_lists_the_library() {
     assert!(ok);
     assert!(out.contains("paper"));
 }
+
+#[test]
+fn model_converts_to_another_convention_before_the_analysis() {
+    // The row of a parameter in the table: `<#> <name> <nominal> <unit> <status>`.
+    let row = |out: &str, name: &str| -> Option<String> {
+        out.lines()
+            .find(|l| l.split_whitespace().nth(1) == Some(name))
+            .map(str::to_string)
+    };
+    let (ok, out, err) = armcal(&["model", "puma560", "--convention", "zrp"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("converted to zrp"), "{out}");
+    for p in [
+        "base.x",
+        "j1.ux",
+        "j1.uy",
+        "j1.uz",
+        "j1.px",
+        "j1.py",
+        "j1.pz",
+        "j1.offset",
+        "j6.offset",
+        "tool.rz",
+    ] {
+        assert!(row(&out, p).is_some(), "{p} missing:\n{out}");
+    }
+    // The DH-family fields of `puma560` are gone.
+    for p in ["j2.beta", "j6.dz", "base.theta"] {
+        assert!(row(&out, p).is_none(), "{p} still there:\n{out}");
+    }
+    // Forward kinematics are unchanged, so a full pose still identifies 4R + 6 = 30.
+    assert!(out.contains("identifiable: 30 parameters"), "{out}");
+
+    let (ok, out, err) = armcal(&["model", "puma560", "--convention", "dh"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("converted to dh"), "{out}");
+    for p in [
+        "base.theta",
+        "base.d",
+        "base.a",
+        "base.alpha",
+        "j2.theta",
+        "j2.d",
+        "j2.a",
+        "j2.alpha",
+        "j6.theta",
+        "tool.x",
+    ] {
+        assert!(row(&out, p).is_some(), "{p} missing:\n{out}");
+    }
+    for p in ["j2.beta", "j6.dz", "j1.ux"] {
+        assert!(row(&out, p).is_none(), "{p} still there:\n{out}");
+    }
+    // Standard DH cannot describe a tilt of the parallel axes 2 and 3 and has their d's
+    // dependent (book §2.6, the reason for Table 6.1's Hayati link): one parameter short.
+    assert!(out.contains("identifiable: 29 parameters"), "{out}");
+    assert!(
+        out.contains("- `j3.d` cannot be separated from `j2.d`"),
+        "{out}"
+    );
+
+    let (ok, out, err) = armcal(&["model", "puma560", "--convention", "mdh", "--json"]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["convention"], "mdh");
+    assert_eq!(v["parameters"].as_array().unwrap().len(), 4 + 6 * 4 + 6);
+
+    let (ok, _, err) = armcal(&["model", "puma560", "--convention", "urdf"]);
+    assert!(!ok);
+    assert!(err.contains("dh") && err.contains("zrp"), "{err}");
+}

@@ -10,7 +10,10 @@ use std::path::Path;
 
 #[test]
 fn kpi_exchange_beats_random_and_parameter_variance_designs() {
-    let cell = Cell::from_file(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-cell.toml")).unwrap();
+    let cell = Cell::from_file(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-cell.toml"),
+    )
+    .unwrap();
     let d = DesignModel::from_cell(&cell).unwrap();
     let pool = random_configurations(&d.model, 2000, 3);
     let none = DMatrix::zeros(0, d.n());
@@ -35,10 +38,30 @@ fn kpi_exchange_beats_random_and_parameter_variance_designs() {
     // Without the incidence limit random poses are far more varied than the paper's
     // heuristic (which keeps only the ≈6 % of draws the tracker can see), so the gain over
     // random is smaller here than the paper's 40 %; the study with constraints checks that.
-    assert!(kpi_k < 0.8 * kpi_random, "KPI design ≥ 20 % better than unconstrained random");
-    assert!(kpi_k < 0.9 * kpi_a, "KPI design ≥ 10 % better than the A design");
+    assert!(
+        kpi_k < 0.8 * kpi_random,
+        "KPI design ≥ 20 % better than unconstrained random"
+    );
+    assert!(
+        kpi_k < 0.9 * kpi_a,
+        "KPI design ≥ 10 % better than the A design"
+    );
     for c in [Criterion::D, Criterion::E, Criterion::O1, Criterion::O3] {
-        let r = exchange(&d, c, &pool, &none, 60, &ExchangeSettings { max_sweeps: 3, ..s.clone() }).unwrap();
-        assert!(r.history.last().unwrap() <= &r.history[0], "{c:?} must not get worse");
+        let r = exchange(
+            &d,
+            c,
+            &pool,
+            &none,
+            60,
+            &ExchangeSettings {
+                max_sweeps: 3,
+                ..s.clone()
+            },
+        )
+        .unwrap();
+        assert!(
+            r.history.last().unwrap() <= &r.history[0],
+            "{c:?} must not get worse"
+        );
     }
 }

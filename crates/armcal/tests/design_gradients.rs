@@ -8,7 +8,10 @@ use std::path::Path;
 
 #[test]
 fn criterion_gradients_match_finite_differences() {
-    let cell = Cell::from_file(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-cell.toml")).unwrap();
+    let cell = Cell::from_file(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-cell.toml"),
+    )
+    .unwrap();
     let d = DesignModel::from_cell(&cell).unwrap();
     let qs = random_configurations(&d.model, 40, 9);
     let measured = random_configurations(&d.model, 3, 10);

@@ -1,7 +1,21 @@
 //! `armcal model <robot-or-cell>`: parameters, completeness and identifiability.
+//!
+//! With `--convention dh|mdh|zrp` the model is first converted by `armcal::model::convert`
+//! (forward kinematics unchanged): `zrp` by `to_zrp` (identity base, one zero-reference
+//! link per joint, the tool pose at q = 0 as tool frame); `dh` by `zrp_to_dh` without a
+//! nominal (standard DH links by the common normals, book §6.3.4, and the tool frame that
+//! remains); `mdh` by `dh_to_mdh` of that. The table and the identifiability analysis are
+//! then those of the converted model. Its statuses, kept simple: the instrument and the
+//! targets, which the conversion copies unchanged, keep the cell's declared statuses; every
+//! chain parameter (base, links, tool) is a candidate, since the conversion redistributes
+//! the geometry among the chain's links and a fixed base or tool of the cell has no
+//! counterpart there. With `free = "auto"` in the cell the unidentifiable ones are shown
+//! fixed, as for the original model.
 
-use armcal::model::identifiability::{IdentifiabilityOptions, Measurement};
-use armcal::model::Status;
+use armcal::cell::Cell;
+use armcal::model::convert::{dh_to_mdh, to_zrp, zrp_to_dh};
+use armcal::model::identifiability::{self, Identifiability, IdentifiabilityOptions, Measurement};
+use armcal::model::{Model, Segment, Status};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -19,24 +33,77 @@ pub struct Args {
     /// Print JSON instead of tables.
     #[arg(long)]
     pub json: bool,
+    /// Convert the model to this convention first (forward kinematics unchanged): the
+    /// table and the analysis are those of the converted model, all chain parameters free.
+    #[arg(long, value_parser = ["dh", "mdh", "zrp"])]
+    pub convention: Option<String>,
+}
+
+/// The cell's model converted to `convention`, with the statuses described in the module
+/// documentation.
+fn converted(cell: &Cell, convention: &str) -> anyhow::Result<Model> {
+    let original = &cell.model;
+    let spec = match convention {
+        "zrp" => to_zrp(original, &original.nominal()),
+        "dh" => zrp_to_dh(&original.spec(), None)?,
+        "mdh" => dh_to_mdh(&zrp_to_dh(&original.spec(), None)?)?,
+        other => anyhow::bail!("unknown convention `{other}`; use dh, mdh or zrp"),
+    };
+    let mut model = Model::from_spec(&spec)?;
+    for i in 0..model.param_count() {
+        let p = model.registry.get(i);
+        let status = match p.segment {
+            Segment::Chain => Status::Free,
+            Segment::Instrument | Segment::Target(_) => {
+                let k = original.registry.require(&p.name)?;
+                if cell.declared_free.contains(&k) {
+                    match original.registry.get(k).status {
+                        Status::Prior { sigma } => Status::Prior { sigma },
+                        _ => Status::Free,
+                    }
+                } else {
+                    Status::Fixed
+                }
+            }
+        };
+        model.registry.set_status(i, status);
+    }
+    Ok(model)
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let cell = super::output::load_cell(&a.target)?;
-    let model = &cell.model;
     let measurement = a
         .measurement
         .as_deref()
         .and_then(Measurement::from_name)
         .unwrap_or(cell.measurement);
-    // The analysis runs on the parameters the cell declared free, before the automatic
-    // reduction, so that every excluded parameter gets its reason.
-    let report = cell.identifiability(&IdentifiabilityOptions {
+    let opts = IdentifiabilityOptions {
         measurement,
         poses: a.poses,
         seed: a.seed,
         ..cell.identifiability_options()
-    })?;
+    };
+    let conversion: Option<(Model, Identifiability)> = match a.convention.as_deref() {
+        Some(c) => {
+            let mut m = converted(&cell, c)?;
+            let report = identifiability::analyze(&m, &m.nominal(), &opts)?;
+            if cell.auto_free {
+                report.apply(&mut m)?;
+            }
+            Some((m, report))
+        }
+        None => None,
+    };
+    let (model, report) = match conversion {
+        Some((m, r)) => (std::borrow::Cow::Owned(m), r),
+        // The analysis runs on the parameters the cell declared free, before the automatic
+        // reduction, so that every excluded parameter gets its reason.
+        None => (
+            std::borrow::Cow::Borrowed(&cell.model),
+            cell.identifiability(&opts)?,
+        ),
+    };
     if a.json {
         let params: Vec<_> = model
             .registry
@@ -53,6 +120,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         let out = serde_json::json!({
             "cell": cell.name,
             "source": cell.robot.source,
+            "convention": a.convention,
             "joints": model.joints,
             "parameters": params,
             "identifiability": report,
@@ -61,7 +129,14 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         return Ok(());
     }
     println!("{} ({})", cell.name, cell.origin);
-    println!("source: {}\n", cell.robot.source);
+    println!("source: {}", cell.robot.source);
+    if let Some(c) = &a.convention {
+        println!(
+            "converted to {c} (forward kinematics unchanged); chain parameters all free, \
+             instrument and targets as the cell declares them"
+        );
+    }
+    println!();
     println!(
         "{:<4} {:<14} {:>14} {:<4} status",
         "#", "parameter", "nominal", "unit"

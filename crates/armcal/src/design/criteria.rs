@@ -78,10 +78,16 @@ pub struct CriterionValue {
 /// factor `R` (from a QR decomposition of the stacked whitened Jacobian: C and the
 /// eigenvalues of M then carry the accuracy of J, not of the squared M). Fails if M is
 /// singular (the design does not identify every free parameter).
-pub fn evaluate(criterion: Criterion, r: &DMatrix<f64>, d: &DesignModel) -> Result<CriterionValue, Error> {
+pub fn evaluate(
+    criterion: Criterion,
+    r: &DMatrix<f64>,
+    d: &DesignModel,
+) -> Result<CriterionValue, Error> {
     let n = r.nrows();
     let nf = n as f64;
-    let singular = || Error::Input("the design's information matrix is singular: it does not identify every free parameter".into());
+    let singular = || {
+        Error::Input("the design's information matrix is singular: it does not identify every free parameter".into())
+    };
     let rmax = r.diagonal().iter().fold(0.0f64, |a, x| a.max(x.abs()));
     if r.diagonal().iter().any(|x| x.abs() <= 1e-13 * rmax) {
         return Err(singular());

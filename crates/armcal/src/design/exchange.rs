@@ -64,12 +64,19 @@ pub fn pool_jacobians(d: &DesignModel, pool: &[Vec<f64>]) -> DMatrix<f64> {
 }
 
 /// The criterion of a set of pool points (plus prior rows).
-fn value_of(d: &DesignModel, c: Criterion, jp: &DMatrix<f64>, prior: &DMatrix<f64>, set: &[usize]) -> Result<f64, Error> {
+fn value_of(
+    d: &DesignModel,
+    c: Criterion,
+    jp: &DMatrix<f64>,
+    prior: &DMatrix<f64>,
+    set: &[usize],
+) -> Result<f64, Error> {
     let rows = d.rows();
     let mut a = DMatrix::zeros(prior.nrows() + rows * set.len(), d.n());
     a.rows_mut(0, prior.nrows()).copy_from(prior);
     for (k, &i) in set.iter().enumerate() {
-        a.rows_mut(prior.nrows() + k * rows, rows).copy_from(&jp.rows(i * rows, rows));
+        a.rows_mut(prior.nrows() + k * rows, rows)
+            .copy_from(&jp.rows(i * rows, rows));
     }
     Ok(evaluate(c, &triangular_factor(a), d)?.value)
 }
@@ -155,10 +162,10 @@ pub fn exchange(
                 }
                 let jx = jp.rows(x * rows, rows);
                 let ux = jc.rows(x * rows, rows);
-                let s = DMatrix::identity(rows, rows) + &ux * jx.transpose();
+                let s = DMatrix::identity(rows, rows) + ux * jx.transpose();
                 let score = match &a {
                     Some(a) => {
-                        let t = &jx * a * jx.transpose();
+                        let t = jx * a * jx.transpose();
                         match s.clone().cholesky() {
                             Some(ch) => -(ch.solve(&t)).trace(),
                             None => f64::INFINITY,

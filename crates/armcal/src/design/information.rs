@@ -40,7 +40,9 @@ impl DesignModel {
         let params = model.nominal();
         let free = model.registry.free();
         if free.is_empty() {
-            return Err(Error::Input("the cell has no free parameters to design for".into()));
+            return Err(Error::Input(
+                "the cell has no free parameters to design for".into(),
+            ));
         }
         let observed: Vec<Observed> = if model.targets.is_empty() {
             vec![Observed::Tool]
@@ -49,7 +51,11 @@ impl DesignModel {
         };
         let working: Vec<Vec<f64>> = cell.working.iter().map(|w| w.q.clone()).collect();
         let kpi_rows = crate::identify::uncertainty::tcp_jacobian(&model, &params, &free, &working);
-        let noise = cell.instrument.as_ref().map(|i| i.noise.clone()).unwrap_or_default();
+        let noise = cell
+            .instrument
+            .as_ref()
+            .map(|i| i.noise.clone())
+            .unwrap_or_default();
         let sigma = match noise {
             NoiseModel::Constant { sigma, .. } => sigma,
             NoiseModel::Range { a, b_per_m } => {
@@ -126,7 +132,15 @@ impl DesignModel {
     pub fn jacobian(&self, ws: &mut InformationWorkspace, q: &[f64]) {
         forward_kinematics(&self.model, &mut ws.data, &self.params, q);
         for (k, &obs) in self.observed.iter().enumerate() {
-            identification_jacobian(&self.model, &ws.data, obs, Rows::Position, &self.free, &mut ws.jac, 3 * k);
+            identification_jacobian(
+                &self.model,
+                &ws.data,
+                obs,
+                Rows::Position,
+                &self.free,
+                &mut ws.jac,
+                3 * k,
+            );
         }
         self.whiten(&mut ws.jac);
     }

@@ -6,6 +6,7 @@ pub mod criteria;
 pub mod exchange;
 pub mod information;
 pub mod objective;
+pub mod refine;
 
 pub use criteria::{Criterion, CriterionValue};
 pub use information::{DesignModel, InformationWorkspace};

@@ -72,7 +72,9 @@ impl<'a> DesignObjective<'a> {
                 self.design.jacobian(&mut ws.info, qi);
             }
             ws.jacs[i].copy_from(&ws.info.jac);
-            stacked.rows_mut(np + rows * i, rows).copy_from(&ws.info.jac);
+            stacked
+                .rows_mut(np + rows * i, rows)
+                .copy_from(&ws.info.jac);
         }
         let r = triangular_factor(stacked);
         let cv = evaluate(self.criterion, &r, self.design)?;
