@@ -2,6 +2,8 @@
 //! calibrated robot most precise where it works (the KPI method), or that optimise a classic
 //! criterion of the parameter covariance.
 
+pub mod baselines;
+pub mod bound;
 pub mod criteria;
 pub mod exchange;
 pub mod information;
