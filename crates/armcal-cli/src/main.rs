@@ -29,6 +29,10 @@ enum Command {
     Identify(commands::identify::Args),
     /// Predict what the instrument measures at given joint configurations.
     Predict(commands::predict::Args),
+    /// Plan optimal measurement poses (paper's KPI method or a classic criterion).
+    Plan(commands::plan::PlanArgs),
+    /// Predicted C_p, C_s, criteria and constraint margins of any design.
+    Evaluate(commands::plan::EvaluateArgs),
 }
 
 fn main() {
@@ -40,6 +44,8 @@ fn main() {
         Command::Simulate(a) => commands::simulate::run(&a),
         Command::Identify(a) => commands::identify::run(&a),
         Command::Predict(a) => commands::predict::run(&a),
+        Command::Plan(a) => commands::plan::run_plan(&a),
+        Command::Evaluate(a) => commands::plan::run_evaluate(&a),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

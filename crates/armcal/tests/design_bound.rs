@@ -12,32 +12,67 @@ use std::path::Path;
 
 #[test]
 fn bound_is_below_every_design_and_efficiency_is_high_for_optimised_designs() {
-    let cell = Cell::from_file(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-cell.toml")).unwrap();
+    let cell = Cell::from_file(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-cell.toml"),
+    )
+    .unwrap();
     let d = DesignModel::from_cell(&cell).unwrap();
     let pool = random_configurations(&d.model, 800, 11);
     let (lo, hi) = d.model.joint_limits();
     for criterion in [Criterion::Kpi, Criterion::A, Criterion::D] {
         let obj = DesignObjective::new(&d, criterion, &[]);
-        let ex = exchange(&d, criterion, &pool, &DMatrix::zeros(0, d.n()), 30, &ExchangeSettings::default()).unwrap();
+        let ex = exchange(
+            &d,
+            criterion,
+            &pool,
+            &DMatrix::zeros(0, d.n()),
+            30,
+            &ExchangeSettings::default(),
+        )
+        .unwrap();
         let start: Vec<Vec<f64>> = ex.chosen.iter().map(|&i| pool[i].clone()).collect();
-        let refined = refine(&obj, &start, &lo, &hi, None, &RefineSettings { max_inner_iterations: 800, ..Default::default() }).unwrap();
-        let b = optimality_bound(&obj, &refined.q, &pool, 20).unwrap();
+        let refined = refine(
+            &obj,
+            &start,
+            &lo,
+            &hi,
+            None,
+            &RefineSettings {
+                max_inner_iterations: 800,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let b = optimality_bound(&obj, &refined.q, &pool, 20, |_| true).unwrap();
         let random = strategy(&d.model, Strategy::S4, 30, 4);
         let mut ws = obj.workspace(30);
-        let v_random = obj.value_and_gradient(&mut ws, &random.concat(), None).unwrap();
+        let v_random = obj
+            .value_and_gradient(&mut ws, &random.concat(), None)
+            .unwrap();
         eprintln!(
             "{criterion:?}: random {v_random:.5}, exchange {:.5}, refined {:.5}, lower bound {:.5}, efficiency {:.3}",
             ex.value, refined.value, b.lower_bound, b.efficiency
         );
-        assert!(b.lower_bound <= refined.value && b.lower_bound <= ex.value && b.lower_bound <= v_random);
-        assert!(b.efficiency > 0.5 && b.efficiency <= 1.0, "efficiency {}", b.efficiency);
+        assert!(
+            b.lower_bound <= refined.value
+                && b.lower_bound <= ex.value
+                && b.lower_bound <= v_random
+        );
+        assert!(
+            b.efficiency > 0.5 && b.efficiency <= 1.0,
+            "efficiency {}",
+            b.efficiency
+        );
     }
 }
 
 #[test]
 fn book_strategy_one_is_much_worse_than_random() {
     // Book Table 4.6: strategy 1 (all joints together along one curve) is the bad one.
-    let cell = Cell::from_file(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-cell.toml")).unwrap();
+    let cell = Cell::from_file(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-cell.toml"),
+    )
+    .unwrap();
     let d = DesignModel::from_cell(&cell).unwrap();
     let obs = |qs: &[Vec<f64>]| {
         let mut ws = armcal::design::InformationWorkspace::new(&d);

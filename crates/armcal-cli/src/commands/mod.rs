@@ -4,6 +4,7 @@ pub mod fk;
 pub mod identify;
 pub mod model;
 pub mod output;
+pub mod plan;
 pub mod predict;
 pub mod robots;
 pub mod simulate;

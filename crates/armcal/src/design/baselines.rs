@@ -24,9 +24,17 @@ pub fn strategy(model: &Model, s: Strategy, n: usize, seed: u64) -> Vec<Vec<f64>
     let k = lo.len();
     let mid: Vec<f64> = lo.iter().zip(&hi).map(|(a, b)| 0.5 * (a + b)).collect();
     let sweep = |j: usize, t: f64| lo[j] + t * (hi[j] - lo[j]);
-    let frac = |i: usize, m: usize| if m <= 1 { 0.5 } else { i as f64 / (m - 1) as f64 };
+    let frac = |i: usize, m: usize| {
+        if m <= 1 {
+            0.5
+        } else {
+            i as f64 / (m - 1) as f64
+        }
+    };
     match s {
-        Strategy::S1 => (0..n).map(|i| (0..k).map(|j| sweep(j, frac(i, n))).collect()).collect(),
+        Strategy::S1 => (0..n)
+            .map(|i| (0..k).map(|j| sweep(j, frac(i, n))).collect())
+            .collect(),
         Strategy::S2 | Strategy::S3 => {
             let per = n.div_ceil(k);
             let mut out = Vec::with_capacity(n);

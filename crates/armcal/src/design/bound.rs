@@ -6,9 +6,10 @@
 //! at the current design M̂ with gradient Φ = ∂φ/∂M gives, for every design,
 //! `φ(M) ≥ φ(M̂) − ⟨Φ, M̂ − M₀⟩ + N · min_x ⟨Φ, I(x)⟩`,
 //! i.e. the equivalence-theorem bound with the sensitivity function `d(x) = −⟨Φ, I(x)⟩`
-//! maximised over the joint box by multi-start projected gradient ascent. Maximising over
-//! the box (a superset of the feasible set) only loosens the bound; the bound is valid up to
-//! the global maximisation of d, which multi-start approximates.
+//! maximised over the feasible configurations (joint limits and the cell's constraints) by
+//! multi-start gradient ascent from the best feasible pool points, accepting only feasible
+//! steps. The bound is valid up to that global maximisation, which multi-start
+//! approximates: a missed maximum would make the bound too high, never too low.
 
 use crate::design::criteria::{evaluate, Criterion};
 use crate::design::information::{DesignModel, InformationWorkspace};
@@ -34,11 +35,20 @@ pub struct OptimalityBound {
 
 /// Whether the bound applies (criterion convex in M).
 pub fn has_bound(c: Criterion) -> bool {
-    matches!(c, Criterion::A | Criterion::D | Criterion::E | Criterion::Kpi | Criterion::O1 | Criterion::O3)
+    matches!(
+        c,
+        Criterion::A | Criterion::D | Criterion::E | Criterion::Kpi | Criterion::O1 | Criterion::O3
+    )
 }
 
 /// Sensitivity `d(x) = −⟨Φ, I(x)⟩ = −tr(J Φ Jᵀ)` and its gradient w.r.t. x.
-fn sensitivity(d: &DesignModel, ws: &mut InformationWorkspace, phi: &DMatrix<f64>, x: &[f64], grad: Option<&mut [f64]>) -> f64 {
+fn sensitivity(
+    d: &DesignModel,
+    ws: &mut InformationWorkspace,
+    phi: &DMatrix<f64>,
+    x: &[f64],
+    grad: Option<&mut [f64]>,
+) -> f64 {
     match grad {
         Some(g) => {
             d.jacobian_dq(ws, x);
@@ -62,6 +72,7 @@ pub fn optimality_bound(
     design: &[Vec<f64>],
     pool: &[Vec<f64>],
     starts: usize,
+    mut feasible: impl FnMut(&[f64]) -> bool,
 ) -> Result<OptimalityBound, Error> {
     let d = objective.design;
     if !has_bound(objective.criterion) {
@@ -106,9 +117,11 @@ pub fn optimality_bound(
             if gn == 0.0 {
                 break;
             }
-            let trial: Vec<f64> = (0..k).map(|j| (x[j] + step * g[j] / gn).clamp(lo[j], hi[j])).collect();
+            let trial: Vec<f64> = (0..k)
+                .map(|j| (x[j] + step * g[j] / gn).clamp(lo[j], hi[j]))
+                .collect();
             let st = sensitivity(d, &mut ws, phi, &trial, None);
-            if st > s {
+            if st > s && feasible(&trial) {
                 s = st;
                 x = trial;
                 step *= 1.5;

@@ -2,12 +2,15 @@
 //! calibrated robot most precise where it works (the KPI method), or that optimise a classic
 //! criterion of the parameter covariance.
 
+pub mod assess;
 pub mod baselines;
 pub mod bound;
 pub mod criteria;
 pub mod exchange;
 pub mod information;
 pub mod objective;
+pub mod order;
+pub mod plan;
 pub mod refine;
 
 pub use criteria::{Criterion, CriterionValue};

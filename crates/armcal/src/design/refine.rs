@@ -38,11 +38,11 @@ pub struct RefineSettings {
 impl Default for RefineSettings {
     fn default() -> Self {
         RefineSettings {
-            tolerance: 1e-6,
+            tolerance: 1e-5,
             constraint_tolerance: 1e-4,
-            max_inner_iterations: 3000,
-            max_outer_iterations: 40,
-            max_duration: Duration::from_secs(60),
+            max_inner_iterations: 400,
+            max_outer_iterations: 12,
+            max_duration: Duration::from_secs(30),
             lbfgs_memory: 10,
         }
     }

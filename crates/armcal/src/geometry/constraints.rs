@@ -31,14 +31,21 @@
 //! two robot capsules only the joints between their frames contribute (a common joint moves
 //! both rigidly and `n · (ω × (P − Q)) = 0`).
 //!
-//! **Which robot pairs are checked (the set 𝓘 of eq. 24b).** Two robot capsules are
-//! compared when at least two joints separate their frames. Frames carrying capsules are
-//! the chain frames `base, j1, …, jn, tool` (link index 0 … n + 1); same-frame pairs and
-//! neighbouring segments (one joint between them) are skipped — "the limitation of joint
-//! movement automatically prevents their collision" (paper §2.2). For a chain in which every
-//! link but base and tool has a joint this is the rule "link indices differ by ≥ 2", with the
-//! fixed base and tool frames merged into their neighbours (`base`–`j1` and `j5`–`tool` are
-//! neighbours: joint 1 resp. joint 6 alone separates them).
+//! **Which robot pairs are checked (the set 𝓘 of eq. 24b).** The robot's bodies are its
+//! capsule-carrying chain frames (`base, j1, …, jn, tool`, in chain order), each body being
+//! all capsules on one frame. Two robot capsules are compared unless
+//! - they are on the same frame;
+//! - their frames are neighbouring bodies (no other capsule-carrying frame between them) —
+//!   "two neighboring segments do not have to be compared as the limitation of joint movement
+//!   automatically prevents their collision" (paper §2.2; with one capsule per body this is
+//!   exactly the count of eq. 22, `n(n − 1)/2 − (n − 1)`);
+//! - no joint separates them (their distance would not depend on q).
+//!
+//! "Link indices differ by ≥ 2" is the same rule when every link carries capsules. It is not
+//! when a frame carries none: in the paper robot the wrist capsule (on `j5`, wrist centre to
+//! flange) and the reflector holder (on `tool`, from the flange) touch at the flange for every
+//! q although their link indices differ by 2 (the flange frame `j6` carries no capsule); the
+//! KUKA models' forearm (`j4`) and wrist (`j6`) likewise meet at the wrist centre.
 //!
 //! **Fixed capsules.** Robot capsules on frames before the first joint (the pedestal on
 //! `base`) do not move: they are checked against the moving robot capsules and against the
@@ -300,14 +307,17 @@ impl ConstraintSet {
             }
         }
         if options.collisions {
+            // Capsule-carrying frames in chain order: body rank of every capsule.
+            let mut bodies: Vec<usize> = capsules.iter().map(|c| c.link).collect();
+            bodies.sort_unstable();
+            bodies.dedup();
+            let rank = |c: &RobotCapsule| bodies.binary_search(&c.link).unwrap_or(0);
             for i in 0..capsules.len() {
                 for j in i + 1..capsules.len() {
-                    if capsules[i].joints.abs_diff(capsules[j].joints) >= 2 {
+                    let (ci, cj) = (&capsules[i], &capsules[j]);
+                    if rank(ci).abs_diff(rank(cj)) >= 2 && ci.joints != cj.joints {
                         items.push(Item::Pair { i, j });
-                        names.push(format!(
-                            "capsule {} / {}",
-                            capsules[i].label, capsules[j].label
-                        ));
+                        names.push(format!("capsule {} / {}", ci.label, cj.label));
                     }
                 }
             }

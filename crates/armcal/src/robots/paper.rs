@@ -38,18 +38,40 @@ pub fn notional(lambda: f64, mu: f64) -> Robot {
         ),
         frame_link("tool", [0.0; 3], [0.0; 3]),
     ];
-    // Capsules (not published; chosen for a KUKA-like arm of this size and kept the same
-    // for the whole study). Coordinates in the frame at the end of the named link.
+    // Capsules (not published; armcal's choice for a KUKA-like arm of this size, kept the same
+    // for the whole study). Coordinates in the frame at the end of the named link, mm.
+    //
+    // Which way is up: frame 0 is at shoulder height with x forward and **z pointing down**
+    // (up = −z0), as in the KUKA models (`kuka.rs`). The joint variables are KUKA axis angles:
+    // the Table 4 ranges are subsets of KUKA's datasheet ranges with KUKA's signs (q2 ≤ 31°
+    // against A2 ≤ 35°, q3 ≤ 154° = A3 max), and with this DH a positive q2 turns the upper
+    // arm towards +z0. So at q2 = −90° the upper arm points along −z0, and KUKA HOME
+    // (0, −90°, 90°, 0, 0, 0) is the upright arm with a horizontal forearm only if −z0 is up.
+    // At the lower limit q2 = −77° the upper arm leans 13° forward of upright (it never leans
+    // back towards the wall 450 mm behind the robot) and at q2 = 31° it points 31° below the
+    // horizontal: a floor-standing robot's working range. Read with z0 up the robot could
+    // never lift its upper arm more than 31° above the horizontal and would hang from its
+    // mount. (See `examples/paper-cell-obstacles.toml` for the consequences in the cell.)
     let capsules = vec![
-        // pedestal and rotating column below the shoulder (frame 0 is at shoulder height)
-        capsule("base", [0.0, 0.0, -1000.0], [0.0, 0.0, -350.0], 300.0),
+        // Pedestal: the robot's base and rotating column and the "long object" the robot is
+        // mounted on (paper §3.2), one vertical capsule from the floor of the paper cell
+        // (z0 = +2400 mm, 2.4 m below the shoulder, see the cell file) up to z0 = +300, where
+        // its cap clears the upper-arm capsule at the axis-2 point (350, 0, 0) by
+        // √(350² + 300²) − 300 − 140 = 21 mm for every q1 (KUKA models: 20 mm).
+        capsule("base", [0.0, 0.0, 2400.0], [0.0, 0.0, 300.0], 300.0),
         // shoulder: from the axis-1 line to the axis-2 origin (x1 points along a1)
         capsule("j1", [-350.0, 0.0, 0.0], [0.0, 0.0, 0.0], 220.0),
         // upper arm along x2, length λ
         capsule("j2", [-lambda, 0.0, 0.0], [0.0, 0.0, 0.0], 140.0),
-        // elbow offset a3 = 145 along x3, then the forearm along −z3 to the wrist centre
+        // elbow: from the axis-3 point (a3 = 145 back along x3) to 250 mm down the forearm
+        // axis (−z3)
         capsule("j3", [-145.0, 0.0, 0.0], [0.0, 0.0, -250.0], 130.0),
-        capsule("j3", [0.0, 0.0, -250.0], [0.0, 0.0, -mu + 120.0], 100.0),
+        // forearm, 250 mm down the axis to the wrist centre. It is symmetric about the axis-4
+        // line, so it sits on frame j4 (the A4 housing): frame-3 point (0, 0, z) is
+        // (0, −(z + μ), 0) in frame 4 (link 4 is Rz(q4) Tz(−μ) Rx(−90°)). On j4 it is the wrist's
+        // neighbouring body and is not compared with the wrist capsule (on j3 it would touch
+        // the wrist capsule at every q5).
+        capsule("j4", [0.0, -(mu - 250.0), 0.0], [0.0, 0.0, 0.0], 100.0),
         // wrist: from the wrist centre along −z5 to the flange (d6 = −170)
         capsule("j5", [0.0, 0.0, 0.0], [0.0, 0.0, -170.0], 75.0),
     ];

@@ -1,0 +1,249 @@
+//! `armcal plan`: optimal measurement poses for a cell; `armcal evaluate`: what any design
+//! (including a hand-made one) gives.
+
+use super::output::{load_cell, write_new};
+use anyhow::bail;
+use armcal::cell::Cell;
+use armcal::design::assess::assess;
+use armcal::design::plan::{constraint_set, plan, CellConstraints, PlanSettings};
+use armcal::design::Criterion;
+use armcal::measure::csv;
+use armcal::model::JointKind;
+use std::path::{Path, PathBuf};
+
+#[derive(clap::Args)]
+pub struct PlanArgs {
+    /// Cell file or built-in robot.
+    #[arg(long)]
+    pub cell: String,
+    /// Number of measurement poses.
+    #[arg(long, default_value_t = 60)]
+    pub poses: usize,
+    /// Criterion: kpi (TCP variance at the working poses, paper eq. 24), a, d, e, o1…o5.
+    #[arg(long, default_value = "kpi", value_parser = ["kpi", "a", "d", "e", "o1", "o2", "o3", "o4", "o5"])]
+    pub criterion: String,
+    /// Collision and line-of-sight constraints.
+    #[arg(long, default_value = "on", value_parser = ["on", "off"])]
+    pub collisions: String,
+    /// Independent exchange + refinement starts (run in parallel).
+    #[arg(long, default_value_t = 2)]
+    pub starts: usize,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Poses already measured (CSV); the design augments them.
+    #[arg(long)]
+    pub measured: Option<PathBuf>,
+    /// Output design (CSV: pose_id, q1_deg, …).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Also write the JSON report (default: the design path with .json).
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    #[arg(long)]
+    pub force: bool,
+}
+
+#[derive(clap::Args)]
+pub struct EvaluateArgs {
+    /// Cell file or built-in robot.
+    #[arg(long)]
+    pub cell: String,
+    /// Design (CSV with joint columns).
+    #[arg(long)]
+    pub design: PathBuf,
+    /// Collision and line-of-sight constraints for the margin report.
+    #[arg(long, default_value = "on", value_parser = ["on", "off"])]
+    pub collisions: String,
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// CSV of configurations in the data-file joint format.
+pub fn design_csv(cell: &Cell, design: &[Vec<f64>]) -> String {
+    let model = &cell.model;
+    let mut s = String::from("pose_id");
+    for j in &model.joints {
+        s.push_str(&format!(
+            ",{}_{}",
+            j.name,
+            if j.kind == JointKind::Revolute {
+                "deg"
+            } else {
+                "mm"
+            }
+        ));
+    }
+    s.push('\n');
+    for (i, q) in design.iter().enumerate() {
+        s.push_str(&format!("{}", i + 1));
+        for (v, j) in q.iter().zip(&model.joints) {
+            let x = if j.kind == JointKind::Revolute {
+                v.to_degrees()
+            } else {
+                *v
+            };
+            s.push_str(&format!(",{x:.6}"));
+        }
+        s.push('\n');
+    }
+    s
+}
+
+pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
+    let cell = load_cell(&a.cell)?;
+    let report_path = a
+        .report
+        .clone()
+        .unwrap_or_else(|| a.out.with_extension("json"));
+    for p in [&a.out, &report_path] {
+        if p.exists() && !a.force {
+            bail!("{} exists; pass --force to overwrite it", p.display());
+        }
+    }
+    let measured: Vec<Vec<f64>> = match &a.measured {
+        Some(p) => csv::read_configurations(p, &cell.model, None)?
+            .into_iter()
+            .map(|(_, q)| q)
+            .collect(),
+        None => Vec::new(),
+    };
+    let settings = PlanSettings {
+        poses: a.poses,
+        criterion: Criterion::from_name(&a.criterion).expect("clap checked"),
+        collisions: a.collisions == "on",
+        starts: a.starts,
+        seed: a.seed,
+        ..PlanSettings::default()
+    };
+    let rep = plan(&cell, &settings, &measured)?;
+    write_new(&a.out, &design_csv(&cell, &rep.design), a.force)?;
+    let json = serde_json::json!({
+        "cell": cell.name,
+        "plan": rep,
+        "assessment": assess(&cell, &rep.design)?,
+    });
+    write_new(&report_path, &serde_json::to_string_pretty(&json)?, a.force)?;
+    println!(
+        "{} poses for `{}`, criterion {:?}: value {:.6} (exchange {:.6}; refinement {}) in {:.2} s",
+        rep.design.len(),
+        cell.name,
+        rep.criterion,
+        rep.value,
+        rep.exchange_value,
+        rep.refine_status.as_deref().unwrap_or("skipped"),
+        rep.time.as_secs_f64()
+    );
+    println!(
+        "constraints: {} per pose; {} (smallest margin {})",
+        rep.constraints_per_pose,
+        if rep.feasible {
+            "every pose feasible"
+        } else {
+            "NOT FEASIBLE"
+        },
+        rep.min_margin
+            .as_ref()
+            .map(|m| format!(
+                "{:.4} on `{}` at pose {}",
+                m.value,
+                m.constraint,
+                m.pose + 1
+            ))
+            .unwrap_or_else(|| "none".into())
+    );
+    if let Some(b) = &rep.bound {
+        println!(
+            "optimality bound: no {}-pose design can go below {:.6}; this design's efficiency {:.3}",
+            rep.design.len(),
+            b.lower_bound,
+            b.efficiency
+        );
+    }
+    if let Some(t) = json["assessment"]["tcp"].as_array().and_then(|v| v.first()) {
+        println!(
+            "(1/3) tr C_s at `{}`: {:.5} mm²",
+            t["name"].as_str().unwrap_or(""),
+            t["kpi"].as_f64().unwrap_or(f64::NAN)
+        );
+    }
+    println!(
+        "design → {}, report → {}",
+        a.out.display(),
+        report_path.display()
+    );
+    if !rep.feasible {
+        bail!("the design violates constraints; see the report");
+    }
+    Ok(())
+}
+
+pub fn run_evaluate(a: &EvaluateArgs) -> anyhow::Result<()> {
+    let cell = load_cell(&a.cell)?;
+    let design: Vec<Vec<f64>> = csv::read_configurations(Path::new(&a.design), &cell.model, None)?
+        .into_iter()
+        .map(|(_, q)| q)
+        .collect();
+    let assess = serde_json::to_value(assess(&cell, &design)?)?;
+    let set = constraint_set(&cell, a.collisions == "on")?;
+    let params = cell.model.nominal();
+    let cons = CellConstraints::new(&set, &params);
+    let infeasible: Vec<usize> = (0..design.len())
+        .filter(|&i| !cons.feasible(&design[i]))
+        .collect();
+    let margin = cons.design_margin(&design);
+    if a.json {
+        let out = serde_json::json!({"cell": cell.name, "poses": design.len(), "assessment": assess, "infeasible_poses": infeasible.iter().map(|i| i + 1).collect::<Vec<_>>(), "min_margin": margin});
+        println!("{}", serde_json::to_string_pretty(&out)?);
+        return Ok(());
+    }
+    println!("{} poses on `{}`", design.len(), cell.name);
+    if let Some(c) = assess["criteria"].as_array() {
+        for kv in c {
+            println!(
+                "  {:<4} {:.6}",
+                kv[0].as_str().unwrap_or(""),
+                kv[1].as_f64().unwrap_or(f64::NAN)
+            );
+        }
+    }
+    println!(
+        "  φ_A(C_p) = tr(C_p)/n_p = {:.6}",
+        assess["phi_a_cp"].as_f64().unwrap_or(f64::NAN)
+    );
+    if let Some(ts) = assess["tcp"].as_array() {
+        for t in ts {
+            println!(
+                "  (1/3) tr C_s at `{}` = {:.5} mm²",
+                t["name"].as_str().unwrap_or(""),
+                t["kpi"].as_f64().unwrap_or(f64::NAN)
+            );
+        }
+    }
+    match (&margin, infeasible.is_empty()) {
+        (_, true) => println!(
+            "every pose feasible; smallest margin {}",
+            margin
+                .map(|m| format!(
+                    "{:.4} on `{}` at pose {}",
+                    m.value,
+                    m.constraint,
+                    m.pose + 1
+                ))
+                .unwrap_or_else(|| "none".into())
+        ),
+        (Some(m), false) => println!(
+            "{} poses violate constraints ({}); worst: {:.4} on `{}` at pose {}",
+            infeasible.len(),
+            infeasible
+                .iter()
+                .map(|i| (i + 1).to_string())
+                .collect::<Vec<_>>()
+                .join(", "),
+            m.value,
+            m.constraint,
+            m.pose + 1
+        ),
+        (None, false) => println!("{} poses outside the joint limits", infeasible.len()),
+    }
+    Ok(())
+}

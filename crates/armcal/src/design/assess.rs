@@ -1,0 +1,65 @@
+//! What a design gives, before anything is measured: predicted C_p (paper §1.1), C_s at
+//! the working configurations, observability indices and every criterion's value — for a
+//! planned design or one a user made by hand.
+
+use crate::cell::Cell;
+use crate::design::{Criterion, DesignModel, DesignObjective, InformationWorkspace};
+use crate::identify::uncertainty::{self, Observability, TcpCovariance};
+use crate::Error;
+use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
+
+/// Predicted precision of a design.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct DesignAssessment {
+    /// Free parameters, the order of `c_p`.
+    pub parameters: Vec<String>,
+    /// Predicted σ of each free parameter (mm, rad).
+    pub sigma: Vec<f64>,
+    pub c_p: DMatrix<f64>,
+    /// tr(C_p)/n_p (the paper's φ_A(C_p), mm and rad unscaled).
+    pub phi_a_cp: f64,
+    pub tcp: Vec<TcpCovariance>,
+    pub observability: Observability,
+    /// Every criterion's value (see [`Criterion`]).
+    pub criteria: Vec<(Criterion, f64)>,
+}
+
+pub fn assess(cell: &Cell, design: &[Vec<f64>]) -> Result<DesignAssessment, Error> {
+    let d = DesignModel::from_cell(cell)?;
+    let mut ws = InformationWorkspace::new(&d);
+    let mut j = DMatrix::zeros(d.rows() * design.len(), d.n());
+    for (i, q) in design.iter().enumerate() {
+        d.model
+            .check_joints(q)
+            .map_err(|e| Error::Input(format!("pose {}: {e}", i + 1)))?;
+        d.jacobian(&mut ws, q);
+        j.rows_mut(i * d.rows(), d.rows()).copy_from(&ws.jac);
+    }
+    let names: Vec<String> = d
+        .free
+        .iter()
+        .map(|&i| d.model.registry.get(i).name.clone())
+        .collect();
+    let unc = uncertainty::parameter_uncertainty(&j, &DVector::zeros(j.nrows()), &names)?;
+    let wnames: Vec<String> = cell.working.iter().map(|w| w.name.clone()).collect();
+    let tcp = uncertainty::tcp_covariance(&d.kpi_rows, &unc.covariance, &wnames);
+    let mut criteria = Vec::new();
+    for c in Criterion::ALL {
+        if c == Criterion::Kpi && cell.working.is_empty() {
+            continue;
+        }
+        let obj = DesignObjective::new(&d, c, &[]);
+        let mut ows = obj.workspace(design.len());
+        criteria.push((c, obj.value_and_gradient(&mut ows, &design.concat(), None)?));
+    }
+    Ok(DesignAssessment {
+        phi_a_cp: unc.covariance.trace() / names.len() as f64,
+        parameters: names,
+        sigma: unc.sigma,
+        c_p: unc.covariance,
+        tcp,
+        observability: uncertainty::observability(&j),
+        criteria,
+    })
+}

@@ -1,0 +1,300 @@
+//! The planner: a feasible candidate pool, multi-start exchange, continuous refinement
+//! under the constraints, a strict feasibility check, travel ordering, and the optimality
+//! bound. Every solver reports its status, iterations and time.
+
+use crate::cell::Cell;
+use crate::design::baselines::random_feasible;
+use crate::design::bound::{has_bound, optimality_bound, OptimalityBound};
+use crate::design::exchange::{exchange, ExchangeSettings};
+use crate::design::information::DesignModel;
+use crate::design::objective::DesignObjective;
+use crate::design::order::order_for_travel;
+use crate::design::refine::{refine, ConfigurationConstraints, RefineSettings};
+use crate::design::Criterion;
+use crate::geometry::{ConstraintOptions, ConstraintSet, ConstraintWorkspace};
+use crate::Error;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::cell::RefCell;
+use std::time::{Duration, Instant};
+
+/// Settings of [`plan`].
+#[derive(Clone, Debug)]
+pub struct PlanSettings {
+    pub poses: usize,
+    pub criterion: Criterion,
+    /// Collision and line-of-sight constraints (the incidence limit applies whenever the
+    /// cell sets one).
+    pub collisions: bool,
+    /// Independent exchange + refinement runs (in parallel).
+    pub starts: usize,
+    pub seed: u64,
+    /// Feasible random configurations in the candidate pool.
+    pub pool: usize,
+    /// Random draws allowed to fill the pool.
+    pub max_draws: usize,
+    /// Skip the continuous refinement (exchange only).
+    pub exchange_only: bool,
+    pub refine: RefineSettings,
+}
+
+impl Default for PlanSettings {
+    fn default() -> Self {
+        PlanSettings {
+            poses: 60,
+            criterion: Criterion::Kpi,
+            collisions: true,
+            starts: 2,
+            seed: 1,
+            pool: 1500,
+            max_draws: 2_000_000,
+            exchange_only: false,
+            refine: RefineSettings::default(),
+        }
+    }
+}
+
+/// Smallest constraint margin of a design.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct DesignMargin {
+    pub constraint: String,
+    pub pose: usize,
+    pub value: f64,
+}
+
+/// What a planner run produced.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct PlanReport {
+    pub criterion: Criterion,
+    pub value: f64,
+    /// The design, ordered for travel (internal units).
+    pub design: Vec<Vec<f64>>,
+    /// Every pose within the joint limits and every constraint ≥ 0.
+    pub feasible: bool,
+    pub min_margin: Option<DesignMargin>,
+    pub constraints_per_pose: usize,
+    pub pool_draws: usize,
+    pub exchange_value: f64,
+    pub exchange_sweeps: usize,
+    pub refine_status: Option<String>,
+    pub refine_iterations: usize,
+    pub bound: Option<OptimalityBound>,
+    pub time: Duration,
+}
+
+/// One start of the planner: design, value, exchange value, exchange sweeps, and the
+/// refinement's status and iterations (if it ran).
+struct StartResult {
+    design: Vec<Vec<f64>>,
+    value: f64,
+    exchange_value: f64,
+    sweeps: usize,
+    refine: Option<(String, usize)>,
+}
+
+/// Adapts a cell's [`ConstraintSet`] to the refinement's constraint interface.
+pub struct CellConstraints<'a> {
+    pub set: &'a ConstraintSet,
+    pub params: &'a [f64],
+    ws: RefCell<ConstraintWorkspace>,
+}
+
+impl<'a> CellConstraints<'a> {
+    pub fn new(set: &'a ConstraintSet, params: &'a [f64]) -> Self {
+        CellConstraints {
+            set,
+            params,
+            ws: RefCell::new(set.workspace()),
+        }
+    }
+
+    /// Whether `q` is within the limits and satisfies every constraint.
+    pub fn feasible(&self, q: &[f64]) -> bool {
+        self.set.feasible(&mut self.ws.borrow_mut(), self.params, q)
+    }
+
+    /// The smallest margin over a design.
+    pub fn design_margin(&self, design: &[Vec<f64>]) -> Option<DesignMargin> {
+        let mut best: Option<DesignMargin> = None;
+        let mut ws = self.ws.borrow_mut();
+        for (i, q) in design.iter().enumerate() {
+            if let Some(m) = self.set.min_margin_at(&mut ws, self.params, q) {
+                if best.as_ref().is_none_or(|b| m.value < b.value) {
+                    best = Some(DesignMargin {
+                        constraint: m.name.to_string(),
+                        pose: i,
+                        value: m.value,
+                    });
+                }
+            }
+        }
+        best
+    }
+}
+
+/// Margins the refinement keeps from every constraint boundary, so that the first-order
+/// solver's small residual violations still leave a strictly feasible design: 1e-4 in the
+/// cosine of the incidence angle (≈ 0.01° at 30°), 0.05 mm for distances.
+const INCIDENCE_MARGIN: f64 = 1e-4;
+const DISTANCE_MARGIN: f64 = 0.05;
+
+impl ConfigurationConstraints for CellConstraints<'_> {
+    fn len(&self) -> usize {
+        self.set.len()
+    }
+
+    fn evaluate(&self, q: &[f64], values: &mut [f64], jacobian: Option<&mut [f64]>) {
+        self.set
+            .evaluate(&mut self.ws.borrow_mut(), self.params, q, values, jacobian);
+        for (i, v) in values.iter_mut().enumerate() {
+            *v -= match self.set.kind(i) {
+                crate::geometry::ConstraintKind::Incidence => INCIDENCE_MARGIN,
+                _ => DISTANCE_MARGIN,
+            };
+        }
+    }
+}
+
+/// The constraint set of a cell for planning.
+pub fn constraint_set(cell: &Cell, collisions: bool) -> Result<ConstraintSet, Error> {
+    ConstraintSet::new(
+        cell,
+        &ConstraintOptions {
+            incidence: cell
+                .instrument
+                .as_ref()
+                .and_then(|i| i.max_incidence)
+                .is_some(),
+            collisions,
+            line_of_sight: collisions,
+            ..ConstraintOptions::default()
+        },
+    )
+}
+
+/// Plans `settings.poses` measurement configurations for `cell`, augmenting `measured`.
+pub fn plan(
+    cell: &Cell,
+    settings: &PlanSettings,
+    measured: &[Vec<f64>],
+) -> Result<PlanReport, Error> {
+    let t0 = Instant::now();
+    let d = DesignModel::from_cell(cell)?;
+    let set = constraint_set(cell, settings.collisions)?;
+    let params = d.params.clone();
+    let (pool, draws) = {
+        let cons = CellConstraints::new(&set, &params);
+        random_feasible(
+            &d.model,
+            settings.pool.max(settings.poses),
+            settings.seed,
+            settings.max_draws,
+            |q| cons.feasible(q),
+        )?
+    };
+    let objective = DesignObjective::new(&d, settings.criterion, measured);
+    let (lo, hi) = d.model.joint_limits();
+    let runs: Vec<Result<StartResult, Error>> = (0..settings.starts.max(1))
+        .into_par_iter()
+        .map(|s| {
+            let ex = exchange(
+                &d,
+                settings.criterion,
+                &pool,
+                &objective.prior_rows,
+                settings.poses,
+                &ExchangeSettings {
+                    seed: settings.seed.wrapping_add(s as u64 * 7919),
+                    ..ExchangeSettings::default()
+                },
+            )?;
+            let start: Vec<Vec<f64>> = ex.chosen.iter().map(|&i| pool[i].clone()).collect();
+            if settings.exchange_only {
+                return Ok(StartResult {
+                    design: start,
+                    value: ex.value,
+                    exchange_value: ex.value,
+                    sweeps: ex.sweeps,
+                    refine: None,
+                });
+            }
+            let cons = CellConstraints::new(&set, &params);
+            let obj = DesignObjective::new(&d, settings.criterion, measured);
+            let r = refine(
+                &obj,
+                &start,
+                &lo,
+                &hi,
+                (!set.is_empty()).then_some(&cons as &dyn ConfigurationConstraints),
+                &settings.refine,
+            )?;
+            // Only a design that violates nothing counts; otherwise keep the exchange design.
+            let ok = r.q.iter().all(|q| cons.feasible(q));
+            if ok && r.value <= ex.value {
+                Ok(StartResult {
+                    design: r.q,
+                    value: r.value,
+                    exchange_value: ex.value,
+                    sweeps: ex.sweeps,
+                    refine: Some((r.status, r.iterations)),
+                })
+            } else {
+                Ok(StartResult {
+                    design: start,
+                    value: ex.value,
+                    exchange_value: ex.value,
+                    sweeps: ex.sweeps,
+                    refine: Some((
+                        format!(
+                            "{} (refined design rejected: {})",
+                            r.status,
+                            if ok { "no better" } else { "infeasible" }
+                        ),
+                        r.iterations,
+                    )),
+                })
+            }
+        })
+        .collect();
+    let mut best: Option<StartResult> = None;
+    for r in runs {
+        let r = r?;
+        if best.as_ref().is_none_or(|b| r.value < b.value) {
+            best = Some(r);
+        }
+    }
+    let StartResult {
+        design,
+        value,
+        exchange_value,
+        sweeps,
+        refine: refine_info,
+    } = best.expect("at least one start");
+    let order = order_for_travel(&design);
+    let design: Vec<Vec<f64>> = order.iter().map(|&i| design[i].clone()).collect();
+    let cons = CellConstraints::new(&set, &params);
+    let feasible = design.iter().all(|q| cons.feasible(q));
+    let min_margin = cons.design_margin(&design);
+    let bound = if has_bound(settings.criterion) {
+        Some(optimality_bound(&objective, &design, &pool, 20, |q| {
+            cons.feasible(q)
+        })?)
+    } else {
+        None
+    };
+    Ok(PlanReport {
+        criterion: settings.criterion,
+        value,
+        design,
+        feasible,
+        min_margin,
+        constraints_per_pose: set.len(),
+        pool_draws: draws,
+        exchange_value,
+        exchange_sweeps: sweeps,
+        refine_status: refine_info.as_ref().map(|r| r.0.clone()),
+        refine_iterations: refine_info.map(|r| r.1).unwrap_or(0),
+        bound,
+        time: t0.elapsed(),
+    })
+}

@@ -1,0 +1,76 @@
+//! The planner end to end on the paper cell: feasible designs, the KPI design better than
+//! the heuristic and the C_p design, the bound below the design.
+
+use armcal::cell::Cell;
+use armcal::design::baselines::random_feasible;
+use armcal::design::plan::{constraint_set, plan, CellConstraints, PlanSettings};
+use armcal::design::{Criterion, DesignModel, DesignObjective};
+use std::path::Path;
+
+fn cell(name: &str) -> Cell {
+    Cell::from_file(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../examples")
+            .join(name),
+    )
+    .unwrap()
+}
+
+#[test]
+fn planner_beats_the_heuristic_with_and_without_collisions() {
+    for (file, collisions) in [
+        ("paper-cell.toml", false),
+        ("paper-cell-obstacles.toml", true),
+    ] {
+        let c = cell(file);
+        let d = DesignModel::from_cell(&c).unwrap();
+        let set = constraint_set(&c, collisions).unwrap();
+        let cons = CellConstraints::new(&set, &d.params);
+        let (heuristic, draws) =
+            random_feasible(&d.model, 60, 3, 2_000_000, |q| cons.feasible(q)).unwrap();
+        let kpi_obj = DesignObjective::new(&d, Criterion::Kpi, &[]);
+        let mut ws = kpi_obj.workspace(60);
+        let kpi_of = |qs: &[Vec<f64>], ws: &mut _| {
+            kpi_obj.value_and_gradient(ws, &qs.concat(), None).unwrap()
+        };
+        let h = kpi_of(&heuristic, &mut ws);
+        let settings = PlanSettings {
+            collisions,
+            ..PlanSettings::default()
+        };
+        let kpi = plan(&c, &settings, &[]).unwrap();
+        let a = plan(
+            &c,
+            &PlanSettings {
+                criterion: Criterion::A,
+                ..settings.clone()
+            },
+            &[],
+        )
+        .unwrap();
+        let a_kpi = kpi_of(&a.design, &mut ws);
+        eprintln!(
+            "{file}: {} constraints/pose, {:.1} % of draws feasible; (1/3) tr C_s heuristic {h:.4}, C_p-optimal {a_kpi:.4}, KPI {:.4} (exchange {:.4}, refine {:?}, {:.2} s); bound {:.4}, efficiency {:.3}; min margin {:?}",
+            kpi.constraints_per_pose,
+            100.0 * 60.0 / draws as f64,
+            kpi.value,
+            kpi.exchange_value,
+            kpi.refine_status,
+            kpi.time.as_secs_f64(),
+            kpi.bound.as_ref().unwrap().lower_bound,
+            kpi.bound.as_ref().unwrap().efficiency,
+            kpi.min_margin
+        );
+        assert!(kpi.feasible && a.feasible);
+        assert!(kpi.min_margin.as_ref().is_none_or(|m| m.value >= 0.0));
+        assert!(
+            kpi.value < 0.7 * h,
+            "KPI design at least 30 % better than the heuristic"
+        );
+        assert!(
+            kpi.value < 0.95 * a_kpi,
+            "KPI design better than the C_p design on the KPI"
+        );
+        assert!(kpi.bound.as_ref().unwrap().lower_bound <= kpi.value);
+    }
+}
