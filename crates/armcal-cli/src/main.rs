@@ -33,6 +33,8 @@ enum Command {
     Plan(commands::plan::PlanArgs),
     /// Predicted C_p, C_s, criteria and constraint margins of any design.
     Evaluate(commands::plan::EvaluateArgs),
+    /// Reproduce a source's experiment (`paper`: Jost et al. 2017, Tables 6–8).
+    Study(commands::study::Args),
 }
 
 fn main() {
@@ -46,6 +48,7 @@ fn main() {
         Command::Predict(a) => commands::predict::run(&a),
         Command::Plan(a) => commands::plan::run_plan(&a),
         Command::Evaluate(a) => commands::plan::run_evaluate(&a),
+        Command::Study(a) => commands::study::run_study(&a),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

@@ -15,5 +15,6 @@ pub mod measure;
 pub mod model;
 pub mod robots;
 pub mod sim;
+pub mod study;
 
 pub use error::{Error, Result};

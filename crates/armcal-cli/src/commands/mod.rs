@@ -8,3 +8,4 @@ pub mod plan;
 pub mod predict;
 pub mod robots;
 pub mod simulate;
+pub mod study;

@@ -41,24 +41,24 @@ pub fn notional(lambda: f64, mu: f64) -> Robot {
     // Capsules (not published; armcal's choice for a KUKA-like arm of this size, kept the same
     // for the whole study). Coordinates in the frame at the end of the named link, mm.
     //
-    // Which way is up: frame 0 is at shoulder height with x forward and **z pointing down**
-    // (up = −z0), as in the KUKA models (`kuka.rs`). The joint variables are KUKA axis angles:
-    // the Table 4 ranges are subsets of KUKA's datasheet ranges with KUKA's signs (q2 ≤ 31°
-    // against A2 ≤ 35°, q3 ≤ 154° = A3 max), and with this DH a positive q2 turns the upper
-    // arm towards +z0. So at q2 = −90° the upper arm points along −z0, and KUKA HOME
-    // (0, −90°, 90°, 0, 0, 0) is the upright arm with a horizontal forearm only if −z0 is up.
-    // At the lower limit q2 = −77° the upper arm leans 13° forward of upright (it never leans
-    // back towards the wall 450 mm behind the robot) and at q2 = 31° it points 31° below the
-    // horizontal: a floor-standing robot's working range. Read with z0 up the robot could
-    // never lift its upper arm more than 31° above the horizontal and would hang from its
-    // mount. (See `examples/paper-cell-obstacles.toml` for the consequences in the cell.)
+    // Orientation: frame 0 is at shoulder height, x forward, and its z axis points from the
+    // shoulder towards the robot's mounting flange, as in the KUKA models (`kuka.rs`). The
+    // joint variables are KUKA axis angles: the Table 4 ranges are subsets of KUKA's datasheet
+    // ranges with KUKA's signs (q2 ≤ 31° against A2 ≤ 35°, q3 ≤ 154° = A3 max), and with this
+    // DH a positive q2 turns the upper arm towards +z0. KUKA's A2 = −90° (HOME
+    // (0, −90°, 90°, 0, 0, 0): upper arm straight out of the base, forearm at right angles)
+    // then points the upper arm along −z0, away from the mount, and the mount is on the +z0
+    // side: the base column below runs from the shoulder towards +z0. At the lower limit
+    // q2 = −77° the upper arm leans 13° forward of −z0 and at q2 = 31° it points 31° from the
+    // x axis towards the mount: a KUKA's usual working range. Which way is up in the world is
+    // the cell's business: the paper cell (`examples/paper-cell-obstacles.toml`) hangs the
+    // robot, z0 up, from the object it is mounted on.
     let capsules = vec![
-        // Pedestal: the robot's base and rotating column and the "long object" the robot is
-        // mounted on (paper §3.2), one vertical capsule from the floor of the paper cell
-        // (z0 = +2400 mm, 2.4 m below the shoulder, see the cell file) up to z0 = +300, where
-        // its cap clears the upper-arm capsule at the axis-2 point (350, 0, 0) by
-        // √(350² + 300²) − 300 − 140 = 21 mm for every q1 (KUKA models: 20 mm).
-        capsule("base", [0.0, 0.0, 2400.0], [0.0, 0.0, 300.0], 300.0),
+        // Base and rotating column: from z0 = +300, where the cap clears the upper-arm capsule
+        // at the axis-2 point (350, 0, 0) by √(350² + 300²) − 300 − 140 = 21 mm for every q1
+        // (KUKA models: 20 mm), to the mounting flange at z0 = +700 (base height of a KR 15
+        // class arm, 675 mm for the KR 15/2; the paper does not publish one).
+        capsule("base", [0.0, 0.0, 700.0], [0.0, 0.0, 300.0], 300.0),
         // shoulder: from the axis-1 line to the axis-2 origin (x1 points along a1)
         capsule("j1", [-350.0, 0.0, 0.0], [0.0, 0.0, 0.0], 220.0),
         // upper arm along x2, length λ

@@ -1,0 +1,3 @@
+//! Reproductions of the sources' experiments.
+
+pub mod paper;
