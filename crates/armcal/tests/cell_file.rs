@@ -158,3 +158,32 @@ fn working_pose_outside_limits_is_kept_with_a_warning() {
         cell.warnings[0]
     );
 }
+
+#[test]
+fn a_cell_can_use_a_urdf_robot() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("urdf-cell");
+    std::fs::create_dir_all(&dir).unwrap();
+    // The paper robot exported to URDF, then used by a cell next to it.
+    let paper = armcal::robots::robot("paper").unwrap();
+    std::fs::write(
+        dir.join("arm.urdf"),
+        armcal::model::urdf::to_urdf(&paper.spec).unwrap(),
+    )
+    .unwrap();
+    let text =
+        "[robot]\nurdf = \"arm.urdf\"\n\n[[targets]]\nname = \"smr1\"\nxyz_mm = [0, 0, 100]\n";
+    std::fs::write(dir.join("cell.toml"), text).unwrap();
+    let cell = Cell::from_file(&dir.join("cell.toml")).unwrap();
+    assert_eq!(cell.model.dof(), 6);
+    assert!(
+        (cell.model.joints[1].upper - 31f64.to_radians()).abs() < 1e-12,
+        "limits kept"
+    );
+    let e = Cell::from_toml("[robot]\nurdf = \"missing.urdf\"\n", "c.toml", &dir)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("robot.urdf") && e.contains("missing.urdf"),
+        "{e}"
+    );
+}
