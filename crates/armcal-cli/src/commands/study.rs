@@ -62,7 +62,15 @@ pub fn run_study(a: &Args) -> anyhow::Result<()> {
             .expect("valid template"),
     );
     let t0 = std::time::Instant::now();
-    let rows = run(&robots, &settings, &|| bar.inc(1))?;
+    let all = run(&robots, &settings, &|| bar.inc(1));
+    for r in all.iter().filter(|r| r.error.is_some()) {
+        println!(
+            "{}: no result: {}",
+            r.robot,
+            r.error.as_deref().unwrap_or("")
+        );
+    }
+    let rows: Vec<StudyRow> = all.iter().filter(|r| r.error.is_none()).cloned().collect();
     bar.finish_and_clear();
     let secs = t0.elapsed().as_secs_f64();
     let col = if collisions { "with" } else { "without" };

@@ -75,7 +75,13 @@ fn build(k: Kr) -> Robot {
     capsules.extend(dh_capsules("j1", 0.0, k.a1, d(90.0), r_sh));
     capsules.extend(dh_capsules("j2", 0.0, k.a2, 0.0, r_ua));
     capsules.extend(dh_capsules("j3", 0.0, k.a3, d(90.0), r_el));
-    capsules.extend(dh_capsules("j4", -k.d4, 0.0, d(-90.0), r_fa));
+    // Forearm along −z3 = +y4 in the wrist frame: it starts clear of the upper-arm capsule
+    // (which ends at the elbow axis, a3 away) and ends clear of the wrist, so that only real
+    // contacts count (a capsule chain that overlaps at every configuration would make every
+    // pose infeasible).
+    let start = k.d4 - (r_ua + r_fa + 10.0);
+    let end = r_fa + 50.0;
+    capsules.push(capsule("j4", [0.0, start, 0.0], [0.0, end, 0.0], r_fa));
     capsules.extend(dh_capsules("j6", -k.d6, 0.0, d(180.0), r_wr));
     Robot {
         name: k.name.into(),

@@ -46,6 +46,8 @@ pub struct StudyRow {
     pub gain_vs_cp: f64,
     pub feasible: bool,
     pub seconds: f64,
+    /// Why this robot has no result (e.g. no feasible configuration in the cell).
+    pub error: Option<String>,
 }
 
 /// Settings of the study.
@@ -134,6 +136,7 @@ pub fn run_robot(robot: &str, s: &StudySettings) -> Result<StudyRow, Error> {
         gain_vs_cp: 1.0 - c.value / a_kpi,
         feasible: a.feasible && c.feasible,
         seconds: t0.elapsed().as_secs_f64(),
+        error: None,
     })
 }
 
