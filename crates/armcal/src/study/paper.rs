@@ -140,16 +140,25 @@ pub fn run_robot(robot: &str, s: &StudySettings) -> Result<StudyRow, Error> {
     })
 }
 
-/// Runs a list of robots in parallel; `progress` is called after each robot.
-pub fn run(
-    robots: &[String],
-    s: &StudySettings,
-    progress: &(dyn Fn() + Sync),
-) -> Result<Vec<StudyRow>, Error> {
+/// Runs a list of robots in parallel; `progress` is called after each robot. A robot that
+/// fails (e.g. no feasible configuration) gets a row with its error instead of stopping
+/// the study.
+pub fn run(robots: &[String], s: &StudySettings, progress: &(dyn Fn() + Sync)) -> Vec<StudyRow> {
     robots
         .par_iter()
         .map(|r| {
-            let row = run_robot(r, s);
+            let row = run_robot(r, s).unwrap_or_else(|e| StudyRow {
+                robot: r.clone(),
+                collisions: s.collisions,
+                heuristic: f64::NAN,
+                cp_optimal: f64::NAN,
+                cs_optimal: f64::NAN,
+                gain_vs_heuristic: f64::NAN,
+                gain_vs_cp: f64::NAN,
+                feasible: false,
+                seconds: 0.0,
+                error: Some(e.to_string()),
+            });
             progress();
             row
         })
