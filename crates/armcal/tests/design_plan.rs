@@ -74,3 +74,25 @@ fn planner_beats_the_heuristic_with_and_without_collisions() {
         assert!(kpi.bound.as_ref().unwrap().lower_bound <= kpi.value);
     }
 }
+
+#[test]
+fn an_obstacle_over_the_tracker_gives_a_clear_report_and_the_best_design() {
+    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-cell-obstacles.toml")).unwrap()
+        + "\n[[obstacles]]\nname = \"crate-over-tracker\"\nkind = \"capsule\"\na_mm = [2730.88, 4554.68, 1200]\nb_mm = [2730.88, 4554.68, 1600]\nradius_mm = 600\n";
+    let c = Cell::from_toml(&text, "blocked.toml", Path::new(".")).unwrap();
+    let rep = plan(
+        &c,
+        &PlanSettings {
+            poses: 10,
+            max_draws: 20_000,
+            ..PlanSettings::default()
+        },
+        &[],
+    )
+    .unwrap();
+    assert!(!rep.feasible);
+    assert_eq!(rep.design.len(), 10);
+    assert_eq!(rep.blocking[0].0, "beam / crate-over-tracker");
+    assert!(rep.blocking[0].1 > 0.99);
+    assert!(rep.min_margin.unwrap().value < 0.0);
+}

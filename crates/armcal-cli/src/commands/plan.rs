@@ -172,6 +172,13 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         report_path.display()
     );
     if !rep.feasible {
+        if !rep.blocking.is_empty() {
+            println!("no feasible configurations could be drawn; the constraints that block random configurations:");
+            for (name, share) in rep.blocking.iter().take(8) {
+                println!("  {name:<28} rejects {:.1} % of draws", 100.0 * share);
+            }
+            println!("the design written is the best found (largest smallest margin), and it is NOT feasible");
+        }
         bail!("the design violates constraints; see the report");
     }
     Ok(())

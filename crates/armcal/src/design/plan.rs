@@ -79,7 +79,74 @@ pub struct PlanReport {
     pub refine_status: Option<String>,
     pub refine_iterations: usize,
     pub bound: Option<OptimalityBound>,
+    /// When no feasible pool could be drawn: each constraint that blocks random
+    /// configurations, with the fraction of draws (within the joint limits) it rejects.
+    pub blocking: Vec<(String, f64)>,
     pub time: Duration,
+}
+
+/// The report when the cell's constraints leave (almost) no feasible configuration: which
+/// constraints block the draws, and the best design found — the `poses` draws with the
+/// largest smallest margin — marked infeasible.
+fn infeasible_report(
+    d: &DesignModel,
+    set: &ConstraintSet,
+    settings: &PlanSettings,
+    t0: Instant,
+) -> PlanReport {
+    let draws = 20_000;
+    let qs = crate::model::identifiability::random_configurations(&d.model, draws, settings.seed);
+    let mut ws = set.workspace();
+    let mut values = vec![0.0; set.len()];
+    let mut counts = vec![0usize; set.len()];
+    let mut scored: Vec<(f64, usize)> = Vec::with_capacity(draws);
+    for (k, q) in qs.iter().enumerate() {
+        set.evaluate(&mut ws, &d.params, q, &mut values, None);
+        let mut worst = f64::INFINITY;
+        for (i, v) in values.iter().enumerate() {
+            if *v < 0.0 {
+                counts[i] += 1;
+            }
+            worst = worst.min(*v);
+        }
+        scored.push((worst, k));
+    }
+    let mut blocking: Vec<(String, f64)> = counts
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| **c > 0)
+        .map(|(i, c)| (set.name(i).to_string(), *c as f64 / draws as f64))
+        .collect();
+    blocking.sort_by(|a, b| b.1.total_cmp(&a.1));
+    scored.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let design: Vec<Vec<f64>> = scored
+        .iter()
+        .take(settings.poses)
+        .map(|(_, k)| qs[*k].clone())
+        .collect();
+    let objective = DesignObjective::new(d, settings.criterion, &[]);
+    let mut ows = objective.workspace(design.len());
+    let value = objective
+        .value_and_gradient(&mut ows, &design.concat(), None)
+        .unwrap_or(f64::NAN);
+    let params = d.params.clone();
+    let cons = CellConstraints::new(set, &params);
+    PlanReport {
+        criterion: settings.criterion,
+        value,
+        min_margin: cons.design_margin(&design),
+        design,
+        feasible: false,
+        constraints_per_pose: set.len(),
+        pool_draws: draws,
+        exchange_value: f64::NAN,
+        exchange_sweeps: 0,
+        refine_status: None,
+        refine_iterations: 0,
+        bound: None,
+        blocking,
+        time: t0.elapsed(),
+    }
 }
 
 /// One start of the planner: design, value, exchange value, exchange sweeps, and the
@@ -184,13 +251,16 @@ pub fn plan(
     let params = d.params.clone();
     let (pool, draws) = {
         let cons = CellConstraints::new(&set, &params);
-        random_feasible(
+        match random_feasible(
             &d.model,
             settings.pool.max(settings.poses),
             settings.seed,
             settings.max_draws,
             |q| cons.feasible(q),
-        )?
+        ) {
+            Ok(p) => p,
+            Err(_) => return Ok(infeasible_report(&d, &set, settings, t0)),
+        }
     };
     let objective = DesignObjective::new(&d, settings.criterion, measured);
     let (lo, hi) = d.model.joint_limits();
@@ -295,6 +365,7 @@ pub fn plan(
         refine_status: refine_info.as_ref().map(|r| r.0.clone()),
         refine_iterations: refine_info.map(|r| r.1).unwrap_or(0),
         bound,
+        blocking: Vec::new(),
         time: t0.elapsed(),
     })
 }
