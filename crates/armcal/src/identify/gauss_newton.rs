@@ -3,9 +3,9 @@
 //! Undamped; it must reach the same estimate as Levenberg–Marquardt (book: "identical").
 
 use super::problem::Problem;
-use super::solver::{gradient_cosine, Observer, Solution, Status, Tolerances};
+use super::solver::{gradient_cosine, Iterate, Observer, Solution, Status, Tolerances};
 use crate::Error;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 use std::time::Instant;
 
 pub fn gauss_newton(
@@ -15,13 +15,9 @@ pub fn gauss_newton(
     observer: &mut dyn Observer,
 ) -> Result<Solution, Error> {
     let t0 = Instant::now();
-    let (m, n) = (problem.rows(), problem.columns());
-    let mut ws = problem.workspace();
-    let mut params = start.to_vec();
-    let mut r = DVector::zeros(m);
-    let mut j = DMatrix::zeros(m, n);
-    problem.evaluate(&mut ws, &params, &mut r, Some(&mut j));
-    let mut cost = 0.5 * r.norm_squared();
+    let n = problem.columns();
+    let mut it = Iterate::start(problem, start)?;
+    let mut cost = it.cost();
     let mut history = vec![cost];
     let mut status = Status::MaxIterations;
     let mut iterations = 0;
@@ -32,7 +28,7 @@ pub fn gauss_newton(
             };
             break;
         }
-        if gradient_cosine(&j, &r) <= tol.gtol {
+        if gradient_cosine(&it.j, &it.r) <= tol.gtol {
             status = Status::Converged {
                 criterion: format!("gradient (cosine ≤ {:e})", tol.gtol),
             };
@@ -41,20 +37,20 @@ pub fn gauss_newton(
         iterations += 1;
         // Column scaling so that mm and rad columns compare; then a rank-revealing solve.
         let scale: DVector<f64> =
-            DVector::from_iterator(n, (0..n).map(|c| j.column(c).norm().max(1e-300)));
-        let mut js = j.clone();
+            DVector::from_iterator(n, (0..n).map(|c| it.j.column(c).norm().max(1e-300)));
+        let mut js = it.j.clone();
         for c in 0..n {
             js.column_mut(c).unscale_mut(scale[c]);
         }
         let svd = js.svd(true, true);
         let step_scaled = svd
-            .solve(&(-&r), 1e-12)
+            .solve(&(-&it.r), 1e-12)
             .map_err(|e| Error::Input(format!("Gauss–Newton step: {e}")))?;
         let step = step_scaled.component_div(&scale);
-        let x = problem.free_values(&params);
-        problem.set_free(&mut params, &(&x + &step));
-        problem.evaluate(&mut ws, &params, &mut r, Some(&mut j));
-        let new_cost = 0.5 * r.norm_squared();
+        let x = problem.free_values(&it.params);
+        problem.set_free(&mut it.params, &(&x + &step));
+        it.update(problem);
+        let new_cost = it.cost();
         observer.iteration(iterations, new_cost, 0.0);
         history.push(new_cost);
         if !new_cost.is_finite() || new_cost > 1e6 * cost.max(1.0) {
@@ -81,13 +77,5 @@ pub fn gauss_newton(
             break;
         }
     }
-    Ok(Solution {
-        params,
-        status,
-        iterations,
-        history,
-        time: t0.elapsed(),
-        residual: r,
-        jacobian: j,
-    })
+    Ok(it.into_solution(status, iterations, history, t0))
 }

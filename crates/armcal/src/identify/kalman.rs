@@ -9,7 +9,7 @@
 //! its final `P` is the covariance `(JᵀJ + P₀⁻¹)⁻¹ ≈ C_p`.
 
 use super::problem::Problem;
-use super::solver::{Observer, Solution, Status, Tolerances};
+use super::solver::{Iterate, Observer, Solution, Status, Tolerances};
 use crate::model::Unit;
 use crate::Error;
 use nalgebra::{DMatrix, DVector};
@@ -51,12 +51,8 @@ pub fn kalman_filter(
 ) -> Result<KalmanSolution, Error> {
     let t0 = Instant::now();
     let (m, n) = (problem.rows(), problem.columns());
-    let mut ws = problem.workspace();
-    let mut params = start.to_vec();
-    let mut r = DVector::zeros(m);
-    let mut j = DMatrix::zeros(m, n);
-    problem.evaluate(&mut ws, &params, &mut r, Some(&mut j));
-    let mut history = vec![0.5 * r.norm_squared()];
+    let mut it = Iterate::start(problem, start)?;
+    let mut history = vec![it.cost()];
     let p0 = DMatrix::from_diagonal(&DVector::from_iterator(
         n,
         problem
@@ -85,8 +81,8 @@ pub fn kalman_filter(
         let mut delta = DVector::zeros(n);
         p.copy_from(&p0);
         for &(row, k) in &blocks {
-            let ji = j.rows(row, k);
-            let innovation = -(r.rows(row, k) + ji * &delta);
+            let ji = it.j.rows(row, k);
+            let innovation = -(it.r.rows(row, k) + ji * &delta);
             let pjt = &p * ji.transpose();
             let s = ji * &pjt + DMatrix::identity(k, k);
             let s_inv = s
@@ -97,10 +93,10 @@ pub fn kalman_filter(
             let a = &identity_n - &gain * ji;
             p = &a * &p * a.transpose() + &gain * gain.transpose();
         }
-        let x = problem.free_values(&params);
-        problem.set_free(&mut params, &(&x + &delta));
-        problem.evaluate(&mut ws, &params, &mut r, Some(&mut j));
-        let cost = 0.5 * r.norm_squared();
+        let x = problem.free_values(&it.params);
+        problem.set_free(&mut it.params, &(&x + &delta));
+        it.update(problem);
+        let cost = it.cost();
         history.push(cost);
         observer.iteration(iterations, cost, 0.0);
         if !cost.is_finite() {
@@ -128,15 +124,7 @@ pub fn kalman_filter(
         }
     }
     Ok(KalmanSolution {
-        solution: Solution {
-            params,
-            status,
-            iterations,
-            history,
-            time: t0.elapsed(),
-            residual: r,
-            jacobian: j,
-        },
+        solution: it.into_solution(status, iterations, history, t0),
         covariance: p,
     })
 }

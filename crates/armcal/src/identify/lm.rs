@@ -7,9 +7,9 @@
 //! explicit criteria and an observer, which are a few lines here.
 
 use super::problem::Problem;
-use super::solver::{gradient_cosine, Observer, Solution, Status, Tolerances};
+use super::solver::{gradient_cosine, Iterate, Observer, Solution, Status, Tolerances};
 use crate::Error;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 use std::time::Instant;
 
 /// Settings of [`levenberg_marquardt`].
@@ -42,20 +42,11 @@ pub fn levenberg_marquardt(
 ) -> Result<Solution, Error> {
     let t0 = Instant::now();
     let (m, n) = (problem.rows(), problem.columns());
-    let mut ws = problem.workspace();
-    let mut params = start.to_vec();
-    let mut r = DVector::zeros(m);
-    let mut j = DMatrix::zeros(m, n);
-    problem.evaluate(&mut ws, &params, &mut r, Some(&mut j));
-    let mut cost = 0.5 * r.norm_squared();
-    if !cost.is_finite() {
-        return Err(Error::Input(
-            "the residual at the starting parameters is not finite".into(),
-        ));
-    }
+    let mut it = Iterate::start(problem, start)?;
+    let mut cost = it.cost();
     let mut history = vec![cost];
     let mut mu = settings.mu0;
-    let mut trial_params = params.clone();
+    let mut trial_params = it.params.clone();
     let mut r_trial = DVector::zeros(m);
     let tol = &settings.tolerances;
     let mut status = Status::MaxIterations;
@@ -68,16 +59,16 @@ pub fn levenberg_marquardt(
             };
             break;
         }
-        let g = j.tr_mul(&r);
-        if gradient_cosine(&j, &r) <= tol.gtol {
+        let g = it.j.tr_mul(&it.r);
+        if gradient_cosine(&it.j, &it.r) <= tol.gtol {
             status = Status::Converged {
                 criterion: format!("gradient (cosine ≤ {:e})", tol.gtol),
             };
             break;
         }
-        let a = j.tr_mul(&j);
+        let a = it.j.tr_mul(&it.j);
         let d: DVector<f64> = a.diagonal().map(|x| x.max(1e-300));
-        let x = problem.free_values(&params);
+        let x = problem.free_values(&it.params);
         let mut accepted = false;
         // Inner loop: raise μ until the step reduces the cost.
         for _ in 0..60 {
@@ -94,19 +85,19 @@ pub fn levenberg_marquardt(
             };
             let x_new = &x + &step;
             problem.set_free(&mut trial_params, &x_new);
-            problem.evaluate(&mut ws, &trial_params, &mut r_trial, None);
+            problem.evaluate(&mut it.ws, &trial_params, &mut r_trial, None);
             let cost_new = 0.5 * r_trial.norm_squared();
             // Predicted reduction of the linear model.
-            let jstep = &j * &step;
+            let jstep = &it.j * &step;
             let predicted = -(g.dot(&step) + 0.5 * jstep.norm_squared());
             observer.iteration(iterations, cost_new, mu);
             if cost_new.is_finite() && cost_new < cost {
                 let scaled_step = step.zip_map(&d, |s, dk| s * dk.sqrt()).norm();
                 let scaled_x = x.zip_map(&d, |xk, dk| xk * dk.sqrt()).norm();
                 let actual = cost - cost_new;
-                params.clone_from(&trial_params);
-                problem.evaluate(&mut ws, &params, &mut r, Some(&mut j));
-                cost = 0.5 * r.norm_squared();
+                it.params.clone_from(&trial_params);
+                it.update(problem);
+                cost = it.cost();
                 history.push(cost);
                 mu = (mu / settings.factor).max(1e-15);
                 accepted = true;
@@ -130,7 +121,7 @@ pub fn levenberg_marquardt(
         }
         if !accepted {
             // No step reduces the cost: at a minimum to machine precision, or stuck.
-            status = if gradient_cosine(&j, &r) < 1e-6 {
+            status = if gradient_cosine(&it.j, &it.r) < 1e-6 {
                 Status::Converged {
                     criterion: "no further decrease possible (at machine precision)".into(),
                 }
@@ -147,13 +138,5 @@ pub fn levenberg_marquardt(
             break;
         }
     }
-    Ok(Solution {
-        params,
-        status,
-        iterations,
-        history,
-        time: t0.elapsed(),
-        residual: r,
-        jacobian: j,
-    })
+    Ok(it.into_solution(status, iterations, history, t0))
 }

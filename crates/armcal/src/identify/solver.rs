@@ -105,3 +105,59 @@ pub(crate) fn gradient_cosine(j: &DMatrix<f64>, r: &DVector<f64>) -> f64 {
         })
         .fold(0.0, f64::max)
 }
+
+/// The state every iterative solver carries: workspace, full parameter vector, whitened
+/// residual and Jacobian at those parameters.
+pub(crate) struct Iterate {
+    pub ws: super::problem::Workspace,
+    pub params: Vec<f64>,
+    pub r: DVector<f64>,
+    pub j: DMatrix<f64>,
+}
+
+impl Iterate {
+    /// Evaluates the problem at `start`; a non-finite residual is an error.
+    pub fn start(problem: &super::Problem, start: &[f64]) -> Result<Iterate, crate::Error> {
+        let mut it = Iterate {
+            ws: problem.workspace(),
+            params: start.to_vec(),
+            r: DVector::zeros(problem.rows()),
+            j: DMatrix::zeros(problem.rows(), problem.columns()),
+        };
+        it.update(problem);
+        if !it.cost().is_finite() {
+            return Err(crate::Error::Input(
+                "the residual at the starting parameters is not finite".into(),
+            ));
+        }
+        Ok(it)
+    }
+
+    /// Re-evaluates residual and Jacobian at `self.params`.
+    pub fn update(&mut self, problem: &super::Problem) {
+        problem.evaluate(&mut self.ws, &self.params, &mut self.r, Some(&mut self.j));
+    }
+
+    /// ½‖r‖².
+    pub fn cost(&self) -> f64 {
+        0.5 * self.r.norm_squared()
+    }
+
+    pub fn into_solution(
+        self,
+        status: Status,
+        iterations: usize,
+        history: Vec<f64>,
+        t0: std::time::Instant,
+    ) -> Solution {
+        Solution {
+            params: self.params,
+            status,
+            iterations,
+            history,
+            time: t0.elapsed(),
+            residual: self.r,
+            jacobian: self.j,
+        }
+    }
+}
