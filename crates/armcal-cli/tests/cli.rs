@@ -1,19 +1,7 @@
 //! The `armcal` binary end to end.
 
-use std::process::Command;
-
-fn armcal(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_armcal"))
-        .args(args)
-        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
-        .output()
-        .expect("run armcal");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+mod common;
+use common::armcal;
 
 #[test]
 fn model_of_the_paper_cell_reports_27_identifiable_parameters_with_reasons() {

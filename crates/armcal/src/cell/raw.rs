@@ -97,76 +97,74 @@ impl Ctx<'_> {
     }
 }
 
-/// A value with a unit suffix from a table: `<key>_mm` / `<key>_m` for lengths,
-/// `<key>_deg` / `<key>_rad` for angles, `<key>` for dimensionless. Returns internal units.
+/// The field `<key><suffix>` of a table with the suffixes a unit allows (`_mm` / `_m` for
+/// lengths, `_deg` / `_rad` for angles, none for dimensionless), its value and the factor to
+/// internal units. Giving the same key with two units is an error.
+fn find_with_unit<'t>(
+    t: &'t toml::Table,
+    key: &str,
+    unit: Unit,
+    used: &mut Vec<String>,
+) -> Result<Option<(String, &'t toml::Value, f64)>, String> {
+    let options: &[(&str, f64)] = match unit {
+        Unit::Mm => &[("_mm", 1.0), ("_m", 1000.0)],
+        Unit::Rad => &[("_deg", std::f64::consts::PI / 180.0), ("_rad", 1.0)],
+        Unit::Unitless => &[("", 1.0)],
+    };
+    let mut found = None;
+    for (suffix, factor) in options {
+        let k = format!("{key}{suffix}");
+        if let Some(v) = t.get(&k) {
+            if found.is_some() {
+                return Err(format!("`{key}` is given twice with different units"));
+            }
+            used.push(k.clone());
+            found = Some((k, v, *factor));
+        }
+    }
+    Ok(found)
+}
+
+fn number(v: &toml::Value) -> Option<f64> {
+    v.as_float()
+        .or_else(|| v.as_integer().map(|i| i as f64))
+        .filter(|x| x.is_finite())
+}
+
+/// A number with a unit suffix (see [`find_with_unit`]), in internal units.
 fn unit_value(
     t: &toml::Table,
     key: &str,
     unit: Unit,
     used: &mut Vec<String>,
 ) -> Result<Option<f64>, String> {
-    let options: &[(&str, f64)] = match unit {
-        Unit::Mm => &[("_mm", 1.0), ("_m", 1000.0)],
-        Unit::Rad => &[("_deg", std::f64::consts::PI / 180.0), ("_rad", 1.0)],
-        Unit::Unitless => &[("", 1.0)],
-    };
-    let mut found = None;
-    for (suffix, factor) in options {
-        let k = format!("{key}{suffix}");
-        if let Some(v) = t.get(&k) {
-            let x = v
-                .as_float()
-                .or_else(|| v.as_integer().map(|i| i as f64))
-                .ok_or_else(|| format!("`{k}` must be a number"))?;
-            if !x.is_finite() {
-                return Err(format!("`{k}` must be finite"));
-            }
-            if found.is_some() {
-                return Err(format!("`{key}` is given twice with different units"));
-            }
-            used.push(k);
-            found = Some(x * factor);
-        }
+    match find_with_unit(t, key, unit, used)? {
+        None => Ok(None),
+        Some((k, v, f)) => number(v)
+            .map(|x| Some(x * f))
+            .ok_or_else(|| format!("`{k}` must be a finite number")),
     }
-    Ok(found)
 }
 
+/// Three numbers with a unit suffix (see [`find_with_unit`]), in internal units.
 fn unit_triple(
     t: &toml::Table,
     key: &str,
     unit: Unit,
     used: &mut Vec<String>,
 ) -> Result<Option<[f64; 3]>, String> {
-    let options: &[(&str, f64)] = match unit {
-        Unit::Mm => &[("_mm", 1.0), ("_m", 1000.0)],
-        Unit::Rad => &[("_deg", std::f64::consts::PI / 180.0), ("_rad", 1.0)],
-        Unit::Unitless => &[("", 1.0)],
-    };
-    let mut found = None;
-    for (suffix, factor) in options {
-        let k = format!("{key}{suffix}");
-        if let Some(v) = t.get(&k) {
-            let arr = v
-                .as_array()
-                .filter(|a| a.len() == 3)
-                .ok_or_else(|| format!("`{k}` must be an array of 3 numbers"))?;
+    match find_with_unit(t, key, unit, used)? {
+        None => Ok(None),
+        Some((k, v, f)) => {
+            let bad = || format!("`{k}` must be an array of 3 finite numbers");
+            let arr = v.as_array().filter(|a| a.len() == 3).ok_or_else(bad)?;
             let mut out = [0.0; 3];
             for (o, x) in out.iter_mut().zip(arr) {
-                *o = x
-                    .as_float()
-                    .or_else(|| x.as_integer().map(|i| i as f64))
-                    .filter(|x| x.is_finite())
-                    .ok_or_else(|| format!("`{k}` must be an array of 3 finite numbers"))?
-                    * factor;
+                *o = number(x).ok_or_else(bad)? * f;
             }
-            if found.is_some() {
-                return Err(format!("`{key}` is given twice with different units"));
-            }
-            used.push(k);
-            found = Some(out);
+            Ok(Some(out))
         }
     }
-    Ok(found)
 }
 
 fn check_unused(t: &toml::Table, used: &[String], allowed: &[&str]) -> Result<(), String> {
@@ -247,11 +245,7 @@ fn inline_link(t: &toml::Table, index: usize) -> Result<LinkSpec, String> {
     if let Some(a) = t.get("axis") {
         let arr: Vec<f64> = a
             .as_array()
-            .map(|v| {
-                v.iter()
-                    .filter_map(|x| x.as_float().or_else(|| x.as_integer().map(|i| i as f64)))
-                    .collect()
-            })
+            .map(|v| v.iter().filter_map(number).collect())
             .unwrap_or_default();
         if arr.len() != 3 || arr.iter().all(|x| *x == 0.0) {
             return Err("`axis` must be a non-zero array of 3 numbers".into());
@@ -272,11 +266,7 @@ fn inline_link(t: &toml::Table, index: usize) -> Result<LinkSpec, String> {
                 JointKind::Revolute => std::f64::consts::PI / 180.0,
                 JointKind::Prismatic => 1.0,
             };
-            let num = |v: &toml::Value| {
-                v.as_float()
-                    .or_else(|| v.as_integer().map(|i| i as f64))
-                    .ok_or("`limits` must hold numbers")
-            };
+            let num = |v: &toml::Value| number(v).ok_or("`limits` must hold finite numbers");
             let jname = string_field(t, "joint_name")?
                 .map(str::to_string)
                 .unwrap_or_else(|| format!("q{index}"));
@@ -398,7 +388,7 @@ fn noise(t: &toml::Table) -> Result<NoiseModel, String> {
             let a = unit_value(t, "a", Unit::Mm, &mut used)?.ok_or("missing `a_mm`")?;
             let b = t
                 .get("b_um_per_m")
-                .and_then(|v| v.as_float().or_else(|| v.as_integer().map(|i| i as f64)))
+                .and_then(number)
                 .ok_or("missing `b_um_per_m` (µm per metre of range)")?;
             used.push("b_um_per_m".into());
             if a <= 0.0 || b < 0.0 {
@@ -725,10 +715,7 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
             .iter()
             .zip(&model.joints)
             .map(|(v, j)| {
-                let x = v
-                    .as_float()
-                    .or_else(|| v.as_integer().map(|i| i as f64))
-                    .unwrap_or(f64::NAN);
+                let x = number(v).unwrap_or(f64::NAN);
                 if j.kind == JointKind::Prismatic {
                     x
                 } else {
@@ -762,11 +749,7 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
         }
         let weight = t
             .get("weight")
-            .map(|v| {
-                v.as_float()
-                    .or_else(|| v.as_integer().map(|i| i as f64))
-                    .unwrap_or(f64::NAN)
-            })
+            .map(|v| number(v).unwrap_or(f64::NAN))
             .unwrap_or(1.0);
         if !(weight > 0.0 && weight.is_finite()) {
             return Err(ctx.err(
