@@ -6,7 +6,7 @@ use armcal::cell::Cell;
 use armcal::identify::*;
 use armcal::model::identifiability::random_configurations;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
-use nalgebra::{DVector, Matrix3, Vector3};
+use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
 use std::path::Path;
 
@@ -64,19 +64,7 @@ fn gauss_newton_kalman_and_lm_agree_on_noisy_data() {
     let (_, gn) = run(Method::GaussNewton);
     let (_, kf) = run(Method::Kalman);
     let problem = Problem::new(model, &data, &noise).unwrap();
-    let sol_sigma = {
-        let mut ws = problem.workspace();
-        let mut r = DVector::zeros(problem.rows());
-        let mut j = nalgebra::DMatrix::zeros(problem.rows(), problem.columns());
-        problem.evaluate(&mut ws, &lm, &mut r, Some(&mut j));
-        let names: Vec<String> = free
-            .iter()
-            .map(|&i| model.registry.get(i).name.clone())
-            .collect();
-        uncertainty::parameter_uncertainty(&j, &r, &names)
-            .unwrap()
-            .sigma
-    };
+    let sol_sigma = problem.uncertainty_at(&lm).unwrap().sigma;
     for (c, &i) in free.iter().enumerate() {
         // Agreement to a tiny fraction of the parameter's standard deviation.
         assert!(
@@ -101,18 +89,8 @@ fn constrained_tcp_covariance_equals_propagated_covariance() {
     let data = simulate(model, &model.nominal(), &qs, None, 0).unwrap();
     let noise = cell.instrument.as_ref().unwrap().noise.clone();
     let problem = Problem::new(model, &data, &noise).unwrap();
-    let mut ws = problem.workspace();
-    let mut r = DVector::zeros(problem.rows());
-    let mut j = nalgebra::DMatrix::zeros(problem.rows(), problem.columns());
-    problem.evaluate(&mut ws, &model.nominal(), &mut r, Some(&mut j));
-    let names: Vec<String> = problem
-        .free
-        .iter()
-        .map(|&i| model.registry.get(i).name.clone())
-        .collect();
-    let cp = uncertainty::parameter_uncertainty(&j, &r, &names)
-        .unwrap()
-        .covariance;
+    let (_, j) = problem.residual_and_jacobian(&model.nominal());
+    let cp = problem.uncertainty_at(&model.nominal()).unwrap().covariance;
     let work: Vec<Vec<f64>> = cell.working.iter().map(|w| w.q.clone()).collect();
     let g = uncertainty::tcp_jacobian(model, &model.nominal(), &problem.free, &work);
     let cs = uncertainty::tcp_covariance(&g, &cp, &["w".into()]);
@@ -168,18 +146,7 @@ fn predicted_tcp_covariance_matches_monte_carlo() {
     // Prediction at the truth.
     let data = simulate(model, &truth, &qs, None, 0).unwrap();
     let problem = Problem::new(model, &data, &noise).unwrap();
-    let mut ws = problem.workspace();
-    let mut r = DVector::zeros(problem.rows());
-    let mut j = nalgebra::DMatrix::zeros(problem.rows(), problem.columns());
-    problem.evaluate(&mut ws, &truth, &mut r, Some(&mut j));
-    let names: Vec<String> = problem
-        .free
-        .iter()
-        .map(|&i| model.registry.get(i).name.clone())
-        .collect();
-    let cp = uncertainty::parameter_uncertainty(&j, &r, &names)
-        .unwrap()
-        .covariance;
+    let cp = problem.uncertainty_at(&truth).unwrap().covariance;
     let g = uncertainty::tcp_jacobian(model, &truth, &problem.free, std::slice::from_ref(&work));
     let cs = uncertainty::tcp_covariance(&g, &cp, &["w".into()]);
     let ratio = emp.trace() / cs[0].covariance.trace();

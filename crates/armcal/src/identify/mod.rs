@@ -341,11 +341,7 @@ pub fn identify(
     let mut problem = Problem::new(model, &train, &noise)?;
     let start = frames_first_start(model, &train, &noise, opts)?;
     let (sol, outliers, robust_scale) = solve(&mut problem, &start, opts, observer)?;
-    let names: Vec<String> = problem
-        .free
-        .iter()
-        .map(|&i| model.registry.get(i).name.clone())
-        .collect();
+    let names = problem.free_names();
     // Covariance from the unweighted whitened Jacobian (robust weights only pick data).
     let unc = uncertainty::parameter_uncertainty(&sol.jacobian, &sol.residual, &names)?;
     let working: Vec<Vec<f64>> = cell.working.iter().map(|w| w.q.clone()).collect();

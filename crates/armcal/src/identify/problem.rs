@@ -149,6 +149,30 @@ impl<'a> Problem<'a> {
         Ok(())
     }
 
+    /// Names of the free parameters, in column order.
+    pub fn free_names(&self) -> Vec<String> {
+        self.free
+            .iter()
+            .map(|&i| self.model.registry.get(i).name.clone())
+            .collect()
+    }
+
+    /// Whitened residual and Jacobian at `params` (allocating; for one-off evaluations).
+    pub fn residual_and_jacobian(&self, params: &[f64]) -> (DVector<f64>, DMatrix<f64>) {
+        let mut ws = self.workspace();
+        let mut r = DVector::zeros(self.rows());
+        let mut j = DMatrix::zeros(self.rows(), self.columns());
+        self.evaluate(&mut ws, params, &mut r, Some(&mut j));
+        (r, j)
+    }
+
+    /// The parameter covariance and tests at `params` (the predicted C_p if `params` are the
+    /// truth or an estimate).
+    pub fn uncertainty_at(&self, params: &[f64]) -> Result<super::ParameterUncertainty, Error> {
+        let (r, j) = self.residual_and_jacobian(params);
+        super::uncertainty::parameter_uncertainty(&j, &r, &self.free_names())
+    }
+
     /// Rows of the whitened residual (data rows + prior rows).
     pub fn rows(&self) -> usize {
         self.sigmas.len() + self.priors.len()
