@@ -6,6 +6,7 @@
 //! laser-tracker measurement poses ("paper").
 
 pub mod cell;
+pub mod compensate;
 pub mod design;
 pub mod error;
 pub mod evaluate;
