@@ -33,6 +33,12 @@ enum Command {
     Plan(commands::plan::PlanArgs),
     /// Predicted C_p, C_s, criteria and constraint margins of any design.
     Evaluate(commands::plan::EvaluateArgs),
+    /// Filter a joint program or Cartesian targets through the calibrated model.
+    Compensate(commands::compensate::Args),
+    /// ISO 9283 accuracy and repeatability, and a model's errors, from a data file.
+    Accuracy(commands::accuracy::Args),
+    /// Export the calibrated model (cell file with DH / modified-DH / zero-reference links, JSON, URDF).
+    Export(commands::export::Args),
     /// Reproduce a source's experiment (`paper`: Jost et al. 2017, Tables 6–8).
     Study(commands::study::Args),
 }
@@ -49,6 +55,9 @@ fn main() {
         Command::Plan(a) => commands::plan::run_plan(&a),
         Command::Evaluate(a) => commands::plan::run_evaluate(&a),
         Command::Study(a) => commands::study::run_study(&a),
+        Command::Export(a) => commands::export::run(&a),
+        Command::Compensate(a) => commands::compensate::run(&a),
+        Command::Accuracy(a) => commands::accuracy::run(&a),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

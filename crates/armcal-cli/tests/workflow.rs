@@ -142,3 +142,87 @@ fn simulate_identify_predict() {
     ]);
     assert!(!ok && err.contains("does not belong to model"), "{err}");
 }
+
+#[test]
+fn compensate_export_and_accuracy() {
+    let dir = scratch("compensate");
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let (data, est) = (dir.join("data.csv"), dir.join("est.json"));
+    let (ok, _, err) = armcal(&[
+        "simulate",
+        "--cell",
+        "examples/paper-cell.toml",
+        "--poses",
+        "examples/paper-poses-random-60.csv",
+        "--seed",
+        "2",
+        "--out",
+        &s(&data),
+    ]);
+    assert!(ok, "{err}");
+    let (ok, _, err) = armcal(&[
+        "identify",
+        "--cell",
+        "examples/paper-cell.toml",
+        "--data",
+        &s(&data),
+        "--out",
+        &s(&est),
+    ]);
+    assert!(ok, "{err}");
+    let corrected = dir.join("corrected.csv");
+    let (ok, out, err) = armcal(&[
+        "compensate",
+        "--cell",
+        "examples/paper-cell.toml",
+        "--estimate",
+        &s(&est),
+        "--targets",
+        "examples/paper-poses-random-60.csv",
+        "--out",
+        &s(&corrected),
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("60 joint configurations"), "{out}");
+    let text = std::fs::read_to_string(&corrected).unwrap();
+    assert!(text
+        .lines()
+        .next()
+        .unwrap()
+        .ends_with("status,position_error_mm,orientation_error_deg"));
+    assert!(text.lines().filter(|l| l.contains(",converged,")).count() >= 50);
+    for fmt in ["dh", "mdh", "zrp", "json", "urdf"] {
+        let out_file = dir.join(format!("model-{fmt}.out"));
+        let (ok, _, err) = armcal(&[
+            "export",
+            "--estimate",
+            &s(&est),
+            "--format",
+            fmt,
+            "--out",
+            &s(&out_file),
+        ]);
+        assert!(ok, "{fmt}: {err}");
+    }
+    // The exported DH cell loads and still identifies 27 parameters.
+    let (ok, out, err) = armcal(&[
+        "model",
+        &s(&dir.join("model-dh.out")),
+        "--measurement",
+        "position",
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("identifiable: 27 parameters"), "{out}");
+    let (ok, out, err) = armcal(&[
+        "accuracy",
+        "--cell",
+        "examples/motoman-right-cell.toml",
+        "--data",
+        "data/motoman-leica/right_arm_repeatability_table1.csv",
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("n = 18") && out.contains("= 0.0318 mm"),
+        "{out}"
+    );
+}

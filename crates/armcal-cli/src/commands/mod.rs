@@ -1,5 +1,8 @@
 //! One module per subcommand.
 
+pub mod accuracy;
+pub mod compensate;
+pub mod export;
 pub mod fk;
 pub mod identify;
 pub mod model;

@@ -2,5 +2,6 @@
 //! (book ch. 7).
 
 pub mod iso9283;
+pub mod report;
 
 pub use crate::identify::ErrorStats;

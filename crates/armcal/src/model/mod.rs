@@ -3,6 +3,7 @@
 
 pub mod chain;
 pub mod convert;
+pub mod export;
 pub mod identifiability;
 pub mod jacobian;
 pub mod kinematics;
