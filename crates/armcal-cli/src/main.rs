@@ -37,9 +37,12 @@ enum Command {
     Compensate(commands::compensate::Args),
     /// ISO 9283 accuracy and repeatability, and a model's errors, from a data file.
     Accuracy(commands::accuracy::Args),
+    /// Joint axes by circle point analysis from one-joint-at-a-time sweeps.
+    Axes(commands::axes::Args),
     /// Export the calibrated model (cell file with DH / modified-DH / zero-reference links, JSON, URDF).
     Export(commands::export::Args),
-    /// Reproduce a source's experiment (`paper`: Jost et al. 2017, Tables 6–8).
+    /// Reproduce a source's experiment (`paper`: Jost et al. 2017, Tables 6–8; `puma`: the
+    /// book's Chapter 6 PUMA 560 calibration, Tables 6.9/6.10 and 6.13).
     Study(commands::study::Args),
 }
 
@@ -58,6 +61,7 @@ fn main() {
         Command::Export(a) => commands::export::run(&a),
         Command::Compensate(a) => commands::compensate::run(&a),
         Command::Accuracy(a) => commands::accuracy::run(&a),
+        Command::Axes(a) => commands::axes::run(&a),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

@@ -226,3 +226,49 @@ fn compensate_export_and_accuracy() {
         "{out}"
     );
 }
+
+#[test]
+fn axes_from_one_joint_sweeps() {
+    let dir = scratch("axes");
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let sweeps = dir.join("sweeps.csv");
+    let (ok, _, err) = armcal(&[
+        "simulate",
+        "--cell",
+        "examples/paper-cell.toml",
+        "--poses",
+        "examples/paper-sweeps.csv",
+        "--noise-free",
+        "--out",
+        &s(&sweeps),
+    ]);
+    assert!(ok, "{err}");
+    let (ok, out, err) = armcal(&[
+        "axes",
+        "--cell",
+        "examples/paper-cell.toml",
+        "--data",
+        &s(&sweeps),
+    ]);
+    assert!(ok, "{err}");
+    // Six axes; noise-free circles fit exactly.
+    let rows: Vec<&str> = out.lines().filter(|l| l.starts_with('q')).collect();
+    assert_eq!(rows.len(), 6, "{out}");
+    for r in rows {
+        let rms: f64 = r.split_whitespace().rev().nth(2).unwrap().parse().unwrap();
+        assert!(rms < 1e-6, "{r}");
+    }
+    // Random poses move several joints at once: refused with the line named.
+    let (ok, _, err) = armcal(&[
+        "axes",
+        "--cell",
+        "examples/paper-cell.toml",
+        "--data",
+        "examples/paper-poses-random-60.csv",
+    ]);
+    assert!(!ok);
+    assert!(
+        err.contains("sweeps move one joint at a time") || err.contains("x, y, z"),
+        "{err}"
+    );
+}

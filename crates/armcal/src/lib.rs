@@ -19,3 +19,5 @@ pub mod sim;
 pub mod study;
 
 pub use error::{Error, Result};
+/// The linear-algebra crate of the public API.
+pub use nalgebra;

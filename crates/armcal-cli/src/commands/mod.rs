@@ -1,6 +1,7 @@
 //! One module per subcommand.
 
 pub mod accuracy;
+pub mod axes;
 pub mod compensate;
 pub mod export;
 pub mod fk;

@@ -1,6 +1,7 @@
 //! Kinematic models: conventions, chain, parameter registry, forward kinematics, exact
 //! Jacobians, identifiability, conversions and URDF.
 
+pub mod axes;
 pub mod chain;
 pub mod convert;
 pub mod export;
