@@ -9,30 +9,9 @@
 //! * Check 6: the identification round trip of §6.3 in simulation: truth = Table 6.5,
 //!   start = Table 6.1, 50 full poses on the book's grid, PIndex-style 6-D pose residuals.
 //!
-//! **The measurement poses (§6.2, Figs. 6.9–6.10).** The book positions the end-effector
-//! origin "on the points of a 3 × 2 × 2 grid in the workspace of the CMM", measures each
-//! point in the "left arm", "right arm", "elbow up" and "elbow down" configurations with a
-//! randomly varied end-effector orientation, and reports 50 poses per data set. Figure 6.9
-//! (where the grid is) is not in the OCR, and 12 × 4 = 48. armcal's reading:
-//! * the grid is aligned with the CMM axes (y is vertical, along axis 1): x ∈ {−11, −5, 1},
-//!   y ∈ {21, 27}, z ∈ {8, 14} in, a 12 × 6 × 6 in box whose centre lies 24 in from axis 1
-//!   horizontally, towards the CMM origin, and 9 in above the shoulder. The place is
-//!   armcal's choice: there every grid point is reachable in all four arm configurations
-//!   within the joint limits (at shoulder height and below, the elbow-down postures of
-//!   many points would need q2 beyond its +45° limit; straight ahead of q1 = 0, one of the
-//!   two arm solutions needs q1 beyond ±160°);
-//! * "left/right arm × elbow up/down" are the four solutions for the wrist centre: right
-//!   arm when, looking horizontally from axis 1 towards the wrist, the forearm plane is
-//!   offset to the right of axis 1; elbow up when the elbow lies above the line from the
-//!   shoulder to the wrist centre, in the arm plane;
-//! * the orientation is uniformly random (the operator's "varied randomly"), redrawn until
-//!   the configuration of the wanted class is non-singular with margins: wrist centre ≥ 4 in
-//!   from the shoulder-singular cylinder, elbow ≥ 20° from straight, |sin(axis 4, axis 6)|
-//!   ≥ sin 20°;
-//! * 48 grid poses + 2 more at the grid centre (random class) make the book's 50;
-//! * joint values come from inverse kinematics on the nominal model (Table 6.1): the
-//!   operator only "roughly" positions the end effector, and what the identification uses
-//!   is the recorded joint values and the measured pose (of the true robot, Table 6.5).
+//! **The measurement poses (§6.2, Figs. 6.9–6.10)** are `armcal::study::puma::book_poses`
+//! (its module documentation gives armcal's reading of the book's grid), the error measures
+//! (eqs. 6.41–6.42) `armcal::study::puma::pose_errors`.
 //!
 //! **Units.** armcal works in mm and rad; the book's Chapter 6 in inches and degrees
 //! (Table 6.4 in mm and rad). Printed numbers are given in both.
@@ -41,16 +20,15 @@ use armcal::cell::Cell;
 use armcal::identify::{solve, IdentifyOptions, Method, Problem, Silent};
 use armcal::measure::{Dataset, MeasurementKind, NoiseModel};
 use armcal::model::identifiability::{analyze, IdentifiabilityOptions, Measurement};
-use armcal::model::pose::rotation_log;
 use armcal::model::*;
 use armcal::robots;
-use armcal::robots::puma560::{book_dh_spec, MM_PER_IN};
+use armcal::robots::puma560::MM_PER_IN;
 use armcal::sim::simulate;
-use nalgebra::{DMatrix, DVector, Matrix3, Quaternion, UnitQuaternion, Vector3};
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
-use rand_distr::StandardNormal;
-use std::f64::consts::PI;
+use armcal::study::puma::{
+    self, arm_configuration, book_poses, pose_errors, table_6_4_noise, Configurations,
+    CONFIGURATIONS, GRID_X, GRID_Y, GRID_Z,
+};
+use nalgebra::Vector3;
 use std::path::Path;
 use std::sync::OnceLock;
 
@@ -196,32 +174,23 @@ fn check1_position_only_identifies_27_or_25_with_the_tool_origin_on_axis_6() {
 const TABLE_6_4_ROT: [f64; 3] = [0.000506, 0.000592, 0.000621];
 const TABLE_6_4_POS: [f64; 3] = [0.05024, 0.04364, 0.05654];
 
-/// Table 6.4 as an armcal noise model: σ per position axis as printed; armcal's constant
-/// model has one σ for the three rotation rows, the RMS of the printed three
-/// (0.000575 rad = 0.0330°). armcal adds the noise in the CMM frame, the book estimated it
-/// in the end-effector frame (eq. 6.17); with σ this close to isotropic (0.044–0.057 mm,
-/// 0.51–0.62 mrad) the difference does not matter.
+/// Table 6.4 as an armcal noise model (`armcal::study::puma::table_6_4_noise`): σ per
+/// position axis as printed; one σ for the three rotation rows, the RMS of the printed three.
 fn table_6_4() -> NoiseModel {
-    let ms = TABLE_6_4_ROT.iter().map(|s| s * s).sum::<f64>() / 3.0;
-    NoiseModel::Constant {
-        sigma: TABLE_6_4_POS,
-        sigma_angle: ms.sqrt(),
-    }
+    let noise = table_6_4_noise();
+    let NoiseModel::Constant { sigma, sigma_angle } = noise else {
+        panic!("{noise:?}")
+    };
+    assert_eq!(sigma, TABLE_6_4_POS);
+    let rms = (TABLE_6_4_ROT.iter().map(|s| s * s).sum::<f64>() / 3.0).sqrt();
+    assert!((sigma_angle - rms).abs() < 1e-15, "{sigma_angle} vs {rms}");
+    noise
 }
 
-/// A Table 6.1-format model with the CMM measuring the end-effector frame: a fixed
-/// `frame6` target `tcp` at the tool (so that `sim::simulate` makes pose measurements) and
-/// the fixed identity `tool`; free: the book's 30 parameters.
+/// A Table 6.1-format model with the CMM measuring the end-effector frame (a fixed `tcp`
+/// target at the tool; `tool` fixed); free: the book's 30 parameters.
 fn book_model(name: &str, csv: &str) -> Model {
-    let mut spec = book_dh_spec(name, csv).unwrap();
-    spec.targets.push(LinkSpec {
-        name: "tcp".into(),
-        geometry: LinkGeometry::frame6([0.0; 3], [0.0; 3]),
-        joint: None,
-    });
-    let mut m = Model::from_spec(&spec).unwrap();
-    m.set_status("tool", Status::Fixed).unwrap();
-    m.set_status("tcp", Status::Fixed).unwrap();
+    let m = puma::book_model(name, csv).unwrap();
     assert_eq!(m.registry.free().len(), 30);
     m
 }
@@ -247,185 +216,12 @@ fn start_and_truth() -> (Model, Vec<f64>) {
     (start, t)
 }
 
-/// Inverse kinematics of the tool frame by damped least squares from `seed`; joints are
-/// wrapped into their limits. `None` if it does not converge or leaves the limits.
-fn ik(m: &Model, params: &[f64], target: &Pose<f64>, seed: &[f64]) -> Option<Vec<f64>> {
-    let mut q = seed.to_vec();
-    let mut d = Data::new(m);
-    // Position rows in units of 100 mm so that they weigh like the rotation rows (rad).
-    let s = 0.01;
-    for _ in 0..200 {
-        forward_kinematics(m, &mut d, params, &q);
-        let t = d.tool();
-        let ep = (target.trans - t.trans) * s;
-        let er = rotation_log(&(target.rot * t.rot.transpose()));
-        if ep.norm() < 1e-10 && er.norm() < 1e-10 {
-            for (v, j) in q.iter_mut().zip(&m.joints) {
-                *v = (*v + PI).rem_euclid(2.0 * PI) - PI;
-                if *v < j.lower {
-                    *v += 2.0 * PI;
-                } else if *v > j.upper {
-                    *v -= 2.0 * PI;
-                }
-                if *v < j.lower || *v > j.upper {
-                    return None;
-                }
-            }
-            return Some(q);
-        }
-        let mut jac = joint_jacobian(&d, Observed::Tool);
-        jac.rows_mut(0, 3).scale_mut(s);
-        let e = DVector::from_iterator(6, ep.iter().chain(er.iter()).copied());
-        let a = &jac * jac.transpose() + DMatrix::identity(6, 6) * 1e-6;
-        let dq = jac.transpose() * a.cholesky()?.solve(&e);
-        let f = (0.3 / dq.norm()).min(1.0);
-        for (v, x) in q.iter_mut().zip(dq.iter()) {
-            *v += f * x;
-        }
-    }
-    None
-}
-
-/// The book's arm configurations (§6.2, Fig. 6.10).
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct ArmConfiguration {
-    right_arm: bool,
-    elbow_up: bool,
-}
-
-const CONFIGURATIONS: [ArmConfiguration; 4] = [
-    ArmConfiguration {
-        right_arm: false,
-        elbow_up: true,
-    },
-    ArmConfiguration {
-        right_arm: false,
-        elbow_up: false,
-    },
-    ArmConfiguration {
-        right_arm: true,
-        elbow_up: true,
-    },
-    ArmConfiguration {
-        right_arm: true,
-        elbow_up: false,
-    },
-];
-
-/// The arm configuration of `q` and whether it keeps the singularity margins (module
-/// documentation). Geometry from the frames: axis 1 = z of `base`, shoulder = origin of
-/// `j1` on axis 2 (z of `j1`), elbow = origin of `j2` on axis 3, wrist centre = origin of
-/// `j4`, axis 4 = z of `j3`, axis 6 = z of `j5`.
-fn arm_configuration(m: &Model, params: &[f64], q: &[f64]) -> (ArmConfiguration, bool) {
-    let mut d = Data::new(m);
-    forward_kinematics(m, &mut d, params, q);
-    let col = |k: usize| d.frames[k].rot.column(2).into_owned();
-    let (up, z1) = (col(0), col(1));
-    // In the arm plane: `reach` along h = z1 × up, `height` along up.
-    let h = z1.cross(&up);
-    let s = d.frames[1].trans;
-    let (e, w) = (d.frames[2].trans - s, d.frames[4].trans - s);
-    let (ex, ey, wx, wy) = (e.dot(&h), e.dot(&up), w.dot(&h), w.dot(&up));
-    // The forearm plane is offset by +d along z1, which is to the right of the viewer (from
-    // axis 1 towards the wrist) exactly when the wrist is behind the shoulder along h.
-    let right_arm = wx < 0.0;
-    // Elbow above the shoulder–wrist line.
-    let elbow_up = (wx * ey - wy * ex) * wx.signum() > 0.0;
-    let (fx, fy) = (wx - ex, wy - ey);
-    let elbow_sin = (ex * fy - ey * fx).abs() / (ex.hypot(ey) * fx.hypot(fy));
-    let wrist_sin = col(3).cross(&col(5)).norm();
-    let margin = 20f64.to_radians().sin();
-    let ok = wx.abs() >= 4.0 * MM_PER_IN && elbow_sin >= margin && wrist_sin >= margin;
-    (
-        ArmConfiguration {
-            right_arm,
-            elbow_up,
-        },
-        ok,
-    )
-}
-
-/// A uniformly random rotation.
-fn random_rotation(r: &mut ChaCha8Rng) -> Matrix3<f64> {
-    let mut g = || r.sample::<f64, _>(StandardNormal);
-    let q = Quaternion::new(g(), g(), g(), g());
-    *UnitQuaternion::from_quaternion(q)
-        .to_rotation_matrix()
-        .matrix()
-}
-
-/// Joints that put the end-effector origin at `position` (mm) in arm configuration
-/// `want` with a random orientation, on the nominal model; non-singular with margins.
-fn place(
-    m: &Model,
-    position: Vector3<f64>,
-    want: ArmConfiguration,
-    r: &mut ChaCha8Rng,
-) -> Vec<f64> {
-    let nominal = m.nominal();
-    for _ in 0..100 {
-        let target = Pose {
-            rot: random_rotation(r),
-            trans: position,
-        };
-        for _ in 0..30 {
-            let seed: Vec<f64> = m
-                .joints
-                .iter()
-                .map(|j| r.random_range(j.lower..j.upper))
-                .collect();
-            if let Some(q) = ik(m, &nominal, &target, &seed) {
-                if arm_configuration(m, &nominal, &q) == (want, true) {
-                    return q;
-                }
-            }
-        }
-    }
-    panic!("no {want:?} configuration reaches {position:?}");
-}
-
-/// The 3 × 2 × 2 grid (in, CMM frame; module documentation).
-const GRID_X: [f64; 3] = [-11.0, -5.0, 1.0];
-const GRID_Y: [f64; 2] = [21.0, 27.0];
-const GRID_Z: [f64; 2] = [8.0, 14.0];
-
-/// Joint vectors (rad).
-type Configurations = Vec<Vec<f64>>;
-
-/// (50 identification poses on the grid, 10 held-out poses at random points of the grid
-/// box), in random arm configurations and orientations. Computed once.
+/// (50 identification poses on the grid, 10 held-out poses), computed once.
 fn poses() -> &'static (Configurations, Configurations) {
     static POSES: OnceLock<(Configurations, Configurations)> = OnceLock::new();
     POSES.get_or_init(|| {
         let (m, _) = start_and_truth();
-        let mut r = ChaCha8Rng::seed_from_u64(6);
-        let mut train = Vec::new();
-        for &x in &GRID_X {
-            for &y in &GRID_Y {
-                for &z in &GRID_Z {
-                    let p = Vector3::new(x, y, z) * MM_PER_IN;
-                    for c in CONFIGURATIONS {
-                        train.push(place(&m, p, c, &mut r));
-                    }
-                }
-            }
-        }
-        let centre = Vector3::new(-5.0, 24.0, 11.0) * MM_PER_IN;
-        for _ in 0..2 {
-            let c = CONFIGURATIONS[r.random_range(0..4)];
-            train.push(place(&m, centre, c, &mut r));
-        }
-        let mut test = Vec::new();
-        for _ in 0..10 {
-            let p = Vector3::new(
-                r.random_range(GRID_X[0]..GRID_X[2]),
-                r.random_range(GRID_Y[0]..GRID_Y[1]),
-                r.random_range(GRID_Z[0]..GRID_Z[1]),
-            ) * MM_PER_IN;
-            let c = CONFIGURATIONS[r.random_range(0..4)];
-            test.push(place(&m, p, c, &mut r));
-        }
-        (train, test)
+        book_poses(&m, 6).unwrap()
     })
 }
 
@@ -510,7 +306,7 @@ fn check6_noise_free_round_trip_recovers_table_6_5() {
     // SSQ in the book's PIndex units (in and rad, unweighted; eq. 6.18 gives δθ² and δr²
     // summed over the rows) and whitened.
     let ssq_book = |d: &Dataset, params: &[f64]| -> f64 {
-        book_errors(&m, params, d)
+        pose_errors(&m, params, d)
             .iter()
             .map(|(dr, dth)| (dr / MM_PER_IN).powi(2) + dth.to_radians().powi(2))
             .sum()
@@ -543,27 +339,6 @@ fn check6_noise_free_round_trip_recovers_table_6_5() {
         lm_gn.0
     );
     assert!(2.0 * lm_sol.cost() < 1e-12, "SSQ {:e}", 2.0 * lm_sol.cost());
-}
-
-/// The book's error measures (eqs. 6.41–6.42) of each pose measurement against the model
-/// at `params`: δr = |translation of Pm⁻¹Pp| (mm), δθ = rotation angle of Pm⁻¹Pp (deg).
-fn book_errors(m: &Model, params: &[f64], data: &Dataset) -> Vec<(f64, f64)> {
-    let mut d = Data::new(m);
-    data.measurements
-        .iter()
-        .map(|x| {
-            let MeasurementKind::Pose { value, .. } = &x.kind else {
-                panic!("pose measurements only");
-            };
-            forward_kinematics(m, &mut d, params, &data.configurations[x.config]);
-            let predicted = observed_pose(&d, x.observed);
-            let delta = value.inverse().compose(&predicted);
-            (
-                delta.trans.norm(),
-                rotation_log(&delta.rot).norm().to_degrees(),
-            )
-        })
-        .collect()
 }
 
 struct Stats {
@@ -651,10 +426,10 @@ fn check6_table_6_4_noise_calibrated_held_out_errors() {
 
     let measured = simulate(&m, &truth, test, Some(&noise), 62).unwrap();
     let exact = simulate(&m, &truth, test, None, 0).unwrap();
-    let nominal = stats(&book_errors(&m, &m.nominal(), &measured));
-    let calibrated = stats(&book_errors(&m, &lm_sol.params, &measured));
-    let calibrated_exact = stats(&book_errors(&m, &lm_sol.params, &exact));
-    let noise_only = stats(&book_errors(&m, &truth, &measured));
+    let nominal = stats(&pose_errors(&m, &m.nominal(), &measured));
+    let calibrated = stats(&pose_errors(&m, &lm_sol.params, &measured));
+    let calibrated_exact = stats(&pose_errors(&m, &lm_sol.params, &exact));
+    let noise_only = stats(&pose_errors(&m, &truth, &measured));
     eprintln!(
         "check 6, Table 6.4 noise: LM {} iterations, variance factor {:.3} ({}); max |estimate − \
          Table 6.5| {:.4} ({}); |LM − GN| ≤ {worst_gn:.1e} σ ({gn_book:.1e} in/deg, {gn_name})",

@@ -1,17 +1,20 @@
 //! `armcal study paper`: the paper's Tables 6–8 reproduced beside the published values.
+//! `armcal study puma`: the book's Chapter 6 PUMA case (Tables 6.9/6.10 and 6.13).
 
 use super::output::write_new;
 use armcal::study::paper::{
     notional_robots, run, table6_robots, StudyRow, StudySettings, PAPER_SUMMARY, PAPER_TABLE6,
 };
+use armcal::study::puma;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Which study: `paper` (Jost et al. 2017, Tables 6–8).
-    #[arg(value_parser = ["paper"])]
+    /// Which study: `paper` (Jost et al. 2017, Tables 6–8) or `puma` (Mooring, Roth, Driels
+    /// 1991, Chapter 6: modified-DH and zero-reference calibration of the PUMA 560).
+    #[arg(value_parser = ["paper", "puma"])]
     pub which: String,
     /// Collision avoidance.
     #[arg(long, default_value = "on", value_parser = ["on", "off"])]
@@ -21,9 +24,9 @@ pub struct Args {
     pub robots: String,
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Directory for study.csv and study.json.
-    #[arg(long, default_value = "out/study-paper")]
-    pub out: PathBuf,
+    /// Directory for the CSV and JSON files [default: out/study-paper or out/study-puma].
+    #[arg(long)]
+    pub out: Option<PathBuf>,
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
@@ -40,6 +43,13 @@ fn mean(rows: &[&StudyRow], f: impl Fn(&StudyRow) -> f64) -> (f64, f64, f64) {
 }
 
 pub fn run_study(a: &Args) -> anyhow::Result<()> {
+    if a.which == "puma" {
+        return run_puma(a);
+    }
+    let out = a
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out/study-paper"));
     let collisions = a.collisions == "on";
     let mut robots = Vec::new();
     if a.robots != "notional" {
@@ -165,8 +175,8 @@ pub fn run_study(a: &Args) -> anyhow::Result<()> {
     } else {
         "no-collisions"
     };
-    let csv_path = a.out.join(format!("study-{suffix}.csv"));
-    let json_path = a.out.join(format!("study-{suffix}.json"));
+    let csv_path = out.join(format!("study-{suffix}.csv"));
+    let json_path = out.join(format!("study-{suffix}.json"));
     write_new(&csv_path, &csv, a.force)?;
     write_new(
         &json_path,
@@ -176,5 +186,214 @@ pub fn run_study(a: &Args) -> anyhow::Result<()> {
         a.force,
     )?;
     println!("\n→ {}, {}", csv_path.display(), json_path.display());
+    Ok(())
+}
+
+/// `armcal study puma`: prints Tables 6.9/6.10 and 6.13 (armcal beside the book) and writes
+/// `puma.json`, `puma-conversion.csv` and `puma-accuracy.csv`.
+fn run_puma(a: &Args) -> anyhow::Result<()> {
+    let out = a
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out/study-puma"));
+    let t0 = std::time::Instant::now();
+    let s = puma::run(&puma::PumaSettings {
+        seed: a.seed,
+        ..Default::default()
+    })?;
+    let secs = t0.elapsed().as_secs_f64();
+    println!(
+        "PUMA 560 study (book ch. 6): truth Table 6.5, {} full poses with Table 6.4 noise \
+         (σ {:.4}/{:.4}/{:.4} mm, {:.4} mrad; seed {}), {} held-out poses — {secs:.1} s",
+        s.identification_poses,
+        s.sigma_mm[0],
+        s.sigma_mm[1],
+        s.sigma_mm[2],
+        1e3 * s.sigma_rad,
+        s.seed,
+        s.held_out_poses
+    );
+    for f in [&s.mdh, &s.zrp] {
+        println!(
+            "\n{}: {} free parameters, {} rows, {} iterations{}, whitened SSQ {:.1} (variance factor {:.2}); \
+             fit RMS δr {:.4} in, δθ {:.3}°",
+            f.model,
+            f.free,
+            f.rows,
+            f.iterations,
+            if f.converged { "" } else { " (NOT converged)" },
+            f.ssq,
+            f.variance_factor,
+            f.fit_rms_dr_in,
+            f.fit_rms_dtheta_deg
+        );
+        for (name, why) in &f.unidentifiable {
+            println!("  fixed {name}: {why}");
+        }
+    }
+    println!(
+        "\nTables 6.9/6.10: zero reference converted to DH vs modified DH identified \
+         (p1–p3; in, deg)"
+    );
+    println!(
+        "{:<5} {:<16} {:>28} {:>28} {:>28} {:>28} {:>28} {:>28}",
+        "",
+        "fields",
+        "converted",
+        "identified",
+        "σ identified",
+        "truth (Table 6.5)",
+        "book converted",
+        "book identified"
+    );
+    let three = |v: &[f64; 3]| format!("{:>9.3}{:>9.3}{:>10.3}", v[0], v[1], v[2]);
+    for r in &s.conversion {
+        println!(
+            "{:<5} {:<16} {:>28} {:>28} {:>28} {:>28} {:>28} {:>28}",
+            r.transform,
+            r.fields.join(","),
+            three(&r.converted),
+            three(&r.identified),
+            format!(
+                "{:>9.4}{:>9.4}{:>10.4}",
+                r.identified_sigma[0], r.identified_sigma[1], r.identified_sigma[2]
+            ),
+            three(&r.truth),
+            three(&r.book_converted),
+            three(&r.book_identified)
+        );
+    }
+    println!(
+        "max |converted − identified|: {:.1e} in, {:.1e}°",
+        s.conversion_max_dlength_in, s.conversion_max_dangle_deg
+    );
+    println!("\nTable 6.13: held-out accuracy, δr (in) and δθ (deg) against the measured pose");
+    println!(
+        "{:<5} {:>20} {:>20} {:>20}   {:>20} {:>20} {:>20}",
+        "pose",
+        "nominal",
+        "modified DH",
+        "zero reference",
+        "book nominal",
+        "book mod. DH",
+        "book ZRP"
+    );
+    let pair = |r: f64, t: f64| format!("{r:>9.4} {t:>9.3}");
+    for r in &s.held_out {
+        let b = r
+            .book
+            .map(|b| {
+                format!(
+                    "{:>20} {:>20} {:>20}",
+                    pair(b.nominal_dr_in, b.nominal_dtheta_deg),
+                    pair(b.mdh_dr_in, b.mdh_dtheta_deg),
+                    pair(b.zrp_dr_in, b.zrp_dtheta_deg)
+                )
+            })
+            .unwrap_or_default();
+        println!(
+            "{:<5} {:>20} {:>20} {:>20}   {b}",
+            r.pose,
+            pair(r.nominal_dr_in, r.nominal_dtheta_deg),
+            pair(r.mdh_dr_in, r.mdh_dtheta_deg),
+            pair(r.zrp_dr_in, r.zrp_dtheta_deg)
+        );
+    }
+    let (m, b) = (&s.held_out_mean, &s.book_mean);
+    println!(
+        "{:<5} {:>20} {:>20} {:>20}   {:>20} {:>20} {:>20}",
+        "mean",
+        pair(m.nominal_dr_in, m.nominal_dtheta_deg),
+        pair(m.mdh_dr_in, m.mdh_dtheta_deg),
+        pair(m.zrp_dr_in, m.zrp_dtheta_deg),
+        pair(b.nominal_dr_in, b.nominal_dtheta_deg),
+        pair(b.mdh_dr_in, b.mdh_dtheta_deg),
+        pair(b.zrp_dr_in, b.zrp_dtheta_deg)
+    );
+    println!(
+        "against the true poses (no CMM noise): modified DH δr {:.4} in, δθ {:.3}°; \
+         zero reference δr {:.4} in, δθ {:.3}°",
+        s.exact_mean_mdh.0, s.exact_mean_mdh.1, s.exact_mean_zrp.0, s.exact_mean_zrp.1
+    );
+    println!(
+        "(the simulated robot is exactly geometric and the CMM noise-only; the book's calibrated \
+         errors include non-geometric errors and the CMM's accuracy)"
+    );
+
+    let mut conv = String::from(
+        "transform,link,field1,field2,field3,conv_p1,conv_p2,conv_p3,ident_p1,ident_p2,ident_p3,\
+         sigma_p1,sigma_p2,sigma_p3,truth_p1,truth_p2,truth_p3,book_conv_p1,book_conv_p2,book_conv_p3,book_ident_p1,\
+         book_ident_p2,book_ident_p3\n",
+    );
+    for r in &s.conversion {
+        let v: Vec<String> = [
+            r.converted,
+            r.identified,
+            r.identified_sigma,
+            r.truth,
+            r.book_converted,
+            r.book_identified,
+        ]
+        .iter()
+        .flatten()
+        .map(|x| format!("{x:.6}"))
+        .collect();
+        conv.push_str(&format!(
+            "{},{},{},{}\n",
+            r.transform,
+            r.link,
+            r.fields.join(","),
+            v.join(",")
+        ));
+    }
+    let mut acc = String::from(
+        "pose,nominal_dr_in,nominal_dtheta_deg,mdh_dr_in,mdh_dtheta_deg,zrp_dr_in,zrp_dtheta_deg,\
+         book_nominal_dr_in,book_nominal_dtheta_deg,book_mdh_dr_in,book_mdh_dtheta_deg,\
+         book_zrp_dr_in,book_zrp_dtheta_deg\n",
+    );
+    for r in &s.held_out {
+        let b = r
+            .book
+            .map(|b| {
+                format!(
+                    "{},{},{},{},{},{}",
+                    b.nominal_dr_in,
+                    b.nominal_dtheta_deg,
+                    b.mdh_dr_in,
+                    b.mdh_dtheta_deg,
+                    b.zrp_dr_in,
+                    b.zrp_dtheta_deg
+                )
+            })
+            .unwrap_or_else(|| ",,,,,".into());
+        acc.push_str(&format!(
+            "{},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{b}\n",
+            r.pose,
+            r.nominal_dr_in,
+            r.nominal_dtheta_deg,
+            r.mdh_dr_in,
+            r.mdh_dtheta_deg,
+            r.zrp_dr_in,
+            r.zrp_dtheta_deg
+        ));
+    }
+    let json_path = out.join("puma.json");
+    let conv_path = out.join("puma-conversion.csv");
+    let acc_path = out.join("puma-accuracy.csv");
+    write_new(&conv_path, &conv, a.force)?;
+    write_new(&acc_path, &acc, a.force)?;
+    write_new(
+        &json_path,
+        &serde_json::to_string_pretty(
+            &serde_json::json!({"study": "puma", "seconds": secs, "result": s}),
+        )?,
+        a.force,
+    )?;
+    println!(
+        "\n→ {}, {}, {}",
+        json_path.display(),
+        conv_path.display(),
+        acc_path.display()
+    );
     Ok(())
 }

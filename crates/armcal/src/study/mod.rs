@@ -1,3 +1,4 @@
 //! Reproductions of the sources' experiments.
 
 pub mod paper;
+pub mod puma;
