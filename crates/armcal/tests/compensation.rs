@@ -117,3 +117,46 @@ fn closed_loop_filtered_program_hits_targets_within_predicted_uncertainty() {
     assert!(miss_filtered <= miss_nominal / 10.0);
     assert!(miss_filtered <= 2.0 * predicted);
 }
+
+#[test]
+fn damping_keeps_wrist_corrections_bounded_near_the_wrist_singularity() {
+    // Book Table 5.7 (check 9): at θ5 = −1°, a small pose correction with γ → 0 asks for
+    // large, opposite motions of joints 4 and 6; damping keeps them small.
+    use armcal::compensate::ik::{damped_step, task_jacobian};
+    use nalgebra::{DVector, Vector3};
+    let cell = paper_cell();
+    let model = &cell.model;
+    let p = model.nominal();
+    let q = [0.0, -30.0, 60.0, 20.0, -1.0, 10.0].map(f64::to_radians);
+    let mut data = Data::new(model);
+    forward_kinematics(model, &mut data, &p, &q);
+    let length = 1000.0;
+    let j = task_jacobian(&data, 6, length);
+    // A correction of 0.5 mm and 0.2° about the world x axis (perpendicular to the wrist).
+    let w = Vector3::new(0.2f64.to_radians(), 0.0, 0.0);
+    let e = DVector::from_vec(vec![
+        0.5,
+        0.0,
+        0.0,
+        w[0] * length,
+        w[1] * length,
+        w[2] * length,
+    ]);
+    let (jtj, jte) = (j.tr_mul(&j), j.tr_mul(&e));
+    let undamped = damped_step(&jtj, &jte, 1e-12).unwrap();
+    let damped = damped_step(&jtj, &jte, 1e4).unwrap();
+    let deg = |v: f64| v.to_degrees().abs();
+    eprintln!(
+        "θ5 = −1°: Δθ4 = {:.2}°, Δθ6 = {:.2}° undamped; {:.3}°, {:.3}° damped",
+        undamped[3].to_degrees(),
+        undamped[5].to_degrees(),
+        damped[3].to_degrees(),
+        damped[5].to_degrees()
+    );
+    assert!(
+        deg(undamped[3]) > 5.0 && deg(undamped[5]) > 5.0,
+        "γ → 0 blows up the wrist"
+    );
+    assert!(undamped[3] * undamped[5] < 0.0, "Δθ4 ≈ −Δθ6");
+    assert!(deg(damped[3]) < 0.5 * deg(undamped[3]));
+}

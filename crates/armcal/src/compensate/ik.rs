@@ -107,6 +107,28 @@ fn error(target: &IkTarget, tool: &Pose<f64>) -> (DVector<f64>, f64, f64) {
     }
 }
 
+/// The weighted task Jacobian `Q^{1/2} J` of the tool frame (position rows, then, for 6
+/// rows, orientation rows scaled by the characteristic length), from evaluated kinematics.
+pub fn task_jacobian(data: &Data<f64>, rows: usize, length: f64) -> DMatrix<f64> {
+    let j6 = joint_jacobian(data, Observed::Tool);
+    let mut j: DMatrix<f64> = j6.rows(0, rows).into_owned();
+    for r in 3..rows {
+        j.row_mut(r).scale_mut(length);
+    }
+    j
+}
+
+/// The one-step optimal compensator (book eqs. 5.85–5.87 with one stage):
+/// `Δq = (JᵀQJ + γ² I)⁻¹ JᵀQ e`, given `JᵀQJ` and `JᵀQe`. `None` if the damped matrix is
+/// not positive definite (γ = 0 at an exact singularity).
+pub fn damped_step(jtj: &DMatrix<f64>, jte: &DVector<f64>, gamma2: f64) -> Option<DVector<f64>> {
+    let mut a = jtj.clone();
+    for k in 0..a.nrows() {
+        a[(k, k)] += gamma2;
+    }
+    a.cholesky().map(|ch| ch.solve(jte))
+}
+
 /// Joint values that bring the tool frame of `model` with parameters `params` to `target`,
 /// starting from `seed` (e.g. the nominal solution or the nominal program's joints).
 pub fn calibrated_ik(
@@ -144,14 +166,10 @@ pub fn calibrated_ik(
                 sigma_min,
             };
         }
-        let j6 = joint_jacobian(&ws.data, Observed::Tool);
-        let mut j: DMatrix<f64> = j6.rows(0, rows).into_owned();
+        let j = task_jacobian(&ws.data, rows, settings.length);
         let mut ew = e.clone();
-        if rows == 6 {
-            for r in 3..6 {
-                j.row_mut(r).scale_mut(settings.length);
-                ew[r] *= settings.length;
-            }
+        for r in 3..rows {
+            ew[r] *= settings.length;
         }
         let weighted = ew.norm();
         let svd = j.clone().svd(false, false);
@@ -169,12 +187,9 @@ pub fn calibrated_ik(
         let mut g2 = gamma2;
         let mut accepted = false;
         for _ in 0..12 {
-            let mut a = jtj.clone();
-            for k in 0..a.nrows() {
-                a[(k, k)] += g2 + 1e-14 * smax * smax;
-            }
-            let Some(ch) = a.cholesky() else { break };
-            let step = ch.solve(&jte);
+            let Some(step) = damped_step(&jtj, &jte, g2 + 1e-14 * smax * smax) else {
+                break;
+            };
             let mut trial = q.clone();
             let mut hits_limit = false;
             for (k, st) in step.iter().enumerate() {
