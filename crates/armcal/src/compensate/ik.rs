@@ -153,8 +153,13 @@ pub fn calibrated_ik(
     let mut stalled = 0;
     let mut sigma_min = f64::INFINITY;
     let mut at_limit = false;
+    // `ws.data` holds the kinematics at `q` after an accepted step; evaluate only otherwise.
+    let mut evaluated = false;
     for it in 0..=settings.max_iterations {
-        forward_kinematics(model, &mut ws.data, params, &q);
+        if !evaluated {
+            forward_kinematics(model, &mut ws.data, params, &q);
+        }
+        evaluated = false;
         let (e, pe, oe) = error(target, ws.data.tool());
         if pe <= settings.position_tolerance && oe <= settings.orientation_tolerance {
             return IkResult {
@@ -210,6 +215,7 @@ pub fn calibrated_ik(
                 q = trial;
                 at_limit = hits_limit;
                 accepted = true;
+                evaluated = true;
                 break;
             }
             g2 = (g2 * 10.0).max(1e-6 * smax * smax);

@@ -2,6 +2,7 @@
 //! calibrated inverse kinematics and program filtering.
 
 pub mod ik;
+pub mod nonparametric;
 pub mod program;
 
 pub use ik::{calibrated_ik, IkResult, IkSettings, IkStatus, IkTarget};
