@@ -17,6 +17,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// The whole workflow on the built-in paper cell: plan, simulate, identify, compensate, evaluate.
+    Demo(commands::demo::Args),
     /// List the built-in robots.
     Robots,
     /// Parameter table, completeness count and identifiability report of a robot or cell.
@@ -50,6 +52,7 @@ fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Robots => commands::robots::run(),
+        Command::Demo(a) => commands::demo::run(&a),
         Command::Model(a) => commands::model::run(&a),
         Command::Fk(a) => commands::fk::run(&a),
         Command::Simulate(a) => commands::simulate::run(&a),

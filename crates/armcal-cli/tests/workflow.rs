@@ -272,3 +272,53 @@ fn axes_from_one_joint_sweeps() {
         "{err}"
     );
 }
+
+#[test]
+fn demo_writes_every_file_and_is_reproducible() {
+    let dir = scratch("demo");
+    let out = dir.join("run");
+    let s = out.to_str().unwrap();
+    let (ok, stdout, err) = armcal(&["demo", "--out", s, "--quiet"]);
+    assert!(ok, "{err}");
+    for needle in [
+        "TCP σ at the working pose, predicted",
+        "held-out error RMS",
+        "compensated",
+        "10 files",
+    ] {
+        assert!(stdout.contains(needle), "{needle}: {stdout}");
+    }
+    let read_all = || {
+        let mut files: Vec<(String, String)> = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .map(|p| {
+                (
+                    p.file_name().unwrap().to_string_lossy().into_owned(),
+                    std::fs::read_to_string(&p).unwrap(),
+                )
+            })
+            .collect();
+        files.sort();
+        files
+    };
+    let first = read_all();
+    assert_eq!(first.len(), 11, "10 files and the marker");
+    let (ok, _, err) = armcal(&["demo", "--out", s, "--quiet"]);
+    assert!(ok, "a demo folder may be rewritten: {err}");
+    assert_eq!(first, read_all(), "same seed → identical files");
+    // The summary comes from the files: the KPI design's predicted TCP σ is in its estimate.
+    let summary: serde_json::Value =
+        serde_json::from_str(&first.iter().find(|f| f.0 == "summary.json").unwrap().1).unwrap();
+    let est: serde_json::Value =
+        serde_json::from_str(&first.iter().find(|f| f.0 == "estimate-kpi.json").unwrap().1)
+            .unwrap();
+    let kpi = est["tcp"][0]["kpi"].as_f64().unwrap();
+    assert!((summary["kpi"]["tcp_sigma_predicted"].as_f64().unwrap() - kpi.sqrt()).abs() < 1e-12);
+    assert!(
+        summary["kpi"]["tcp_sigma_predicted"].as_f64().unwrap()
+            < summary["heuristic"]["tcp_sigma_predicted"]
+                .as_f64()
+                .unwrap()
+    );
+}

@@ -1,4 +1,5 @@
 //! Reproductions of the sources' experiments.
 
+pub mod demo;
 pub mod paper;
 pub mod puma;
