@@ -1,10 +1,9 @@
 //! `armcal accuracy`: ISO 9283 accuracy and repeatability, and the model's errors, from a
 //! data file.
 
-use super::output::load_cell;
+use super::output::{load_cell, load_data};
 use armcal::evaluate::report::accuracy_report;
 use armcal::identify::Estimate;
-use armcal::measure::csv;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -25,11 +24,7 @@ pub struct Args {
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
-    let (data, _) = csv::read(
-        &a.data,
-        model,
-        cell.data_columns.as_ref().map(|d| d.joints.as_slice()),
-    )?;
+    let data = load_data(&cell, &a.data)?;
     let params = match &a.estimate {
         Some(p) => Estimate::from_file(p)?.params_for(model)?,
         None => model.nominal(),

@@ -1,9 +1,9 @@
 //! `armcal axes`: joint-axis identification by circle point analysis (book §4.6) from
 //! one-joint-at-a-time sweeps, compared with the cell's nominal axes.
 
-use super::output::{load_cell, write_new};
+use super::output::{load_cell, load_data, write_new};
 use anyhow::bail;
-use armcal::measure::{csv, MeasurementKind};
+use armcal::measure::MeasurementKind;
 use armcal::model::axes::{identify_axes, JointSweep};
 use armcal::model::{forward_kinematics, Data};
 use armcal::nalgebra::Vector3;
@@ -27,11 +27,7 @@ pub struct Args {
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
-    let (data, _) = csv::read(
-        &a.data,
-        model,
-        cell.data_columns.as_ref().map(|d| d.joints.as_slice()),
-    )?;
+    let data = load_data(&cell, &a.data)?;
     let dof = model.dof();
     let mut sweeps: Vec<JointSweep> = (0..dof)
         .map(|joint| JointSweep {

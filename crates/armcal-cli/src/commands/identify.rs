@@ -1,9 +1,8 @@
 //! `armcal identify`: calibrate the cell's free parameters from a data file.
 
-use super::output::{load_cell, write_new};
+use super::output::{load_cell, load_data, write_new};
 use anyhow::bail;
 use armcal::identify::{identify, Estimate, IdentifyOptions, Loss, Method, Silent};
-use armcal::measure::csv;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -36,14 +35,7 @@ pub struct Args {
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let cell = load_cell(&a.cell)?;
-    let (data, report) = csv::read(
-        &a.data,
-        &cell.model,
-        cell.data_columns.as_ref().map(|d| d.joints.as_slice()),
-    )?;
-    if !report.ignored.is_empty() {
-        eprintln!("note: ignored columns: {}", report.ignored.join(", "));
-    }
+    let data = load_data(&cell, &a.data)?;
     let opts = IdentifyOptions {
         method: Method::from_name(&a.method).expect("clap checked"),
         robust: a.robust.as_deref().and_then(Loss::from_name),

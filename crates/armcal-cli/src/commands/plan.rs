@@ -3,12 +3,10 @@
 
 use super::output::{load_cell, write_new};
 use anyhow::bail;
-use armcal::cell::Cell;
 use armcal::design::assess::assess;
 use armcal::design::plan::{constraint_set, plan, CellConstraints, PlanSettings};
 use armcal::design::Criterion;
 use armcal::measure::csv;
-use armcal::model::JointKind;
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -58,37 +56,6 @@ pub struct EvaluateArgs {
     pub json: bool,
 }
 
-/// CSV of configurations in the data-file joint format.
-pub fn design_csv(cell: &Cell, design: &[Vec<f64>]) -> String {
-    let model = &cell.model;
-    let mut s = String::from("pose_id");
-    for j in &model.joints {
-        s.push_str(&format!(
-            ",{}_{}",
-            j.name,
-            if j.kind == JointKind::Revolute {
-                "deg"
-            } else {
-                "mm"
-            }
-        ));
-    }
-    s.push('\n');
-    for (i, q) in design.iter().enumerate() {
-        s.push_str(&format!("{}", i + 1));
-        for (v, j) in q.iter().zip(&model.joints) {
-            let x = if j.kind == JointKind::Revolute {
-                v.to_degrees()
-            } else {
-                *v
-            };
-            s.push_str(&format!(",{x:.6}"));
-        }
-        s.push('\n');
-    }
-    s
-}
-
 pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
     let cell = load_cell(&a.cell)?;
     let report_path = a
@@ -116,7 +83,11 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         ..PlanSettings::default()
     };
     let rep = plan(&cell, &settings, &measured)?;
-    write_new(&a.out, &design_csv(&cell, &rep.design), a.force)?;
+    write_new(
+        &a.out,
+        &csv::write_configurations(&cell.model, &rep.design),
+        a.force,
+    )?;
     let json = serde_json::json!({
         "cell": cell.name,
         "plan": rep,

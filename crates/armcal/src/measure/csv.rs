@@ -553,3 +553,37 @@ pub fn write_string(data: &Dataset, model: &Model) -> Result<String, Error> {
     let bytes = w.into_inner().map_err(|e| Error::Input(e.to_string()))?;
     String::from_utf8(bytes).map_err(|e| Error::Input(e.to_string()))
 }
+
+/// Writes joint configurations (a pose list, design or joint program): `pose_id` 1, 2, …
+/// and one column per joint, `_deg` for revolute and `_mm` for prismatic joints — the format
+/// [`read_configurations`] reads.
+pub fn write_configurations(model: &Model, qs: &[Vec<f64>]) -> String {
+    let mut s = String::from("pose_id");
+    for j in &model.joints {
+        s.push_str(&format!(
+            ",{}_{}",
+            j.name,
+            if j.kind == JointKind::Revolute {
+                "deg"
+            } else {
+                "mm"
+            }
+        ));
+    }
+    s.push('\n');
+    for (i, q) in qs.iter().enumerate() {
+        s.push_str(&format!("{}", i + 1));
+        for (v, j) in q.iter().zip(&model.joints) {
+            s.push_str(&format!(
+                ",{:.6}",
+                if j.kind == JointKind::Revolute {
+                    v.to_degrees()
+                } else {
+                    *v
+                }
+            ));
+        }
+        s.push('\n');
+    }
+    s
+}

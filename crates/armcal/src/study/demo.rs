@@ -11,7 +11,7 @@ use crate::design::plan::{constraint_set, plan, CellConstraints, PlanSettings};
 use crate::design::DesignModel;
 use crate::identify::{identify, ErrorStats, Estimate, IdentifyOptions, Silent};
 use crate::measure::csv;
-use crate::model::{forward_kinematics, observed_position, Data, JointKind, Model, Observed};
+use crate::model::{forward_kinematics, observed_position, Data, Observed};
 use crate::sim::{perturbed_truth, simulate, Perturbation};
 use crate::Error;
 use serde::{Deserialize, Serialize};
@@ -51,37 +51,6 @@ pub struct Demo {
     pub files: Vec<(String, String)>,
 }
 
-fn design_csv(model: &Model, qs: &[Vec<f64>]) -> String {
-    let mut s = String::from("pose_id");
-    for j in &model.joints {
-        s.push_str(&format!(
-            ",{}_{}",
-            j.name,
-            if j.kind == JointKind::Revolute {
-                "deg"
-            } else {
-                "mm"
-            }
-        ));
-    }
-    s.push('\n');
-    for (i, q) in qs.iter().enumerate() {
-        s.push_str(&format!("{}", i + 1));
-        for (v, j) in q.iter().zip(&model.joints) {
-            s.push_str(&format!(
-                ",{:.6}",
-                if j.kind == JointKind::Revolute {
-                    v.to_degrees()
-                } else {
-                    *v
-                }
-            ));
-        }
-        s.push('\n');
-    }
-    s
-}
-
 /// Runs the demo; `progress` receives a short label before each stage.
 pub fn run_demo(seed: u64, progress: &dyn Fn(&str)) -> Result<Demo, Error> {
     let cell =
@@ -113,8 +82,14 @@ pub fn run_demo(seed: u64, progress: &dyn Fn(&str)) -> Result<Demo, Error> {
     let (heuristic, _) = random_feasible(model, poses, seed.wrapping_add(1), 2_000_000, |q| {
         cons.feasible(q)
     })?;
-    files.push(("design-kpi.csv".into(), design_csv(model, &report.design)));
-    files.push(("design-heuristic.csv".into(), design_csv(model, &heuristic)));
+    files.push((
+        "design-kpi.csv".into(),
+        csv::write_configurations(model, &report.design),
+    ));
+    files.push((
+        "design-heuristic.csv".into(),
+        csv::write_configurations(model, &heuristic),
+    ));
 
     // Held-out configurations: feasible poses not in either design.
     let (held_out, _) = random_feasible(model, 100, seed.wrapping_add(2), 2_000_000, |q| {
@@ -220,14 +195,14 @@ pub fn run_demo(seed: u64, progress: &dyn Fn(&str)) -> Result<Demo, Error> {
     }
     files.push((
         "program.csv".into(),
-        design_csv(
+        csv::write_configurations(
             model,
             &program.iter().map(|p| p.1.clone()).collect::<Vec<_>>(),
         ),
     ));
     files.push((
         "program-corrected.csv".into(),
-        design_csv(
+        csv::write_configurations(
             model,
             &rows.iter().map(|r| r.result.q.clone()).collect::<Vec<_>>(),
         ),
