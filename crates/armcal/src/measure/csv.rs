@@ -136,6 +136,20 @@ fn joint_layout(
     Ok(joints)
 }
 
+/// A trimming CSV reader over `text` and its header.
+fn reader<'t>(text: &'t str, file: &str) -> Result<(csv::Reader<&'t [u8]>, Vec<String>), Error> {
+    let mut rdr = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    let header = rdr
+        .headers()
+        .map_err(|e| err(file, format!("header: {e}")))?
+        .iter()
+        .map(str::to_string)
+        .collect();
+    Ok((rdr, header))
+}
+
 /// Parses the joint values of one record (internal units), with line and column in errors.
 fn record_joints(
     record: &csv::StringRecord,
@@ -203,15 +217,7 @@ pub fn read_configurations_str(
     model: &Model,
     joint_columns: Option<&[String]>,
 ) -> Result<Vec<(String, Vec<f64>)>, Error> {
-    let mut rdr = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_reader(text.as_bytes());
-    let header: Vec<String> = rdr
-        .headers()
-        .map_err(|e| err(file, format!("header: {e}")))?
-        .iter()
-        .map(str::to_string)
-        .collect();
+    let (mut rdr, header) = reader(text, file)?;
     let mut used = vec![false; header.len()];
     let joints = joint_layout(&header, model, joint_columns, file, &mut used)?;
     let id_col = header.iter().position(|h| h == "pose_id");
@@ -251,15 +257,7 @@ pub fn read_str(
     model: &Model,
     joint_columns: Option<&[String]>,
 ) -> Result<(Dataset, ReadReport), Error> {
-    let mut rdr = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_reader(text.as_bytes());
-    let header: Vec<String> = rdr
-        .headers()
-        .map_err(|e| err(file, format!("header: {e}")))?
-        .iter()
-        .map(str::to_string)
-        .collect();
+    let (mut rdr, header) = reader(text, file)?;
     let find = |name: &str| header.iter().position(|h| h == name);
     let mut used = vec![false; header.len()];
 

@@ -55,6 +55,19 @@ fn link_toml(out: &mut String, table: &str, l: &LinkSpec, with_convention: bool)
     out.push('\n');
 }
 
+/// `xyz_mm` and `rpy_deg` lines of a frame6 (x, y, z in mm, rx, ry, rz in rad).
+fn frame_fields(v: &[f64]) -> String {
+    format!(
+        "xyz_mm = [{:?}, {:?}, {:?}]\nrpy_deg = [{:?}, {:?}, {:?}]\n",
+        v[0],
+        v[1],
+        v[2],
+        v[3].to_degrees(),
+        v[4].to_degrees(),
+        v[5].to_degrees()
+    )
+}
+
 /// A cell file holding the model as inline links (every convention the cell format reads),
 /// the instrument frame and the targets. Values are written with full precision.
 pub fn to_cell_toml(spec: &ModelSpec) -> Result<String, Error> {
@@ -72,17 +85,11 @@ pub fn to_cell_toml(spec: &ModelSpec) -> Result<String, Error> {
                 i.name
             )));
         }
-        let v = &i.geometry.values;
         let _ = writeln!(
             out,
-            "[instrument]\nname = \"{}\"\nxyz_mm = [{:?}, {:?}, {:?}]\nrpy_deg = [{:?}, {:?}, {:?}]\n",
+            "[instrument]\nname = \"{}\"\n{}",
             i.name,
-            v[0],
-            v[1],
-            v[2],
-            v[3].to_degrees(),
-            v[4].to_degrees(),
-            v[5].to_degrees()
+            frame_fields(&i.geometry.values)
         );
     }
     for t in &spec.targets {
@@ -98,14 +105,9 @@ pub fn to_cell_toml(spec: &ModelSpec) -> Result<String, Error> {
             Convention::Frame6 => {
                 let _ = writeln!(
                     out,
-                    "[[targets]]\nname = \"{}\"\nxyz_mm = [{:?}, {:?}, {:?}]\nrpy_deg = [{:?}, {:?}, {:?}]\n",
+                    "[[targets]]\nname = \"{}\"\n{}",
                     t.name,
-                    v[0],
-                    v[1],
-                    v[2],
-                    v[3].to_degrees(),
-                    v[4].to_degrees(),
-                    v[5].to_degrees()
+                    frame_fields(v)
                 );
             }
             c => {
