@@ -14,6 +14,7 @@ pub mod geometry;
 pub mod identify;
 pub mod measure;
 pub mod model;
+pub mod report;
 pub mod robots;
 pub mod sim;
 pub mod study;
