@@ -43,6 +43,8 @@ enum Command {
     Axes(commands::axes::Args),
     /// Export the calibrated model (cell file with DH / modified-DH / zero-reference links, JSON, URDF).
     Export(commands::export::Args),
+    /// A self-contained HTML report (inline SVG figures, 3D cell view) of estimates, designs and studies.
+    Report(commands::report::Args),
     /// Reproduce a source's experiment (`paper`: Jost et al. 2017, Tables 6–8; `puma`: the
     /// book's Chapter 6 PUMA 560 calibration, Tables 6.9/6.10 and 6.13).
     Study(commands::study::Args),
@@ -61,6 +63,7 @@ fn main() {
         Command::Plan(a) => commands::plan::run_plan(&a),
         Command::Evaluate(a) => commands::plan::run_evaluate(&a),
         Command::Study(a) => commands::study::run_study(&a),
+        Command::Report(a) => commands::report::run(&a),
         Command::Export(a) => commands::export::run(&a),
         Command::Compensate(a) => commands::compensate::run(&a),
         Command::Accuracy(a) => commands::accuracy::run(&a),

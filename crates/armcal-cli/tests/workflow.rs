@@ -284,7 +284,8 @@ fn demo_writes_every_file_and_is_reproducible() {
         "TCP σ at the working pose, predicted",
         "held-out error RMS",
         "compensated",
-        "10 files",
+        "13 files",
+        "report.html",
     ] {
         assert!(stdout.contains(needle), "{needle}: {stdout}");
     }
@@ -303,7 +304,40 @@ fn demo_writes_every_file_and_is_reproducible() {
         files
     };
     let first = read_all();
-    assert_eq!(first.len(), 11, "10 files and the marker");
+    assert_eq!(first.len(), 14, "13 files and the marker");
+    // The report is among the compared files: one self-contained page whose figure count
+    // matches its inline SVGs, with the 3D view of both designs.
+    let html = &first.iter().find(|f| f.0 == "report.html").unwrap().1;
+    let figures = html.matches("<svg").count();
+    assert!(
+        html.contains(&format!(
+            "<meta name=\"armcal-figures\" content=\"{figures}\">"
+        )),
+        "{figures} figures"
+    );
+    assert!(figures >= 12, "{figures}");
+    assert!(!html.contains("http://") && !html.contains("https://"));
+    assert!(html.contains("class=\"cell-view\"") && html.contains("heuristic design"));
+    // `armcal report` on the demo's JSON files gives the same sections and figures.
+    let mut args = vec!["report".to_string()];
+    args.extend(
+        first
+            .iter()
+            .filter(|f| f.0.ends_with(".json"))
+            .map(|f| out.join(&f.0).to_str().unwrap().to_string()),
+    );
+    args.extend([
+        "--out".into(),
+        dir.join("rep").to_str().unwrap().to_string(),
+    ]);
+    let (ok, stdout, err) = armcal(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(ok, "{err}");
+    assert!(
+        stdout.contains(&format!("({figures} figures, 3D view")),
+        "{stdout}"
+    );
+    let again = std::fs::read_to_string(dir.join("rep").join("report.html")).unwrap();
+    assert!(again.contains("Summary: KPI design vs heuristic design"));
     let (ok, _, err) = armcal(&["demo", "--out", s, "--quiet"]);
     assert!(ok, "a demo folder may be rewritten: {err}");
     assert_eq!(first, read_all(), "same seed → identical files");
@@ -321,4 +355,113 @@ fn demo_writes_every_file_and_is_reproducible() {
                 .as_f64()
                 .unwrap()
     );
+}
+
+#[test]
+fn report_from_identify_and_plan_files() {
+    let dir = scratch("report");
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let (data, est, design) = (
+        dir.join("data.csv"),
+        dir.join("est.json"),
+        dir.join("design.csv"),
+    );
+    for args in [
+        vec![
+            "simulate",
+            "--cell",
+            "examples/paper-cell.toml",
+            "--poses",
+            "examples/paper-poses-random-60.csv",
+            "--seed",
+            "4",
+            "--out",
+            &s(&data),
+        ],
+        vec![
+            "identify",
+            "--cell",
+            "examples/paper-cell.toml",
+            "--data",
+            &s(&data),
+            "--holdout",
+            "0.3",
+            "--out",
+            &s(&est),
+        ],
+        vec![
+            "plan",
+            "--cell",
+            "examples/paper-cell.toml",
+            "--poses",
+            "30",
+            "--starts",
+            "1",
+            "--out",
+            &s(&design),
+        ],
+    ] {
+        let (ok, _, err) = armcal(&args);
+        assert!(ok, "{args:?}: {err}");
+    }
+    let out = dir.join("report");
+    let design_json = dir.join("design.json");
+    let report = ["report", &s(&est), &s(&design_json), "--out", &s(&out)];
+    let (ok, stdout, err) = armcal(&report);
+    assert!(ok, "{err}");
+    assert!(
+        stdout.contains("report →") && stdout.contains("3D view"),
+        "{stdout}"
+    );
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let figures = html.matches("<svg").count();
+    // TCP ellipses (3), design joints and clearances (2), residual histograms, per-pose
+    // residuals and held-out bars (3).
+    assert_eq!(figures, 8, "{stdout}");
+    assert!(html.contains("<meta name=\"armcal-figures\" content=\"8\">"));
+    assert!(!html.contains("http://") && !html.contains("https://"));
+    for needle in [
+        "Estimate: est",
+        "Design: design",
+        "TCP precision at the working pose",
+        "Held-out validation",
+        "optimality bound",
+        "class=\"cell-view\"",
+    ] {
+        assert!(html.contains(needle), "{needle}");
+    }
+    // Never overwritten without --force.
+    let (ok, _, err) = armcal(&report);
+    assert!(
+        !ok && err.contains("exists") && err.contains("--force"),
+        "{err}"
+    );
+    let mut forced = report.to_vec();
+    forced.push("--force");
+    let (ok, _, err) = armcal(&forced);
+    assert!(ok, "{err}");
+    assert_eq!(
+        html,
+        std::fs::read_to_string(out.join("report.html")).unwrap()
+    );
+    // Files armcal did not write are refused with the file name and what was expected.
+    let other = dir.join("other.json");
+    std::fs::write(&other, r#"{"hello": 1, "world": [2]}"#).unwrap();
+    for (file, needle) in [
+        (
+            s(&other),
+            "not an armcal result (top-level fields: hello, world)",
+        ),
+        (s(&data), "not JSON"),
+    ] {
+        let (ok, _, err) = armcal(&["report", &file, "--out", &s(&dir.join("r2"))]);
+        assert!(!ok, "{file}");
+        assert!(
+            err.contains(&file)
+                && err.contains(needle)
+                && err.contains("expected an armcal estimate"),
+            "{err}"
+        );
+    }
+    assert!(!dir.join("r2").join("report.html").exists());
 }

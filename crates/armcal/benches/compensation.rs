@@ -1,9 +1,13 @@
-//! Calibrated inverse kinematics: full-pose solves of the paper robot from a seed within
-//! 3° per joint (as from a nominal solution).
+//! Calibrated inverse kinematics of the paper robot with a perturbed (calibrated) model, full
+//! tool poses, single thread:
+//!
+//! * random reachable targets, each seeded from the nominal closed form (the branch nearest a
+//!   fixed home configuration; the closed-form solve is part of the timing);
+//! * a program path of nearby targets (≈ 1° per joint between rows), each seeded from the
+//!   previous row's solution, as in program filtering.
 
 use armcal::cell::Cell;
-use armcal::compensate::ik::IkWorkspace;
-use armcal::compensate::{calibrated_ik, IkSettings, IkTarget};
+use armcal::compensate::{CalibratedIk, IkSettings, IkTarget};
 use armcal::model::identifiability::random_configurations;
 use armcal::model::{forward_kinematics, Data};
 use armcal::sim::{perturbed_truth, Perturbation};
@@ -14,6 +18,7 @@ const CELL: &str = include_str!("../../../examples/paper-cell.toml");
 fn ik(c: &mut Criterion) {
     let cell = Cell::from_toml(CELL, "paper-cell.toml", std::path::Path::new(".")).expect("cell");
     let model = &cell.model;
+    let nominal = model.nominal();
     let calibrated = perturbed_truth(
         model,
         &Perturbation {
@@ -22,29 +27,52 @@ fn ik(c: &mut Criterion) {
         },
         3,
     );
-    let qs = random_configurations(model, 1000, 4);
     let mut data = Data::new(model);
-    let cases: Vec<(IkTarget, Vec<f64>)> = qs
+    let mut pose_at = |q: &[f64]| {
+        forward_kinematics(model, &mut data, &calibrated, q);
+        IkTarget::Pose(*data.tool())
+    };
+    let random: Vec<IkTarget> = random_configurations(model, 1000, 4)
         .iter()
-        .enumerate()
-        .map(|(i, q)| {
-            forward_kinematics(model, &mut data, &calibrated, q);
-            let seed = q
-                .iter()
-                .enumerate()
-                .map(|(j, x)| x + 0.05 * (((i * 7 + j * 13) % 11) as f64 / 5.0 - 1.0))
-                .collect();
-            (IkTarget::Pose(*data.tool()), seed)
+        .map(|q| pose_at(q))
+        .collect();
+    // A path: from a random start, every joint moves by up to ±1° per row, kept inside the
+    // limits.
+    let start = random_configurations(model, 1, 5).remove(0);
+    let steps = random_configurations(model, 1000, 6);
+    let mut q = start.clone();
+    let path: Vec<IkTarget> = steps
+        .iter()
+        .map(|s| {
+            for (k, j) in model.joints.iter().enumerate() {
+                let u = (s[k] - j.lower) / (j.upper - j.lower) * 2.0 - 1.0;
+                q[k] = (q[k] + u * 1f64.to_radians()).clamp(j.lower + 0.1, j.upper - 0.1);
+            }
+            pose_at(&q)
         })
         .collect();
-    let settings = IkSettings::default();
-    let mut ws = IkWorkspace::new(model);
+    let home: Vec<f64> = model
+        .joints
+        .iter()
+        .map(|j| 0.5 * (j.lower + j.upper))
+        .collect();
+    let mut ik = CalibratedIk::new(model, &nominal, &calibrated, IkSettings::default());
     let mut group = c.benchmark_group("calibrated IK");
-    group.throughput(Throughput::Elements(cases.len() as u64));
-    group.bench_function("1000 full-pose solves", |b| {
+    group.throughput(Throughput::Elements(1000));
+    group.bench_function("1000 random poses, closed-form seed", |b| {
         b.iter(|| {
-            for (t, s) in &cases {
-                std::hint::black_box(calibrated_ik(model, &calibrated, t, s, &settings, &mut ws));
+            for t in &random {
+                std::hint::black_box(ik.solve(t, &home));
+            }
+        })
+    });
+    group.bench_function("1000-row path, previous-row seed", |b| {
+        b.iter(|| {
+            let mut seed = start.clone();
+            for t in &path {
+                let r = ik.solve_from(t, &seed);
+                seed.copy_from_slice(&r.q);
+                std::hint::black_box(r);
             }
         })
     });

@@ -46,11 +46,11 @@ fn kinematics(c: &mut Criterion) {
             black_box(&data.targets[0]);
         })
     });
-    let mut ws = MixedWorkspace::new(model, Rows::Position, columns.len());
+    let mut ws = MixedWorkspace::new(model);
     let mut value = DMatrix::zeros(3, columns.len());
     let mut dq = vec![DMatrix::zeros(3, columns.len()); 6];
     c.bench_function(
-        "mixed derivative dJ/dq (6 joints × 3 × 27, dual numbers)",
+        "mixed derivative dJ/dq (6 joints × 3 × 27, analytic)",
         |b| {
             b.iter(|| {
                 identification_jacobian_dq(

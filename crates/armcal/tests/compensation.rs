@@ -1,15 +1,19 @@
-//! Calibrated inverse kinematics on 10 000 random reachable poses, and the closed loop:
+//! Closed-form nominal IK on every branch, calibrated inverse kinematics from its seed on
+//! 10 000 random reachable poses, per-row statuses for bad targets, and the closed loop:
 //! identify a truth robot, filter a program, and execute it on the truth.
 
 use armcal::cell::Cell;
-use armcal::compensate::ik::IkWorkspace;
-use armcal::compensate::program::filter_joint_program;
-use armcal::compensate::{calibrated_ik, IkSettings, IkStatus, IkTarget};
+use armcal::compensate::closed_form::SphericalWristIk;
+use armcal::compensate::program::{corrected_cartesian_targets, filter_joint_program};
+use armcal::compensate::{CalibratedIk, IkSettings, IkStatus, IkTarget};
 use armcal::identify::{identify, IdentifyOptions, Silent};
 use armcal::model::identifiability::random_configurations;
-use armcal::model::{forward_kinematics, Data};
+use armcal::model::pose::rotation_log;
+use armcal::model::{forward_kinematics, Data, Model, Pose};
+use armcal::robots;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use rand::{Rng, SeedableRng};
+use std::f64::consts::PI;
 use std::path::Path;
 
 fn paper_cell() -> Cell {
@@ -17,8 +21,78 @@ fn paper_cell() -> Cell {
         .unwrap()
 }
 
+/// Largest joint difference modulo 2π.
+fn angle_gap(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| {
+            let d = (x - y).rem_euclid(2.0 * PI);
+            d.min(2.0 * PI - d)
+        })
+        .fold(0.0, f64::max)
+}
+
 #[test]
-fn calibrated_ik_reaches_10000_random_poses() {
+fn closed_form_reproduces_random_poses_on_every_branch() {
+    for name in ["paper-650-600", "kr15", "kr300", "kr500", "puma560"] {
+        let model = Model::from_spec(&robots::robot(name).unwrap().spec).unwrap();
+        let nominal = model.nominal();
+        let cf = SphericalWristIk::new(&model, &nominal).unwrap();
+        let mut data = Data::new(&model);
+        let zero = [0.0; 6];
+        let (mut branches, mut within, mut worst_mm, mut worst_rad, mut worst_match) =
+            (0, 0, 0.0f64, 0.0f64, 0.0f64);
+        let qs = random_configurations(&model, 1000, 31);
+        for q in &qs {
+            forward_kinematics(&model, &mut data, &nominal, q);
+            let target = *data.tool();
+            let solutions = cf.solve(&target, &zero);
+            assert!(!solutions.as_slice().is_empty(), "{name}: {q:?}");
+            for b in solutions.as_slice().iter().filter(|b| b.reach_miss == 0.0) {
+                forward_kinematics(&model, &mut data, &nominal, &b.q);
+                worst_mm = worst_mm.max((data.tool().trans - target.trans).norm());
+                worst_rad =
+                    worst_rad.max(rotation_log(&(data.tool().rot * target.rot.transpose())).norm());
+                branches += 1;
+                within += usize::from(b.within_limits);
+            }
+            // The generating configuration is one of the branches, and the branch nearest
+            // it is itself.
+            let gap = solutions
+                .as_slice()
+                .iter()
+                .filter(|b| b.reach_miss == 0.0)
+                .map(|b| angle_gap(&b.q, q))
+                .fold(f64::INFINITY, f64::min);
+            worst_match = worst_match.max(gap);
+            let nearest = cf.solve(&target, q).nearest(q).unwrap();
+            assert!(nearest.within_limits);
+            assert!(
+                angle_gap(&nearest.q, q) < 1e-6,
+                "{name}: {nearest:?} vs {q:?}"
+            );
+        }
+        eprintln!(
+            "closed form {name}: 1000 poses, {branches} exact branches ({within} within limits), \
+             worst position {worst_mm:.1e} mm, orientation {worst_rad:.1e} rad, generating q \
+             found to {worst_match:.1e} rad"
+        );
+        assert!(worst_mm < 1e-9, "{name}: {worst_mm}");
+        assert!(worst_rad < 1e-9, "{name}: {worst_rad}");
+        assert!(worst_match < 1e-6, "{name}: {worst_match}");
+        assert!(branches >= 4 * qs.len(), "{name}: {branches}");
+    }
+    // No spherical wrist: the UR10 has no closed form of this kind, with the reason.
+    let ur = Model::from_spec(&robots::robot("ur10").unwrap().spec).unwrap();
+    let err = SphericalWristIk::new(&ur, &ur.nominal()).unwrap_err();
+    assert!(
+        err.to_string().contains("axes 4, 5, 6 do not meet"),
+        "{err}"
+    );
+}
+
+#[test]
+fn calibrated_ik_from_closed_form_seed_reaches_10000_random_poses() {
     let cell = paper_cell();
     let model = &cell.model;
     let calibrated = perturbed_truth(
@@ -30,38 +104,122 @@ fn calibrated_ik_reaches_10000_random_poses() {
         3,
     );
     let qs = random_configurations(model, 10_000, 4);
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
     let mut data = Data::new(model);
-    let mut ws = IkWorkspace::new(model);
-    let settings = IkSettings::default();
-    let (mut converged, mut singular, mut other) = (0, 0, 0);
+    let mut ik = CalibratedIk::new(model, &model.nominal(), &calibrated, IkSettings::default());
+    assert!(ik.closed_form().is_ok());
+    // The branch is chosen nearest a fixed home configuration (the middle of the joint
+    // ranges), not the generating one: the seed knows nothing of the answer.
+    let home: Vec<f64> = model
+        .joints
+        .iter()
+        .map(|j| 0.5 * (j.lower + j.upper))
+        .collect();
+    let (mut converged, mut singular, mut limits, mut other) = (0, 0, 0, 0);
+    let (mut worst_mm, mut worst_rad, mut iterations) = (0.0f64, 0.0f64, 0);
     for q in &qs {
         forward_kinematics(model, &mut data, &calibrated, q);
         let target = IkTarget::Pose(*data.tool());
-        // Seed: the configuration disturbed by up to 3° per joint (a nominal solution).
-        let seed: Vec<f64> = q
-            .iter()
-            .map(|x| x + rng.random_range(-0.05..0.05))
-            .collect();
-        let r = calibrated_ik(model, &calibrated, &target, &seed, &settings, &mut ws);
+        let r = ik.solve(&target, &home);
         match r.status {
             IkStatus::Converged => {
                 converged += 1;
-                assert!(
-                    r.position_error < 1e-3 && r.orientation_error < 1e-6,
-                    "{r:?}"
-                );
+                iterations += r.iterations;
+                // Independent check of the residual.
+                forward_kinematics(model, &mut data, &calibrated, &r.q);
+                let IkTarget::Pose(t) = target else {
+                    unreachable!()
+                };
+                worst_mm = worst_mm.max((data.tool().trans - t.trans).norm());
+                worst_rad =
+                    worst_rad.max(rotation_log(&(data.tool().rot * t.rot.transpose())).norm());
+                model.check_joints(&r.q).unwrap();
             }
             IkStatus::Singular => singular += 1,
+            IkStatus::JointLimits => limits += 1,
             _ => other += 1,
         }
     }
-    eprintln!("IK: {converged} converged, {singular} near a singularity, {other} other of 10 000");
-    assert!(converged >= 9_900, "{converged}");
-    assert!(
-        other <= 20,
-        "{other} solves ended neither converged nor at a reported singularity"
+    eprintln!(
+        "IK from the closed-form seed: {converged} converged (worst {worst_mm:.1e} mm, \
+         {worst_rad:.1e} rad, {:.2} iterations on average), {singular} near a singularity, \
+         {limits} at joint limits, {other} other of 10 000",
+        iterations as f64 / converged as f64
     );
+    assert!(worst_mm < 1e-3 && worst_rad < 1e-6);
+    assert!(converged >= 9_990, "{converged}");
+    assert!(
+        other == 0,
+        "{other} solves ended neither converged nor at a reported singularity or limit"
+    );
+}
+
+#[test]
+fn bad_targets_get_a_specific_row_status() {
+    let cell = paper_cell();
+    let model = &cell.model;
+    let nominal = model.nominal();
+    let calibrated = perturbed_truth(model, &Perturbation::default(), 12);
+    let settings = IkSettings::default();
+    let deg = |q: [f64; 6]| q.map(f64::to_radians).to_vec();
+    let program = vec![
+        ("ok".to_string(), deg([0.0, -30.0, 60.0, 0.0, -60.0, 0.0])),
+        // q5 beyond its 87° limit.
+        ("q5".to_string(), deg([0.0, -30.0, 60.0, 0.0, 100.0, 0.0])),
+        // q1 a whole turn beyond its 82° limit: the same pose as q1 = 10°.
+        (
+            "turn".to_string(),
+            deg([370.0, -30.0, 60.0, 0.0, -60.0, 0.0]),
+        ),
+    ];
+    let rows = filter_joint_program(model, &nominal, &calibrated, &program, &settings);
+    assert_eq!(rows[0].result.status, IkStatus::Converged);
+    assert_eq!(rows[0].result.describe(model), "converged");
+    let r = &rows[1].result;
+    assert_eq!(r.status, IkStatus::JointLimits, "{r:?}");
+    let text = r.describe(model);
+    assert!(
+        text.starts_with("joint-limits: q5 = 99.9") && text.ends_with("> 87.000 deg"),
+        "{text}"
+    );
+    // The returned joints stay within the limits.
+    model.check_joints(&r.q).unwrap();
+    let r = &rows[2].result;
+    assert_eq!(r.status, IkStatus::Converged, "{r:?}");
+    assert!((r.q[0].to_degrees() - 10.0).abs() < 0.5, "{r:?}");
+
+    // Cartesian targets: one 5 m away, one reachable, one not a number.
+    let mut data = Data::new(model);
+    forward_kinematics(model, &mut data, &calibrated, &program[0].1);
+    let far = Pose::from_xyz_rpy([5000.0, 0.0, 0.0], [0.0; 3]);
+    let nan = Pose::from_xyz_rpy([f64::NAN, 0.0, 0.0], [0.0; 3]);
+    let home = vec![0.0; 6];
+    let out = corrected_cartesian_targets(
+        model,
+        &nominal,
+        &calibrated,
+        &[far, *data.tool(), nan],
+        &[home.clone(), home.clone(), home],
+        &settings,
+        None,
+    );
+    let r = &out[0].result;
+    assert_eq!(r.status, IkStatus::Unreachable, "{r:?}");
+    let text = r.describe(model);
+    assert!(text.starts_with("unreachable: residual "), "{text}");
+    assert!(r.position_error > 1000.0, "{r:?}");
+    assert_eq!(out[1].result.status, IkStatus::Converged);
+    assert_ne!(out[2].result.status, IkStatus::Converged);
+
+    // A position-only target (3 task rows, redundant): solved from the reference joints.
+    let mut ik = CalibratedIk::new(model, &nominal, &calibrated, settings.clone());
+    let p = data.tool().trans;
+    let r = ik.solve(
+        &IkTarget::Position(p),
+        &deg([5.0, -25.0, 55.0, 5.0, -55.0, 5.0]),
+    );
+    assert_eq!(r.status, IkStatus::Converged, "{r:?}");
+    forward_kinematics(model, &mut data, &calibrated, &r.q);
+    assert!((data.tool().trans - p).norm() < 1e-6);
 }
 
 #[test]
@@ -122,8 +280,8 @@ fn closed_loop_filtered_program_hits_targets_within_predicted_uncertainty() {
 fn damping_keeps_wrist_corrections_bounded_near_the_wrist_singularity() {
     // Book Table 5.7 (check 9): at θ5 = −1°, a small pose correction with γ → 0 asks for
     // large, opposite motions of joints 4 and 6; damping keeps them small.
-    use armcal::compensate::ik::{damped_step, task_jacobian};
-    use nalgebra::{DVector, Vector3};
+    use armcal::compensate::ik::{damped_step, task_jacobian_columns};
+    use nalgebra::{Vector3, Vector6};
     let cell = paper_cell();
     let model = &cell.model;
     let p = model.nominal();
@@ -131,20 +289,23 @@ fn damping_keeps_wrist_corrections_bounded_near_the_wrist_singularity() {
     let mut data = Data::new(model);
     forward_kinematics(model, &mut data, &p, &q);
     let length = 1000.0;
-    let j = task_jacobian(&data, 6, length);
+    let mut j = [Vector6::zeros(); 6];
+    task_jacobian_columns(&data, length, &mut j);
     // A correction of 0.5 mm and 0.2° about the world x axis (perpendicular to the wrist).
     let w = Vector3::new(0.2f64.to_radians(), 0.0, 0.0);
-    let e = DVector::from_vec(vec![
-        0.5,
-        0.0,
-        0.0,
-        w[0] * length,
-        w[1] * length,
-        w[2] * length,
-    ]);
-    let (jtj, jte) = (j.tr_mul(&j), j.tr_mul(&e));
-    let undamped = damped_step(&jtj, &jte, 1e-12).unwrap();
-    let damped = damped_step(&jtj, &jte, 1e4).unwrap();
+    let e = Vector6::new(0.5, 0.0, 0.0, w[0] * length, w[1] * length, w[2] * length);
+    let (mut undamped, mut damped) = ([0.0; 6], [0.0; 6]);
+    assert!(damped_step(&j, &e, 1e-12, &mut undamped));
+    assert!(damped_step(&j, &e, 1e4, &mut damped));
+    // The task-space step equals the joint-space one, (JᵀJ + γ²I)⁻¹ Jᵀ e.
+    let jm = nalgebra::Matrix6::from_columns(&j);
+    let joint_space = (jm.transpose() * jm + nalgebra::Matrix6::identity() * 1e4)
+        .cholesky()
+        .unwrap()
+        .solve(&(jm.transpose() * e));
+    for k in 0..6 {
+        assert!((joint_space[k] - damped[k]).abs() < 1e-9 * (1.0 + joint_space[k].abs()));
+    }
     let deg = |v: f64| v.to_degrees().abs();
     eprintln!(
         "θ5 = −1°: Δθ4 = {:.2}°, Δθ6 = {:.2}° undamped; {:.3}°, {:.3}° damped",

@@ -38,7 +38,7 @@ fn bound_is_below_every_design_and_efficiency_is_high_for_optimised_designs() {
             &hi,
             None,
             &RefineSettings {
-                max_inner_iterations: 800,
+                max_iterations: 800,
                 ..Default::default()
             },
         )

@@ -1,13 +1,16 @@
 //! `armcal compensate`: filter a nominal joint program (or Cartesian targets) through the
-//! calibrated model.
+//! calibrated model, optionally with a nonparametric correction of the error it leaves
+//! (book §5.4).
 
-use super::output::{load_cell, write_new};
+use super::output::{load_cell, load_data, write_new};
 use anyhow::bail;
-use armcal::compensate::program::{corrected_cartesian_targets, filter_joint_program};
-use armcal::compensate::{IkResult, IkSettings};
+use armcal::compensate::nonparametric::{CorrectionInputs, ResidualCorrection};
+use armcal::compensate::program::{corrected_cartesian_targets, filter_joint_program_corrected};
+use armcal::compensate::{IkResult, IkSettings, IkStatus};
 use armcal::identify::Estimate;
 use armcal::measure::{csv, MeasurementKind};
 use armcal::model::{JointKind, Model, Pose};
+use armcal::nalgebra::Vector3;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -28,6 +31,20 @@ pub struct Args {
     pub out: PathBuf,
     #[arg(long)]
     pub force: bool,
+    /// Calibration data (CSV, as for `identify`) on which to fit a polynomial correction of
+    /// the position error the calibrated model leaves (measured − predicted, book §5.4); the
+    /// targets are then shifted by its prediction and the output gets `correction_*_mm`
+    /// columns (the shift applied to each target, world frame).
+    #[arg(long, value_name = "DATA.csv")]
+    pub nonparametric: Option<PathBuf>,
+    /// Total degree of the correction polynomials.
+    #[arg(long, default_value_t = 3, requires = "nonparametric")]
+    pub degree: usize,
+    /// What the correction is a function of: `arm-joints` (q1…q3: the configuration sets the
+    /// non-geometric errors, and the same TCP position in another configuration has another
+    /// error), `joints` (all joints) or `position` (TCP position, world frame).
+    #[arg(long, default_value = "arm-joints", value_parser = ["arm-joints", "joints", "position"], requires = "nonparametric")]
+    pub nonparametric_inputs: String,
 }
 
 fn joints_header(model: &Model) -> String {
@@ -66,16 +83,24 @@ fn joint_values(model: &Model, q: &[f64]) -> String {
         .join(",")
 }
 
-fn status_columns(r: &IkResult) -> String {
+/// Status (with the joint and limit, or the residual, for a row that did not converge) and
+/// residual columns.
+fn status_columns(model: &Model, r: &IkResult) -> String {
     format!(
         "{},{:.9},{:.9}",
-        serde_json::to_value(r.status)
-            .ok()
-            .and_then(|v| v.as_str().map(String::from))
-            .unwrap_or_default(),
+        r.describe(model),
         r.position_error,
         r.orientation_error.to_degrees()
     )
+}
+
+/// `correction_x_mm,…,` columns (empty without a correction).
+fn correction_columns(c: &Vector3<f64>, with: bool) -> String {
+    if with {
+        format!("{:.6},{:.6},{:.6},", c.x, c.y, c.z)
+    } else {
+        String::new()
+    }
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
@@ -89,6 +114,36 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let cartesian = header.split(',').any(|h| h.trim().starts_with("roll"));
     let program =
         csv::read_configurations_str(&text, &a.targets.display().to_string(), model, None)?;
+    let correction = match &a.nonparametric {
+        Some(path) => {
+            let data = load_data(&cell, path)?;
+            let inputs = match a.nonparametric_inputs.as_str() {
+                "joints" => CorrectionInputs::Joints,
+                "position" => CorrectionInputs::Position,
+                _ => CorrectionInputs::ArmJoints,
+            };
+            let c = ResidualCorrection::fit(model, &calibrated, &data, inputs, a.degree)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+            println!(
+                "nonparametric correction ({}, degree {}, {} terms): position error RMS on {} \
+                 {:.4} mm → {:.4} mm after the fit",
+                a.nonparametric_inputs,
+                a.degree,
+                c.polynomial.basis.len(),
+                path.display(),
+                c.polynomial.training_rms_before,
+                c.polynomial.training_rms
+            );
+            Some(c)
+        }
+        None => None,
+    };
+    let with = correction.is_some();
+    let correction_header = if with {
+        "correction_x_mm,correction_y_mm,correction_z_mm,"
+    } else {
+        ""
+    };
     let mut out = String::new();
     let mut failed = 0;
     if cartesian {
@@ -114,38 +169,57 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
             .iter()
             .map(|m| data.configurations[m.config].clone())
             .collect();
-        let rows =
-            corrected_cartesian_targets(model, &nominal, &calibrated, &poses, &seeds, &settings);
-        out.push_str(&format!("pose_id,{},x_mm,y_mm,z_mm,roll_deg,pitch_deg,yaw_deg,status,position_error_mm,orientation_error_deg\n", joints_header(model)));
-        for (i, (pose, r)) in rows.iter().enumerate() {
-            let (xyz, rpy) = pose.to_xyz_rpy();
-            failed += usize::from(r.status != armcal::compensate::IkStatus::Converged);
+        let rows = corrected_cartesian_targets(
+            model,
+            &nominal,
+            &calibrated,
+            &poses,
+            &seeds,
+            &settings,
+            correction.as_ref(),
+        );
+        out.push_str(&format!(
+            "pose_id,{},x_mm,y_mm,z_mm,roll_deg,pitch_deg,yaw_deg,{correction_header}status,position_error_mm,orientation_error_deg\n",
+            joints_header(model)
+        ));
+        for (i, row) in rows.iter().enumerate() {
+            let (xyz, rpy) = row.pose.to_xyz_rpy();
+            failed += usize::from(row.result.status != IkStatus::Converged);
             out.push_str(&format!(
-                "{},{},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{}\n",
+                "{},{},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{}{}\n",
                 data.config_ids[data.measurements[i].config],
-                joint_values(model, &r.q),
+                joint_values(model, &row.result.q),
                 xyz[0],
                 xyz[1],
                 xyz[2],
                 rpy[0].to_degrees(),
                 rpy[1].to_degrees(),
                 rpy[2].to_degrees(),
-                status_columns(r)
+                correction_columns(&row.correction, with),
+                status_columns(model, &row.result)
             ));
         }
     } else {
-        let rows = filter_joint_program(model, &nominal, &calibrated, &program, &settings);
+        let rows = filter_joint_program_corrected(
+            model,
+            &nominal,
+            &calibrated,
+            &program,
+            &settings,
+            correction.as_ref(),
+        );
         out.push_str(&format!(
-            "pose_id,{},status,position_error_mm,orientation_error_deg\n",
+            "pose_id,{},{correction_header}status,position_error_mm,orientation_error_deg\n",
             joints_header(model)
         ));
         for row in &rows {
-            failed += usize::from(row.result.status != armcal::compensate::IkStatus::Converged);
+            failed += usize::from(row.result.status != IkStatus::Converged);
             out.push_str(&format!(
-                "{},{},{}\n",
+                "{},{},{}{}\n",
                 row.id,
                 joint_values(model, &row.result.q),
-                status_columns(&row.result)
+                correction_columns(&row.correction, with),
+                status_columns(model, &row.result)
             ));
         }
     }

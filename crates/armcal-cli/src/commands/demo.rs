@@ -88,5 +88,9 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         a.out.display(),
         t0.elapsed().as_secs_f64()
     );
+    println!(
+        "report: {} — open it in a browser (one self-contained file)",
+        a.out.join("report.html").display()
+    );
     Ok(())
 }

@@ -7,6 +7,7 @@ use armcal::design::assess::assess;
 use armcal::design::plan::{constraint_set, plan, CellConstraints, PlanSettings};
 use armcal::design::Criterion;
 use armcal::measure::csv;
+use armcal::report::DesignRecord;
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -88,12 +89,22 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         &csv::write_configurations(&cell.model, &rep.design),
         a.force,
     )?;
-    let json = serde_json::json!({
-        "cell": cell.name,
-        "plan": rep,
-        "assessment": assess(&cell, &rep.design)?,
-    });
-    write_new(&report_path, &serde_json::to_string_pretty(&json)?, a.force)?;
+    let record = DesignRecord::new(
+        &cell,
+        Some(&a.cell),
+        &format!(
+            "armcal plan, criterion {}, {} start(s), seed {}",
+            a.criterion, a.starts, a.seed
+        ),
+        &rep.design,
+        Some(rep.clone()),
+        settings.collisions,
+    )?;
+    write_new(
+        &report_path,
+        &serde_json::to_string_pretty(&record)?,
+        a.force,
+    )?;
     println!(
         "{} poses for `{}`, criterion {:?}: value {:.6} (exchange {:.6}; refinement {}) in {:.2} s",
         rep.design.len(),
@@ -130,12 +141,8 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
             b.efficiency
         );
     }
-    if let Some(t) = json["assessment"]["tcp"].as_array().and_then(|v| v.first()) {
-        println!(
-            "(1/3) tr C_s at `{}`: {:.5} mm²",
-            t["name"].as_str().unwrap_or(""),
-            t["kpi"].as_f64().unwrap_or(f64::NAN)
-        );
+    if let Some(t) = record.assessment.tcp.first() {
+        println!("(1/3) tr C_s at `{}`: {:.5} mm²", t.name, t.kpi);
     }
     println!(
         "design → {}, report → {}",

@@ -1,18 +1,37 @@
-//! Calibrated inverse kinematics by damped least squares (book §5.2–5.3).
+//! Calibrated inverse kinematics by damped least squares (book §5.2–5.3), seeded with the
+//! nominal robot's closed-form solution where it has one ([`CalibratedIk`]).
 //!
 //! The book's optimal (LQR) compensator for one step is exactly damped least squares
 //! (book eqs. 5.85–5.87, check 9): `Δq = (JᵀQJ + Γ)⁻¹ JᵀQ e`. armcal weights the task error
 //! with `Q = diag(1, 1, 1, L², L², L²)` (position in mm, orientation in rad scaled by a
 //! characteristic length L, the book's `k2/‖p‖²` form) and uses `Γ = γ² I` with γ chosen from
-//! the smallest singular value σ_min of `Q^{1/2} J` (Maciejewski–Klein): γ = 0 while
+//! the smallest singular value σ_min of `J_w = Q^{1/2} J` (Maciejewski–Klein): γ = 0 while
 //! σ_min ≥ ε, and `γ² = (1 − (σ_min/ε)²) γ_max²` below, so steps stay bounded near a
-//! singularity instead of blowing up as they do with γ → 0 (book Table 5.7). Joint limits
-//! are enforced by clamping each step.
+//! singularity instead of blowing up as they do with γ → 0 (book Table 5.7). γ_max² is
+//! capped by the squared weighted error ‖e_w‖² (mm²), the Levenberg–Marquardt parameter of
+//! Yamashita and Fukushima (2001), so that the last, small corrections near a singular
+//! configuration converge quadratically instead of crawling under full damping; corrections
+//! above γ_max (1 mm) get the full damping. Joint limits are enforced by clamping each step.
+//!
+//! At a singular configuration the error has no gradient along the singular direction (a
+//! stretched elbow that must bend to shorten): a solve that stalls there with σ_min < ε
+//! is restarted from the stalled joints moved ±2° along the right singular vector of
+//! σ_min, and the better end is kept.
+//!
+//! The step is computed in task space, `Δq = J_wᵀ (J_w J_wᵀ + γ² I)⁻¹ e_w`, which equals the
+//! joint-space form by the push-through identity and needs only a 6×6 (3×3 for position
+//! targets) Cholesky factorisation on the stack whatever the number of joints. σ_min ≥ ε is
+//! certified by the Cholesky factorisation of `J_w J_wᵀ − ε² I` succeeding; only when it
+//! fails is σ_min computed (inverse iteration). One forward-kinematics evaluation per
+//! iteration: the trial point of an accepted step is the next iterate. Nothing is allocated
+//! inside the iterations.
 
+use crate::compensate::closed_form::{NoClosedForm, SphericalWristIk};
 use crate::model::pose::rotation_log;
-use crate::model::{forward_kinematics, joint_jacobian, Data, Model, Observed, Pose};
-use nalgebra::{DMatrix, DVector, Vector3};
+use crate::model::{forward_kinematics, Data, JointKind, Model, Pose};
+use nalgebra::{Cholesky, SMatrix, SVector, Vector3, Vector6};
 use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
 
 /// What the tool frame must reach (world frame, mm).
 #[derive(Clone, Copy, Debug)]
@@ -28,11 +47,26 @@ pub enum IkStatus {
     Converged,
     /// Stopped near a singular configuration (σ_min < ε) above the tolerance.
     Singular,
-    /// The target needs joint values beyond the limits.
+    /// The target needs joint values beyond the limits ([`IkResult::limit`] names the joint).
     JointLimits,
-    /// The residual stopped decreasing far from the target (out of reach).
+    /// Out of reach: the nominal robot misses the target by more than the calibration moves
+    /// the tool ([`CalibratedIk::solve`]), or the residual stopped decreasing away from a
+    /// singularity.
     Unreachable,
     MaxIterations,
+}
+
+impl IkStatus {
+    /// The kebab-case name used in files (`converged`, `joint-limits`, …).
+    pub fn name(self) -> &'static str {
+        match self {
+            IkStatus::Converged => "converged",
+            IkStatus::Singular => "singular",
+            IkStatus::JointLimits => "joint-limits",
+            IkStatus::Unreachable => "unreachable",
+            IkStatus::MaxIterations => "max-iterations",
+        }
+    }
 }
 
 /// Settings of [`calibrated_ik`].
@@ -54,13 +88,25 @@ impl Default for IkSettings {
     fn default() -> Self {
         IkSettings {
             max_iterations: 60,
-            position_tolerance: 1e-7,
-            orientation_tolerance: 1e-10,
+            // 1000× below the 1 µm / 1 µrad the calibrated IK is required to reach.
+            position_tolerance: 1e-6,
+            orientation_tolerance: 1e-9,
             length: 1000.0,
             epsilon: 1.0,
             gamma_max: 1.0,
         }
     }
+}
+
+/// A joint that the target needs beyond its limits: the value the unconstrained solution
+/// takes (the representative modulo 2π nearest the limits, for a revolute joint) and the
+/// limit it crosses (internal units).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LimitViolation {
+    /// Joint index (0-based).
+    pub joint: usize,
+    pub value: f64,
+    pub limit: f64,
 }
 
 /// Result of one solve.
@@ -72,65 +118,399 @@ pub struct IkResult {
     /// Remaining position error (mm) and orientation error (rad; 0 for position targets).
     pub position_error: f64,
     pub orientation_error: f64,
-    /// Smallest singular value of the weighted Jacobian at the end.
-    pub sigma_min: f64,
+    /// Smallest singular value of the weighted Jacobian at the end, for a solve that did
+    /// not converge (it tells a singular configuration from an unreachable target); `None`
+    /// for a converged solve, where computing it would cost a sixth of the solve.
+    pub sigma_min: Option<f64>,
+    /// For [`IkStatus::JointLimits`]: the joint beyond its limits.
+    pub limit: Option<LimitViolation>,
 }
 
-/// Reusable buffers.
+impl IkResult {
+    /// One line for reports: `converged`; `joint-limits: q5 = 132.100 deg > 87.000 deg`;
+    /// otherwise the status and the residual, e.g. `unreachable: residual 153.2 mm, 2.1 deg`.
+    pub fn describe(&self, model: &Model) -> String {
+        if let (IkStatus::JointLimits, Some(v)) = (self.status, self.limit) {
+            if let Some(j) = model.joints.get(v.joint) {
+                let unit = j.kind.unit();
+                let f = unit.display_factor();
+                return format!(
+                    "joint-limits: {} = {:.3} {} {} {:.3} {}",
+                    j.name,
+                    v.value * f,
+                    unit.display_name(),
+                    if v.value > v.limit { ">" } else { "<" },
+                    v.limit * f,
+                    unit.display_name()
+                );
+            }
+        }
+        if self.status == IkStatus::Converged {
+            return self.status.name().to_string();
+        }
+        format!(
+            "{}: residual {:.4} mm, {:.4} deg",
+            self.status.name(),
+            self.position_error,
+            self.orientation_error.to_degrees()
+        )
+    }
+}
+
+/// Reusable buffers (sized for one model): kinematics, joint limits, iterate and trial
+/// joints, Jacobian columns, and the warm start of the σ_min inverse iteration.
 pub struct IkWorkspace {
     data: Data<f64>,
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+    revolute: Vec<bool>,
+    q: Vec<f64>,
+    trial: Vec<f64>,
+    constrained: Vec<f64>,
+    direction: Vec<f64>,
+    best: Vec<f64>,
+    columns: Vec<Vector6<f64>>,
+    eigenvector: Vector6<f64>,
 }
 
 impl IkWorkspace {
     pub fn new(model: &Model) -> Self {
+        let (lower, upper) = model.joint_limits();
+        let n = model.dof();
         IkWorkspace {
             data: Data::new(model),
+            lower,
+            upper,
+            revolute: model
+                .joints
+                .iter()
+                .map(|j| j.kind == JointKind::Revolute)
+                .collect(),
+            q: vec![0.0; n],
+            trial: vec![0.0; n],
+            constrained: vec![0.0; n],
+            direction: vec![0.0; n],
+            best: vec![0.0; n],
+            columns: vec![Vector6::zeros(); n],
+            eigenvector: Vector6::repeat(1.0 / 6f64.sqrt()),
         }
     }
 }
 
-fn error(target: &IkTarget, tool: &Pose<f64>) -> (DVector<f64>, f64, f64) {
+/// Task error `e` (target minus tool; position rows, then for 6 rows the rotation vector of
+/// `R_target R_toolᵀ` scaled by L), its position norm and its rotation angle.
+fn weighted_error<const R: usize>(
+    target: &IkTarget,
+    tool: &Pose<f64>,
+    length: f64,
+) -> (SVector<f64, R>, f64, f64) {
+    let (d, w) = match target {
+        IkTarget::Position(p) => (p - tool.trans, Vector3::zeros()),
+        IkTarget::Pose(t) => (
+            t.trans - tool.trans,
+            rotation_log(&(t.rot * tool.rot.transpose())),
+        ),
+    };
+    let e = Vector6::new(d.x, d.y, d.z, w.x * length, w.y * length, w.z * length);
+    (e.fixed_rows::<R>(0).into_owned(), d.norm(), w.norm())
+}
+
+/// Columns of the weighted task Jacobian `Q^{1/2} J` of the tool frame, one per joint, from
+/// evaluated kinematics: joint j's world twist (ω, v) moves the tool origin p with
+/// `ω × p + v` (rows 0–2) and turns it with ω, scaled by L (rows 3–5).
+pub fn task_jacobian_columns(data: &Data<f64>, length: f64, columns: &mut [Vector6<f64>]) {
+    let p = data.tool().trans;
+    for (col, tw) in columns.iter_mut().zip(&data.joint_twists) {
+        let v = tw.point_velocity(&p);
+        *col = Vector6::new(
+            v.x,
+            v.y,
+            v.z,
+            tw.w.x * length,
+            tw.w.y * length,
+            tw.w.z * length,
+        );
+    }
+}
+
+/// `J_w J_wᵀ` over the first R rows.
+fn normal_matrix<const R: usize>(columns: &[Vector6<f64>]) -> SMatrix<f64, R, R> {
+    let mut a = SMatrix::<f64, R, R>::zeros();
+    for c in columns {
+        let j = c.fixed_rows::<R>(0);
+        a += j * j.transpose();
+    }
+    a
+}
+
+/// `Δq = J_wᵀ (A + γ² I)⁻¹ e` with `A = J_w J_wᵀ` into `step`; `false` if `A + γ² I` is
+/// not positive definite.
+fn step_from<const R: usize>(
+    a: &SMatrix<f64, R, R>,
+    columns: &[Vector6<f64>],
+    e: &SVector<f64, R>,
+    gamma2: f64,
+    step: &mut [f64],
+) -> bool {
+    let Some(ch) = Cholesky::new(a + SMatrix::<f64, R, R>::identity() * gamma2) else {
+        return false;
+    };
+    let y = ch.solve(e);
+    for (s, c) in step.iter_mut().zip(columns) {
+        *s = c.fixed_rows::<R>(0).dot(&y);
+    }
+    true
+}
+
+/// The one-step optimal compensator (book eqs. 5.85–5.87 with one stage), in task-space
+/// form: `Δq = J_wᵀ (J_w J_wᵀ + γ² I)⁻¹ e_w = (J_wᵀJ_w + γ² I)⁻¹ J_wᵀ e_w`, from the columns
+/// of the weighted Jacobian (first R rows) and the weighted error. Writes `step` (one
+/// value per column); `false` if the damped matrix is not positive definite (γ = 0 at an
+/// exact singularity).
+pub fn damped_step<const R: usize>(
+    columns: &[Vector6<f64>],
+    e: &SVector<f64, R>,
+    gamma2: f64,
+    step: &mut [f64],
+) -> bool {
+    step_from(&normal_matrix::<R>(columns), columns, e, gamma2, step)
+}
+
+/// Smallest eigenvalue of the symmetric positive semi-definite `a` (σ_min² of J_w) by
+/// inverse iteration from the warm start `v` (updated), to 1e-3 relative (the Rayleigh
+/// quotient, whose error is quadratic in that of the vector; enough for the damping and
+/// the report).
+fn smallest_eigenvalue<const R: usize>(a: &SMatrix<f64, R, R>, v: &mut Vector6<f64>) -> f64 {
+    // A shift of rounding size keeps the factorisation defined at an exact singularity.
+    let shift = 1e-13 * a.trace().max(f64::MIN_POSITIVE);
+    let Some(ch) = Cholesky::new(a + SMatrix::<f64, R, R>::identity() * shift) else {
+        return 0.0;
+    };
+    let mut x: SVector<f64, R> = v.fixed_rows::<R>(0).into_owned();
+    if !x.iter().all(|c| c.is_finite()) || x.norm() <= 1e-3 {
+        x = SVector::repeat(1.0);
+    }
+    x.normalize_mut();
+    let mut mu = 0.0;
+    for _ in 0..30 {
+        let y = ch.solve(&x);
+        let next = x.dot(&y);
+        let n = y.norm();
+        x = y / n;
+        let done = (next - mu).abs() <= 1e-3 * next;
+        mu = next;
+        if done {
+            break;
+        }
+    }
+    v.fixed_rows_mut::<R>(0).copy_from(&x);
+    (1.0 / mu - shift).max(0.0)
+}
+
+/// How one damped-least-squares run ended (`ws.q` holds its joints, `ws.data` its
+/// kinematics).
+struct Run {
+    converged: bool,
+    iterations: usize,
+    position_error: f64,
+    orientation_error: f64,
+    /// Not computed (NaN) for a converged run.
+    sigma_min: f64,
+    at_limit: bool,
+    stalled: bool,
+}
+
+/// Damped least squares from `ws.q` (already set), R task rows; with `limits`, every step is
+/// clamped to the joint limits.
+fn run_dls<const R: usize>(
+    model: &Model,
+    params: &[f64],
+    target: &IkTarget,
+    settings: &IkSettings,
+    ws: &mut IkWorkspace,
+    limits: bool,
+) -> Run {
+    let eps2 = settings.epsilon * settings.epsilon;
+    let length = settings.length;
+    forward_kinematics(model, &mut ws.data, params, &ws.q);
+    let mut best = f64::INFINITY;
+    let mut stalls = 0;
+    let mut at_limit = false;
+    let mut iterations = 0;
+    loop {
+        let (e, pe, oe) = weighted_error::<R>(target, ws.data.tool(), length);
+        if pe <= settings.position_tolerance && oe <= settings.orientation_tolerance {
+            return Run {
+                converged: true,
+                iterations,
+                position_error: pe,
+                orientation_error: oe,
+                sigma_min: f64::NAN,
+                at_limit,
+                stalled: false,
+            };
+        }
+        task_jacobian_columns(&ws.data, length, &mut ws.columns);
+        let a = normal_matrix::<R>(&ws.columns);
+        if iterations >= settings.max_iterations || stalls >= 5 {
+            let sigma_min = smallest_eigenvalue(&a, &mut ws.eigenvector).sqrt();
+            // Right singular vector of σ_min, v ∝ J_wᵀ u (u: the left one), in `ws.trial`.
+            let u = ws.eigenvector.fixed_rows::<R>(0);
+            for (t, c) in ws.trial.iter_mut().zip(&ws.columns) {
+                *t = c.fixed_rows::<R>(0).dot(&u);
+            }
+            return Run {
+                converged: false,
+                iterations,
+                position_error: pe,
+                orientation_error: oe,
+                sigma_min,
+                at_limit,
+                stalled: stalls >= 5,
+            };
+        }
+        iterations += 1;
+        let identity = SMatrix::<f64, R, R>::identity();
+        let weighted = e.norm();
+        let gamma2 = if Cholesky::new(a - identity * eps2).is_some() {
+            0.0
+        } else {
+            let s2 = smallest_eigenvalue(&a, &mut ws.eigenvector);
+            let cap = (settings.gamma_max * settings.gamma_max).min(weighted * weighted);
+            (1.0 - s2 / eps2).max(0.0) * cap
+        };
+        // Damped step; if it does not reduce the weighted error, raise the damping (a
+        // Levenberg–Marquardt safeguard, so that every accepted step is a descent step).
+        let trace = a.trace();
+        let mut g2 = gamma2;
+        let mut accepted = false;
+        for _ in 0..12 {
+            if !step_from(&a, &ws.columns, &e, g2 + 1e-14 * trace, &mut ws.trial) {
+                break;
+            }
+            let mut hits_limit = false;
+            for k in 0..ws.q.len() {
+                let v = ws.q[k] + ws.trial[k];
+                if limits && (v < ws.lower[k] || v > ws.upper[k]) {
+                    hits_limit = true;
+                    ws.trial[k] = v.clamp(ws.lower[k], ws.upper[k]);
+                } else {
+                    ws.trial[k] = v;
+                }
+            }
+            forward_kinematics(model, &mut ws.data, params, &ws.trial);
+            let (et, _, _) = weighted_error::<R>(target, ws.data.tool(), length);
+            if et.norm() < weighted {
+                std::mem::swap(&mut ws.q, &mut ws.trial);
+                at_limit = hits_limit;
+                accepted = true;
+                break;
+            }
+            g2 = (g2 * 10.0).max(1e-6 * trace);
+        }
+        if !accepted {
+            // No descent step: a stationary point of the weighted error.
+            forward_kinematics(model, &mut ws.data, params, &ws.q);
+            stalls = 5;
+            continue;
+        }
+        if weighted < best * (1.0 - 1e-3) {
+            best = weighted;
+            stalls = 0;
+        } else {
+            stalls += 1;
+        }
+    }
+}
+
+fn run_rows(
+    model: &Model,
+    params: &[f64],
+    target: &IkTarget,
+    settings: &IkSettings,
+    ws: &mut IkWorkspace,
+    limits: bool,
+) -> Run {
     match target {
-        IkTarget::Position(p) => {
-            let e = p - tool.trans;
-            (DVector::from_column_slice(e.as_slice()), e.norm(), 0.0)
-        }
-        IkTarget::Pose(t) => {
-            let e = t.trans - tool.trans;
-            let w = rotation_log(&(t.rot * tool.rot.transpose()));
-            (
-                DVector::from_iterator(6, e.iter().chain(w.iter()).copied()),
-                e.norm(),
-                w.norm(),
-            )
-        }
+        IkTarget::Position(_) => run_dls::<3>(model, params, target, settings, ws, limits),
+        IkTarget::Pose(_) => run_dls::<6>(model, params, target, settings, ws, limits),
     }
 }
 
-/// The weighted task Jacobian `Q^{1/2} J` of the tool frame (position rows, then, for 6
-/// rows, orientation rows scaled by the characteristic length), from evaluated kinematics.
-pub fn task_jacobian(data: &Data<f64>, rows: usize, length: f64) -> DMatrix<f64> {
-    let j6 = joint_jacobian(data, Observed::Tool);
-    let mut j: DMatrix<f64> = j6.rows(0, rows).into_owned();
-    for r in 3..rows {
-        j.row_mut(r).scale_mut(length);
+/// Joint step (rad or mm) of the restarts off a singular stall.
+const ESCAPE_STEP: f64 = 0.035;
+
+/// Restarts a solve that stalled at a singular configuration from the stalled joints moved
+/// ±[`ESCAPE_STEP`] along the right singular vector of σ_min (left in `ws.trial` by
+/// [`run_dls`]); returns the best of the three ends (converged first, then the smallest
+/// weighted error), with its joints in `ws.q`.
+fn escape_singular(
+    model: &Model,
+    params: &[f64],
+    target: &IkTarget,
+    settings: &IkSettings,
+    ws: &mut IkWorkspace,
+    stalled: Run,
+) -> Run {
+    let norm = ws.trial.iter().map(|v| v * v).sum::<f64>().sqrt();
+    if !norm.is_finite() || norm <= 0.0 {
+        return stalled;
     }
-    j
+    // `constrained` keeps the stalled joints, `direction` the unit singular vector, `best`
+    // the joints of the best end so far.
+    ws.constrained.copy_from_slice(&ws.q);
+    for (d, t) in ws.direction.iter_mut().zip(&ws.trial) {
+        *d = t / norm;
+    }
+    ws.best.copy_from_slice(&ws.q);
+    let score = |r: &Run| {
+        (
+            !r.converged,
+            r.position_error + r.orientation_error * settings.length,
+        )
+    };
+    let mut best = stalled;
+    for sign in [1.0, -1.0] {
+        for (k, q) in ws.q.iter_mut().enumerate() {
+            *q = (ws.constrained[k] + sign * ESCAPE_STEP * ws.direction[k])
+                .clamp(ws.lower[k], ws.upper[k]);
+        }
+        let mut run = run_rows(model, params, target, settings, ws, true);
+        run.iterations += best.iterations;
+        if score(&run) < score(&best) {
+            best = run;
+            ws.best.copy_from_slice(&ws.q);
+            if best.converged {
+                break;
+            }
+        }
+    }
+    ws.q.copy_from_slice(&ws.best);
+    best
 }
 
-/// The one-step optimal compensator (book eqs. 5.85–5.87 with one stage):
-/// `Δq = (JᵀQJ + γ² I)⁻¹ JᵀQ e`, given `JᵀQJ` and `JᵀQe`. `None` if the damped matrix is
-/// not positive definite (γ = 0 at an exact singularity).
-pub fn damped_step(jtj: &DMatrix<f64>, jte: &DVector<f64>, gamma2: f64) -> Option<DVector<f64>> {
-    let mut a = jtj.clone();
-    for k in 0..a.nrows() {
-        a[(k, k)] += gamma2;
+/// The representative of a revolute joint value modulo 2π nearest the interval [lo, hi]
+/// (the value itself for a prismatic joint).
+fn nearest_in_range(x: f64, lo: f64, hi: f64, revolute: bool) -> f64 {
+    if !revolute || (lo..=hi).contains(&x) {
+        return x;
     }
-    a.cholesky().map(|ch| ch.solve(jte))
+    let mid = 0.5 * (lo + hi);
+    let y = x + 2.0 * PI * ((mid - x) / (2.0 * PI)).round();
+    let outside = |v: f64| (lo - v).max(v - hi);
+    [y - 2.0 * PI, y, y + 2.0 * PI]
+        .into_iter()
+        .min_by(|a, b| outside(*a).total_cmp(&outside(*b)))
+        .unwrap_or(x)
 }
 
 /// Joint values that bring the tool frame of `model` with parameters `params` to `target`,
 /// starting from `seed` (e.g. the nominal solution or the nominal program's joints).
+///
+/// If the limits stop the solve, the solve is repeated without them: when that one
+/// converges, either every revolute joint can be shifted by whole turns into its limits
+/// (the shifted solution is returned as converged) or the status is
+/// [`IkStatus::JointLimits`] with the joint furthest beyond its limits.
 pub fn calibrated_ik(
     model: &Model,
     params: &[f64],
@@ -139,119 +519,173 @@ pub fn calibrated_ik(
     settings: &IkSettings,
     ws: &mut IkWorkspace,
 ) -> IkResult {
-    let (lo, hi) = model.joint_limits();
-    let mut q: Vec<f64> = seed
-        .iter()
-        .zip(lo.iter().zip(&hi))
-        .map(|(x, (a, b))| x.clamp(*a, *b))
-        .collect();
-    let rows = match target {
-        IkTarget::Position(_) => 3,
-        IkTarget::Pose(_) => 6,
-    };
-    let mut best_err = f64::INFINITY;
-    let mut stalled = 0;
-    let mut sigma_min = f64::INFINITY;
-    let mut at_limit = false;
-    // `ws.data` holds the kinematics at `q` after an accepted step; evaluate only otherwise.
-    let mut evaluated = false;
-    for it in 0..=settings.max_iterations {
-        if !evaluated {
-            forward_kinematics(model, &mut ws.data, params, &q);
-        }
-        evaluated = false;
-        let (e, pe, oe) = error(target, ws.data.tool());
-        if pe <= settings.position_tolerance && oe <= settings.orientation_tolerance {
-            return IkResult {
-                q,
-                status: IkStatus::Converged,
-                iterations: it,
-                position_error: pe,
-                orientation_error: oe,
-                sigma_min,
-            };
-        }
-        let j = task_jacobian(&ws.data, rows, settings.length);
-        let mut ew = e.clone();
-        for r in 3..rows {
-            ew[r] *= settings.length;
-        }
-        let weighted = ew.norm();
-        let svd = j.clone().svd(false, false);
-        sigma_min = svd.singular_values.min();
-        let gamma2 = if sigma_min >= settings.epsilon {
-            0.0
-        } else {
-            (1.0 - (sigma_min / settings.epsilon).powi(2)) * settings.gamma_max.powi(2)
-        };
-        // Damped step; if it does not reduce the weighted error, raise the damping (a
-        // Levenberg–Marquardt safeguard, so that every accepted step is a descent step).
-        let jtj = j.tr_mul(&j);
-        let jte = j.tr_mul(&ew);
-        let smax = svd.singular_values.max();
-        let mut g2 = gamma2;
-        let mut accepted = false;
-        for _ in 0..12 {
-            let Some(step) = damped_step(&jtj, &jte, g2 + 1e-14 * smax * smax) else {
-                break;
-            };
-            let mut trial = q.clone();
-            let mut hits_limit = false;
-            for (k, st) in step.iter().enumerate() {
-                let v = q[k] + st;
-                if v < lo[k] || v > hi[k] {
-                    hits_limit = true;
-                }
-                trial[k] = v.clamp(lo[k], hi[k]);
-            }
-            forward_kinematics(model, &mut ws.data, params, &trial);
-            let (mut et, _, _) = error(target, ws.data.tool());
-            if rows == 6 {
-                for r in 3..6 {
-                    et[r] *= settings.length;
-                }
-            }
-            if et.norm() < weighted {
-                q = trial;
-                at_limit = hits_limit;
-                accepted = true;
-                evaluated = true;
-                break;
-            }
-            g2 = (g2 * 10.0).max(1e-6 * smax * smax);
-        }
-        if !accepted {
-            break;
-        }
-        if weighted < best_err * (1.0 - 1e-3) {
-            best_err = weighted;
-            stalled = 0;
-        } else {
-            stalled += 1;
-            if stalled >= 5 {
-                break;
-            }
-        }
+    solve_with_diagnosis(model, params, target, seed, settings, ws)
+}
+
+fn solve_with_diagnosis(
+    model: &Model,
+    params: &[f64],
+    target: &IkTarget,
+    seed: &[f64],
+    settings: &IkSettings,
+    ws: &mut IkWorkspace,
+) -> IkResult {
+    for k in 0..ws.q.len() {
+        let s = seed.get(k).copied().unwrap_or(0.0);
+        ws.q[k] = s.clamp(ws.lower[k], ws.upper[k]);
     }
-    forward_kinematics(model, &mut ws.data, params, &q);
-    let (_, pe, oe) = error(target, ws.data.tool());
-    let status = if pe <= settings.position_tolerance && oe <= settings.orientation_tolerance {
-        IkStatus::Converged
-    } else if at_limit {
-        IkStatus::JointLimits
-    } else if sigma_min < settings.epsilon {
+    let mut run = run_rows(model, params, target, settings, ws, true);
+    if !run.converged && run.sigma_min < settings.epsilon {
+        run = escape_singular(model, params, target, settings, ws, run);
+    }
+    let result = |ws: &IkWorkspace, run: &Run, status, limit| IkResult {
+        q: ws.q.clone(),
+        status,
+        iterations: run.iterations,
+        position_error: run.position_error,
+        orientation_error: run.orientation_error,
+        sigma_min: (!run.converged).then_some(run.sigma_min),
+        limit,
+    };
+    if run.converged {
+        return result(ws, &run, IkStatus::Converged, None);
+    }
+    if run.at_limit {
+        ws.constrained.copy_from_slice(&ws.q);
+        for k in 0..ws.q.len() {
+            ws.q[k] = seed.get(k).copied().unwrap_or(0.0);
+        }
+        let free = run_rows(model, params, target, settings, ws, false);
+        if free.converged {
+            let mut worst: Option<LimitViolation> = None;
+            let mut excess = 0.0;
+            for k in 0..ws.q.len() {
+                let (lo, hi) = (ws.lower[k], ws.upper[k]);
+                let x = nearest_in_range(ws.q[k], lo, hi, ws.revolute[k]);
+                ws.q[k] = x;
+                let beyond = (lo - x).max(x - hi);
+                if beyond > 0.0 && beyond > excess {
+                    excess = beyond;
+                    worst = Some(LimitViolation {
+                        joint: k,
+                        value: x,
+                        limit: if x > hi { hi } else { lo },
+                    });
+                }
+            }
+            if worst.is_none() {
+                // Whole turns bring the unconstrained solution within the limits.
+                return result(ws, &free, IkStatus::Converged, None);
+            }
+            ws.q.copy_from_slice(&ws.constrained);
+            return result(ws, &run, IkStatus::JointLimits, worst);
+        }
+        ws.q.copy_from_slice(&ws.constrained);
+    }
+    let status = if run.sigma_min < settings.epsilon {
         IkStatus::Singular
-    } else if stalled >= 5 {
+    } else if run.stalled {
         IkStatus::Unreachable
     } else {
         IkStatus::MaxIterations
     };
-    IkResult {
-        q,
-        status,
-        iterations: settings.max_iterations,
-        position_error: pe,
-        orientation_error: oe,
-        sigma_min,
+    result(ws, &run, status, None)
+}
+
+/// Calibrated IK as book §5.2 describes it: the nominal robot's closed-form solution
+/// ([`SphericalWristIk`]) seeds damped least squares on the calibrated model. Robots
+/// without a closed form, and position-only targets, start from the caller's reference
+/// joints instead.
+pub struct CalibratedIk<'a> {
+    model: &'a Model,
+    nominal: Vec<f64>,
+    calibrated: &'a [f64],
+    settings: IkSettings,
+    closed_form: Result<SphericalWristIk, NoClosedForm>,
+    ws: IkWorkspace,
+}
+
+impl<'a> CalibratedIk<'a> {
+    /// Detects the closed form on the nominal parameters `nominal`.
+    pub fn new(
+        model: &'a Model,
+        nominal: &[f64],
+        calibrated: &'a [f64],
+        settings: IkSettings,
+    ) -> Self {
+        CalibratedIk {
+            model,
+            nominal: nominal.to_vec(),
+            calibrated,
+            settings,
+            closed_form: SphericalWristIk::new(model, nominal),
+            ws: IkWorkspace::new(model),
+        }
+    }
+
+    /// The nominal closed-form solver, or why there is none.
+    pub fn closed_form(&self) -> Result<&SphericalWristIk, &NoClosedForm> {
+        self.closed_form.as_ref()
+    }
+
+    /// Solves for `target`. For a pose target with a closed form, the seed is the nominal
+    /// branch nearest `reference` in joint space (exact and within the limits if any branch
+    /// is, [`Branches::ordered`]); if the calibrated solve does not converge from it, the
+    /// other branches are tried in order (near the workspace boundary or a joint limit the
+    /// calibrated robot may reach a target in another branch only), and the first branch's
+    /// result is returned if none converges. It is [`IkStatus::Unreachable`] when the
+    /// nominal wrist centre misses the target by more than the calibration moves the tool
+    /// there (`|FK_cal(q) − FK_nom(q)|`): then the calibrated robot cannot reach it either.
+    /// Without a closed form, or for a position target, the seed is `reference` itself.
+    ///
+    /// [`Branches::ordered`]: crate::compensate::closed_form::Branches::ordered
+    pub fn solve(&mut self, target: &IkTarget, reference: &[f64]) -> IkResult {
+        if let (IkTarget::Pose(pose), Ok(cf)) = (target, &self.closed_form) {
+            if reference.len() == 6 {
+                let branches = cf.solve(pose, reference).ordered(reference);
+                let mut first: Option<(IkResult, f64)> = None;
+                for b in branches.as_slice() {
+                    let r = solve_with_diagnosis(
+                        self.model,
+                        self.calibrated,
+                        target,
+                        &b.q,
+                        &self.settings,
+                        &mut self.ws,
+                    );
+                    if r.status == IkStatus::Converged {
+                        return r;
+                    }
+                    first.get_or_insert((r, b.reach_miss));
+                }
+                if let Some((mut r, miss)) = first {
+                    if miss > 0.0 && r.status != IkStatus::JointLimits {
+                        // The calibration moves the tool by |FK_cal(q) − FK_nom(q)| here; a
+                        // nominal miss beyond that is out of the calibrated robot's reach too.
+                        forward_kinematics(self.model, &mut self.ws.data, &self.nominal, &r.q);
+                        let nominal_tcp = self.ws.data.tool().trans;
+                        forward_kinematics(self.model, &mut self.ws.data, self.calibrated, &r.q);
+                        if miss > (self.ws.data.tool().trans - nominal_tcp).norm() {
+                            r.status = IkStatus::Unreachable;
+                        }
+                    }
+                    return r;
+                }
+            }
+        }
+        self.solve_from(target, reference)
+    }
+
+    /// Solves for `target` from the numerical seed `seed` (e.g. the previous program row's
+    /// solution, or the nominal program's joints).
+    pub fn solve_from(&mut self, target: &IkTarget, seed: &[f64]) -> IkResult {
+        calibrated_ik(
+            self.model,
+            self.calibrated,
+            target,
+            seed,
+            &self.settings,
+            &mut self.ws,
+        )
     }
 }

@@ -1,8 +1,11 @@
 //! Compensation (book ch. 5): making the robot move differently because of a calibration —
 //! calibrated inverse kinematics and program filtering.
 
+pub mod closed_form;
+pub mod cmac;
 pub mod ik;
+pub mod lqr;
 pub mod nonparametric;
 pub mod program;
 
-pub use ik::{calibrated_ik, IkResult, IkSettings, IkStatus, IkTarget};
+pub use ik::{calibrated_ik, CalibratedIk, IkResult, IkSettings, IkStatus, IkTarget};

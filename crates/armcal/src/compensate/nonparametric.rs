@@ -9,9 +9,14 @@
 //!   β18 = η2η3², β19 = η3³): graded by degree, lexicographic within a degree.
 //! * [`PolynomialCorrection`] fits one polynomial per component of a 3-vector error, on
 //!   inputs normalised to [−1, 1] from the training data's range.
+//! * [`ResidualCorrection`] fits it on a calibration data set's remaining position errors,
+//!   for program filtering (`compensate::program`).
 
 use crate::error::{Error, Result};
+use crate::measure::{Dataset, MeasurementKind};
+use crate::model::{forward_kinematics, observed_position, Data, Model};
 use nalgebra::{DMatrix, Vector3};
+use serde::{Deserialize, Serialize};
 
 /// `n` Chebyshev-spaced points on `[a, b]` (Eq. 5.195, the zeros of the degree-`n`
 /// Chebyshev polynomial mapped to the interval), in the book's order (k = 0 first, which
@@ -211,5 +216,97 @@ impl PolynomialCorrection {
             }
         }
         out
+    }
+}
+
+/// What a [`ResidualCorrection`] is a function of.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CorrectionInputs {
+    /// The arm joints q1…q3 (default). The non-geometric errors a kinematic model leaves
+    /// (joint compliance under gravity, gear and encoder errors) are functions of the
+    /// configuration, and the arm joints set most of it; the same TCP position reached in
+    /// another configuration has another error, so joints are the better-posed input, and
+    /// three of them keep the basis small (20 terms at degree 3, against 84 for six).
+    ArmJoints,
+    /// Every joint (for errors that depend on the wrist too).
+    Joints,
+    /// The TCP position in the world frame (book §5.4's workspace interpolation): fitted at
+    /// the measured point, applied at the tool point.
+    Position,
+}
+
+impl CorrectionInputs {
+    /// The input vector at joints `q` and world position `position`.
+    pub fn values(self, q: &[f64], position: &Vector3<f64>) -> Vec<f64> {
+        match self {
+            CorrectionInputs::ArmJoints => q[..q.len().min(3)].to_vec(),
+            CorrectionInputs::Joints => q.to_vec(),
+            CorrectionInputs::Position => position.iter().copied().collect(),
+        }
+    }
+}
+
+/// The position error a parametric calibration leaves, `e = measured − calibrated-model
+/// prediction` in the world frame, as a polynomial of [`CorrectionInputs`] (book §5.4).
+/// Compensation asks the calibrated model to reach `t − ê` so that the real robot, which
+/// lands at `FK_cal(q) + e(q)`, reaches `t`. The error is measured at the observed point
+/// (reflector) and applied at the tool point: exact for the translational part of the
+/// error, approximate by (rotation error × their distance) otherwise.
+#[derive(Clone, Debug)]
+pub struct ResidualCorrection {
+    pub inputs: CorrectionInputs,
+    pub polynomial: PolynomialCorrection,
+}
+
+impl ResidualCorrection {
+    /// Fits on the position (and pose) measurements of `data`: the residual of each,
+    /// rotated from the instrument frame into the world frame with the calibrated
+    /// instrument orientation, `e = R_I (m − m̂)`. Distance measurements carry no position
+    /// and are skipped.
+    pub fn fit(
+        model: &Model,
+        calibrated: &[f64],
+        data: &Dataset,
+        inputs: CorrectionInputs,
+        degree: usize,
+    ) -> Result<Self> {
+        if inputs == CorrectionInputs::ArmJoints && model.dof() < 3 {
+            return Err(Error::Input(format!(
+                "nonparametric correction on q1…q3: model `{}` has {} joints",
+                model.name,
+                model.dof()
+            )));
+        }
+        let mut fk = Data::new(model);
+        let (mut xs, mut es) = (Vec::new(), Vec::new());
+        for m in &data.measurements {
+            let measured = match &m.kind {
+                MeasurementKind::Position { value, .. } => *value,
+                MeasurementKind::Pose { value, .. } => value.trans,
+                _ => continue,
+            };
+            let q = &data.configurations[m.config];
+            forward_kinematics(model, &mut fk, calibrated, q);
+            let predicted = observed_position(&fk, m.observed);
+            let world = fk.instrument.transform_point(&predicted);
+            xs.push(inputs.values(q, &world));
+            es.push(fk.instrument.rot * (measured - predicted));
+        }
+        if xs.is_empty() {
+            return Err(Error::Input(format!(
+                "nonparametric correction: `{}` has no position measurements",
+                data.source
+            )));
+        }
+        Ok(ResidualCorrection {
+            inputs,
+            polynomial: PolynomialCorrection::fit(&xs, &es, degree)?,
+        })
+    }
+
+    /// Predicted error (world, mm) at joints `q` with the tool at `position`.
+    pub fn predict(&self, q: &[f64], position: &Vector3<f64>) -> Vector3<f64> {
+        self.polynomial.predict(&self.inputs.values(q, position))
     }
 }

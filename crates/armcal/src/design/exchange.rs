@@ -11,6 +11,7 @@
 use crate::design::criteria::{evaluate, kpi_matrix, Criterion};
 use crate::design::information::{DesignModel, InformationWorkspace};
 use crate::design::objective::triangular_factor;
+use crate::design::small_cholesky;
 use crate::Error;
 use nalgebra::DMatrix;
 use rand::seq::SliceRandom;
@@ -129,7 +130,13 @@ pub fn exchange(
     let mut history = vec![value];
     let mut sweeps = 0;
     let mut exchanges = 0;
-    let in_design = |chosen: &[usize], c: usize| chosen.contains(&c);
+    // Buffers: U = J_pool C, V = J_pool (L C)ᵀ, a candidate's S (rows × rows), one column.
+    let mut u = DMatrix::zeros(jp.nrows(), n);
+    let mut vl = DMatrix::zeros(jp.nrows(), l.as_ref().map_or(0, |l| l.nrows()));
+    let mut s_buf = vec![0.0; rows * rows];
+    let mut t_buf = vec![0.0; rows];
+    let mut in_design = vec![false; pool.len()];
+    let mut scores: Vec<(f64, usize)> = Vec::with_capacity(pool.len());
     while sweeps < settings.max_sweeps {
         sweeps += 1;
         let start_value = value;
@@ -137,51 +144,67 @@ pub fn exchange(
             // Covariance without the point in `slot`.
             let mut others: Vec<usize> = chosen.clone();
             others.remove(slot);
-            let m = {
-                let mut m = prior.tr_mul(prior);
-                for &i in &others {
-                    let ji = jp.rows(i * rows, rows);
-                    m.gemm_tr(1.0, &ji, &ji, 1.0);
-                }
-                m
-            };
-            let c = match m.clone().cholesky() {
+            in_design.fill(false);
+            for &i in &others {
+                in_design[i] = true;
+            }
+            let mut m = prior.tr_mul(prior);
+            for &i in &others {
+                let ji = jp.rows(i * rows, rows);
+                m.gemm_tr(1.0, &ji, &ji, 1.0);
+            }
+            let c = match m.cholesky() {
                 Some(ch) => ch.inverse(),
                 None => continue, // this point is essential; keep it
             };
-            // Score every candidate by the rank-`rows` update.
-            let jc = &jp * &c; // (rows·pool) × n
-            let a = l.as_ref().map(|l| {
+            // Score every candidate by the rank-`rows` update: S = I + J_x C J_xᵀ and, for
+            // A-type criteria, tr(S⁻¹ J_x C LᵀL C J_xᵀ) = tr(S⁻¹ V_x V_xᵀ).
+            u.gemm(1.0, &jp, &c, 0.0);
+            if let Some(l) = &l {
                 let lc = l * &c;
-                lc.tr_mul(&lc)
-            });
-            let mut scores: Vec<(f64, usize)> = Vec::with_capacity(pool.len());
-            for x in 0..pool.len() {
-                if in_design(&others, x) {
+                vl.gemm(1.0, &jp, &lc.transpose(), 0.0);
+            }
+            scores.clear();
+            for (x, _) in in_design.iter().enumerate().filter(|(_, used)| !**used) {
+                let r0 = x * rows;
+                for a in 0..rows {
+                    for b in 0..=a {
+                        let mut sab = if a == b { 1.0 } else { 0.0 };
+                        for p in 0..n {
+                            sab += u[(r0 + a, p)] * jp[(r0 + b, p)];
+                        }
+                        s_buf[a * rows + b] = sab;
+                        s_buf[b * rows + a] = sab;
+                    }
+                }
+                if !small_cholesky::factor(&mut s_buf, rows) {
                     continue;
                 }
-                let jx = jp.rows(x * rows, rows);
-                let ux = jc.rows(x * rows, rows);
-                let s = DMatrix::identity(rows, rows) + ux * jx.transpose();
-                let score = match &a {
-                    Some(a) => {
-                        let t = jx * a * jx.transpose();
-                        match s.clone().cholesky() {
-                            Some(ch) => -(ch.solve(&t)).trace(),
-                            None => f64::INFINITY,
+                let score = if l.is_some() {
+                    // tr(S⁻¹ V_x V_xᵀ) = Σ_c v_cᵀ S⁻¹ v_c over the columns of V_x.
+                    let mut tr = 0.0;
+                    for col in 0..vl.ncols() {
+                        for a in 0..rows {
+                            t_buf[a] = vl[(r0 + a, col)];
+                        }
+                        small_cholesky::solve(&s_buf, &mut t_buf, rows);
+                        for a in 0..rows {
+                            tr += t_buf[a] * vl[(r0 + a, col)];
                         }
                     }
-                    None => match s.clone().cholesky() {
-                        Some(ch) => -2.0 * ch.l().diagonal().iter().map(|v| v.ln()).sum::<f64>(),
-                        None => f64::INFINITY,
-                    },
+                    -tr
+                } else {
+                    -2.0 * (0..rows).map(|a| s_buf[a * rows + a].ln()).sum::<f64>()
                 };
                 scores.push((score, x));
             }
-            scores.sort_by(|p, q| p.0.total_cmp(&q.0));
             let best = if l.is_some() || criterion == Criterion::D {
-                scores.first().map(|s| s.1)
+                scores
+                    .iter()
+                    .min_by(|p, q| p.0.total_cmp(&q.0))
+                    .map(|s| s.1)
             } else {
+                scores.sort_by(|p, q| p.0.total_cmp(&q.0));
                 // Exact evaluation of a short list.
                 let mut best = None;
                 let mut best_v = f64::INFINITY;

@@ -118,7 +118,7 @@ impl InformationWorkspace {
         let n = d.n();
         InformationWorkspace {
             data: Data::new(&d.model),
-            mixed: MixedWorkspace::new(&d.model, Rows::Position, n),
+            mixed: MixedWorkspace::new(&d.model),
             jac: DMatrix::zeros(d.rows(), n),
             jac_dq: vec![DMatrix::zeros(d.rows(), n); d.dof()],
             value: DMatrix::zeros(3, n),

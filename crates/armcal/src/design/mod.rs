@@ -12,6 +12,7 @@ pub mod objective;
 pub mod order;
 pub mod plan;
 pub mod refine;
+pub mod small_cholesky;
 
 pub use criteria::{Criterion, CriterionValue};
 pub use information::{DesignModel, InformationWorkspace};

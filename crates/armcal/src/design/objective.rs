@@ -20,6 +20,8 @@ pub struct ObjectiveWorkspace {
     info: InformationWorkspace,
     jacs: Vec<DMatrix<f64>>,
     jacs_dq: Vec<Vec<DMatrix<f64>>>,
+    /// `W^{1/2}J_i Φ` of one configuration.
+    j_phi: DMatrix<f64>,
 }
 
 impl<'a> DesignObjective<'a> {
@@ -44,6 +46,7 @@ impl<'a> DesignObjective<'a> {
             info: InformationWorkspace::new(d),
             jacs: vec![DMatrix::zeros(d.rows(), d.n()); n_configs],
             jacs_dq: vec![vec![DMatrix::zeros(d.rows(), d.n()); d.dof()]; n_configs],
+            j_phi: DMatrix::zeros(d.rows(), d.n()),
         }
     }
 
@@ -80,9 +83,9 @@ impl<'a> DesignObjective<'a> {
         let cv = evaluate(self.criterion, &r, self.design)?;
         if let Some(g) = gradient {
             for i in 0..nconf {
-                let b = &ws.jacs[i] * &cv.gradient;
+                ws.j_phi.gemm(1.0, &ws.jacs[i], &cv.gradient, 0.0);
                 for j in 0..k {
-                    g[i * k + j] = 2.0 * b.dot(&ws.jacs_dq[i][j]);
+                    g[i * k + j] = 2.0 * ws.j_phi.dot(&ws.jacs_dq[i][j]);
                 }
             }
         }

@@ -102,6 +102,22 @@ pub struct ResidualReport {
     pub z: ErrorStats,
     /// Euclidean position error per measurement (scalar error for distances and planes).
     pub norm: ErrorStats,
+    /// Every measurement's residual, in data order (for the report's histograms and
+    /// per-pose plot).
+    #[serde(default)]
+    pub per_measurement: Vec<MeasurementResidual>,
+}
+
+/// One measurement's residual, `model − measured` (mm; the robust weights undone).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct MeasurementResidual {
+    /// Configuration number in the fitted data (1-based) and its `pose_id`.
+    pub pose: usize,
+    pub pose_id: String,
+    /// Position residual x, y, z (mm); `None` for distance and plane measurements.
+    pub xyz: Option<[f64; 3]>,
+    /// Euclidean position error (the scalar error for distances and planes, mm).
+    pub norm: f64,
 }
 
 /// Held-out validation (position error on configurations not used in the fit, mm).
@@ -286,25 +302,43 @@ fn residual_report(problem: &Problem, params: &[f64]) -> ResidualReport {
     let n = problem.rows();
     let mut r = DVector::zeros(n);
     problem.evaluate(&mut ws, params, &mut r, None);
+    let norms = problem.errors(&mut ws, params);
     let (mut x, mut y, mut z) = (Vec::new(), Vec::new(), Vec::new());
+    let mut per_measurement = Vec::with_capacity(norms.len());
     for (i, m) in problem.data.measurements.iter().enumerate() {
-        if let MeasurementKind::Position { .. } | MeasurementKind::Pose { .. } = m.kind {
+        let xyz = if let MeasurementKind::Position { .. } | MeasurementKind::Pose { .. } = m.kind {
             let row = problem.row_of[i];
             // Undo whitening (and robust weights) to get mm.
             let un = |k: usize| {
                 let w = problem.row_weights[row + k].sqrt() / problem.sigmas[row + k];
                 r[row + k] / w
             };
-            x.push(un(0));
-            y.push(un(1));
-            z.push(un(2));
-        }
+            let v = [un(0), un(1), un(2)];
+            x.push(v[0]);
+            y.push(v[1]);
+            z.push(v[2]);
+            Some(v)
+        } else {
+            None
+        };
+        per_measurement.push(MeasurementResidual {
+            pose: m.config + 1,
+            pose_id: problem
+                .data
+                .config_ids
+                .get(m.config)
+                .cloned()
+                .unwrap_or_default(),
+            xyz,
+            norm: norms[i],
+        });
     }
     ResidualReport {
         x: ErrorStats::of(&x),
         y: ErrorStats::of(&y),
         z: ErrorStats::of(&z),
-        norm: ErrorStats::of(&problem.errors(&mut ws, params)),
+        norm: ErrorStats::of(&norms),
+        per_measurement,
     }
 }
 

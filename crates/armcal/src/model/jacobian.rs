@@ -6,15 +6,14 @@
 //!   book eqs. 4.14–4.20); instrument parameters enter with the minus sign because the
 //!   measurement is `T_I⁻¹ T_target` (paper eq. 3);
 //! * joint (geometric) Jacobian w.r.t. q;
-//! * the mixed derivative ∂/∂q of the identification Jacobian, by forward-mode dual numbers
-//!   through the same generic code (for the pose-design gradients).
+//! * the mixed derivative ∂/∂q of the identification Jacobian, analytic from the same
+//!   twists (Lie brackets of joint and parameter twists), for the pose-design gradients.
 
-use crate::model::chain::Model;
+use crate::model::chain::{Model, Step};
 use crate::model::kinematics::{forward_kinematics, Data};
 use crate::model::pose::Pose;
 use crate::model::registry::Segment;
 use nalgebra::{DMatrix, Matrix3, RealField, Vector3};
-use num_dual::Dual64;
 use serde::{Deserialize, Serialize};
 
 /// The point or frame a measurement observes.
@@ -129,27 +128,70 @@ pub fn joint_jacobian<T: RealField + Copy>(data: &Data<T>, obs: Observed) -> DMa
     j
 }
 
-/// Workspace for [`identification_jacobian_dq`]: dual-number buffers sized for a model and
-/// a column set, reused across calls.
+/// Workspace for [`identification_jacobian_dq`]: kinematics buffers and, for every
+/// parameter and joint, the position of its factor along the chain (what can move what).
 pub struct MixedWorkspace {
-    data: Data<Dual64>,
-    q: Vec<Dual64>,
-    jac: DMatrix<Dual64>,
+    data: Data<f64>,
+    /// Instrument factors 0, chain factor i → i + 1, target factors `usize::MAX`.
+    param_order: Vec<usize>,
+    joint_order: Vec<usize>,
+    /// Per joint, in the instrument frame: `R_Iᵀ ω_k` and the point's velocity `R_Iᵀ ṗ`.
+    joint_w: Vec<Vector3<f64>>,
+    joint_p_dot: Vec<Vector3<f64>>,
 }
 
 impl MixedWorkspace {
-    pub fn new(model: &Model, rows: Rows, columns: usize) -> Self {
+    pub fn new(model: &Model) -> Self {
+        let mut param_order = vec![0; model.param_count()];
+        let mut joint_order = vec![0; model.dof()];
+        let mut mark = |step: &Step, order: usize| {
+            let (params, joint) = match step {
+                Step::Elementary { param, joint, .. } => (*param..*param + 1, *joint),
+                Step::Screw { first, joint, .. } => (*first..*first + 7, *joint),
+            };
+            for p in params {
+                param_order[p] = order;
+            }
+            if let Some(j) = joint {
+                joint_order[j] = order;
+            }
+        };
+        for step in &model.instrument_steps {
+            mark(step, 0);
+        }
+        for (i, step) in model.chain_steps.iter().enumerate() {
+            mark(step, i + 1);
+        }
+        for step in model.target_steps.iter().flatten() {
+            mark(step, usize::MAX);
+        }
         MixedWorkspace {
             data: Data::new(model),
-            q: vec![Dual64::from(0.0); model.dof()],
-            jac: DMatrix::from_element(rows.count(), columns, Dual64::from(0.0)),
+            param_order,
+            joint_order,
+            joint_w: vec![Vector3::zeros(); model.dof()],
+            joint_p_dot: vec![Vector3::zeros(); model.dof()],
         }
     }
 }
 
-/// The identification Jacobian `J` (into `value`) and its derivatives `∂J/∂q_j` (into
-/// `dq[j]`, one matrix per joint), by forward-mode dual numbers: one dual pass per joint
-/// through the same code as [`identification_jacobian`].
+/// The identification Jacobian `J` (into `value`) and its derivatives `∂J/∂q_k` (into
+/// `dq[k]`, one matrix per joint) in one forward-kinematics pass.
+///
+/// With `ξ_k = (ω_k, v_k)` the world twist of joint k, `ξ_j = (ω_j, v_j)` that of parameter
+/// j and `c_j = ω_j × p + v_j` its world position column (the J column is `s R_Iᵀ c_j`):
+/// * parameter j acts after joint k: everything beyond joint k turns rigidly with it, so
+///   `ξ̇_j = [ξ_k, ξ_j] = (ω_k × ω_j, ω_k × v_j + v_k × ω_j)` (book §2.4–2.5) and, with
+///   `ṗ = ω_k × p + v_k` and the Jacobi identity, `ċ_j = ω̇_j × p + ω_j × ṗ + v̇_j = ω_k × c_j`;
+/// * parameter j acts before joint k: its twist is fixed and only the point moves,
+///   `ċ_j = ω_j × ṗ`;
+/// * both in one zero-reference screw: `ċ_j = ω̇_j × p + v̇_j + ω_j × ṗ` with `ξ̇_j` the
+///   factor's own rate ([`Data::param_twist_rates`]).
+///
+/// Rotations commute with cross products, so in the instrument frame each entry is one
+/// cross product: `∂J_j/∂q_k = (R_Iᵀω_k) × J_j` or `J^ω_j × (R_Iᵀ ṗ)` with
+/// `J^ω_j = s R_Iᵀ ω_j` (the orientation column). Orientation rows: `(R_Iᵀω_k) × J^ω_j`
+/// after joint k, the screw's `s R_Iᵀ ω̇_j`, zero before. Allocates nothing.
 #[allow(clippy::too_many_arguments)]
 pub fn identification_jacobian_dq(
     model: &Model,
@@ -162,18 +204,43 @@ pub fn identification_jacobian_dq(
     value: &mut DMatrix<f64>,
     dq: &mut [DMatrix<f64>],
 ) {
-    for (j, dqj) in dq.iter_mut().enumerate().take(model.dof()) {
-        for (i, qi) in ws.q.iter_mut().enumerate() {
-            *qi = Dual64::new(q[i], if i == j { 1.0 } else { 0.0 });
-        }
-        forward_kinematics(model, &mut ws.data, params, &ws.q);
-        identification_jacobian(model, &ws.data, obs, rows, columns, &mut ws.jac, 0);
-        for (d, x) in dqj.iter_mut().zip(ws.jac.iter()) {
-            *d = x.eps;
-        }
-        if j == 0 {
-            for (v, x) in value.iter_mut().zip(ws.jac.iter()) {
-                *v = x.re;
+    forward_kinematics(model, &mut ws.data, params, q);
+    identification_jacobian(model, &ws.data, obs, rows, columns, value, 0);
+    let data = &ws.data;
+    let p = observed_world(data, obs).trans;
+    let rt: Matrix3<f64> = data.instrument.rot.transpose();
+    for (k, jk) in data.joint_twists.iter().enumerate() {
+        ws.joint_w[k] = rt * jk.w;
+        ws.joint_p_dot[k] = rt * jk.point_velocity(&p);
+    }
+    for (c, &j) in columns.iter().enumerate() {
+        let s = influence(model.registry.get(j).segment, obs);
+        let order_j = ws.param_order[j];
+        let w_j = rt * data.param_twists[j].w * s;
+        let col = Vector3::new(value[(0, c)], value[(1, c)], value[(2, c)]);
+        for (k, out) in dq.iter_mut().enumerate().take(model.dof()) {
+            let (w_k, p_dot) = (&ws.joint_w[k], &ws.joint_p_dot[k]);
+            let order_k = ws.joint_order[k];
+            let (d_pos, d_rot) = if s == 0.0 {
+                (Vector3::zeros(), Vector3::zeros())
+            } else if order_j > order_k {
+                (w_k.cross(&col), w_k.cross(&w_j))
+            } else if order_j == order_k {
+                let rate = &data.param_twist_rates[j];
+                (
+                    rt * rate.point_velocity(&p) * s + w_j.cross(p_dot),
+                    rt * rate.w * s,
+                )
+            } else {
+                (w_j.cross(p_dot), Vector3::zeros())
+            };
+            out[(0, c)] = d_pos[0];
+            out[(1, c)] = d_pos[1];
+            out[(2, c)] = d_pos[2];
+            if rows == Rows::Pose {
+                out[(3, c)] = d_rot[0];
+                out[(4, c)] = d_rot[1];
+                out[(5, c)] = d_rot[2];
             }
         }
     }

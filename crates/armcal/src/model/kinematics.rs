@@ -22,6 +22,11 @@ pub struct Data<T: RealField + Copy> {
     pub param_twists: Vec<Twist<T>>,
     /// For every joint, the world-frame twist caused by a unit change of its variable.
     pub joint_twists: Vec<Twist<T>>,
+    /// For every parameter, the derivative of its world twist w.r.t. the angle (or
+    /// displacement) φ of its own factor. Only zero-reference screws have one (their
+    /// axis-direction and axis-point twists turn with φ, see [`apply_screw`]); every other
+    /// parameter's twist is taken before its factor acts and its entry stays zero.
+    pub param_twist_rates: Vec<Twist<T>>,
 }
 
 impl<T: RealField + Copy> Data<T> {
@@ -32,6 +37,7 @@ impl<T: RealField + Copy> Data<T> {
             targets: vec![Pose::identity(); model.targets.len()],
             param_twists: vec![Twist::zero(); model.param_count()],
             joint_twists: vec![Twist::zero(); model.dof()],
+            param_twist_rates: vec![Twist::zero(); model.param_count()],
         }
     }
 
@@ -170,6 +176,10 @@ fn rotate_columns<T: RealField + Copy>(pose: &mut Pose<T>, a: usize, b: usize, a
 /// - `p_k`: `(0, e_k − Rot e_k)`.
 ///
 /// Prismatic: `T(û φ)`; offset `(0, û)`, `u_k` `(0, φ dû)`, `p` has no effect.
+///
+/// Their derivatives w.r.t. φ (into `param_twist_rates`): `u_k`:
+/// `ω' = cos φ dû + sin φ û × dû`, `v' = p × ω'` (prismatic: `(0, dû)`); `p_k`:
+/// `(0, −û × Rot e_k)`; the offset twist does not depend on φ.
 fn apply_screw<T: RealField + Copy>(
     first: usize,
     joint: Option<usize>,
@@ -204,9 +214,14 @@ fn apply_screw<T: RealField + Copy>(
             data.joint_twists[j] = offset;
         }
         for k in 0..3 {
+            let d = du(k);
             data.param_twists[first + k] = pose.adjoint(&Twist {
                 w: Vector3::zeros(),
-                v: du(k) * phi,
+                v: d * phi,
+            });
+            data.param_twist_rates[first + k] = pose.adjoint(&Twist {
+                w: Vector3::zeros(),
+                v: d,
             });
             data.param_twists[first + 3 + k] = Twist::zero();
         }
@@ -227,11 +242,20 @@ fn apply_screw<T: RealField + Copy>(
         let d = du(k);
         let w = d * s + uh.cross(&d) * (T::one() - c);
         data.param_twists[first + k] = pose.adjoint(&Twist { w, v: p.cross(&w) });
+        let w_rate = d * c + uh.cross(&d) * s;
+        data.param_twist_rates[first + k] = pose.adjoint(&Twist {
+            w: w_rate,
+            v: p.cross(&w_rate),
+        });
         let mut e = Vector3::zeros();
         e[k] = T::one();
         data.param_twists[first + 3 + k] = pose.adjoint(&Twist {
             w: Vector3::zeros(),
             v: e - rot.column(k),
+        });
+        data.param_twist_rates[first + 3 + k] = pose.adjoint(&Twist {
+            w: Vector3::zeros(),
+            v: -uh.cross(&rot.column(k)),
         });
     }
     let local = Pose {

@@ -1,4 +1,191 @@
 //! Self-contained HTML reports: figures as inline SVG (plotters, embedded font) and a 3D
 //! view of the cell drawn in the browser from inline data. One file, no network fetches.
+//!
+//! [`documents`] recognises armcal's JSON results; one module per kind builds its section
+//! ([`estimate`], [`design`], [`study`], [`tcp`] for the Figure 7 comparison,
+//! [`demo_summary`]); [`figures`] draws plain data to SVG; [`html`] assembles the page.
 
 pub mod cell_view;
+pub mod demo_summary;
+pub mod design;
+pub mod design_record;
+pub mod documents;
+pub mod ellipse;
+pub mod estimate;
+pub mod figures;
+pub mod font;
+pub mod html;
+pub mod study;
+pub mod tcp;
+
+pub use design_record::DesignRecord;
+pub use documents::{Document, StudyRecord};
+
+use crate::cell::Cell;
+use crate::study::demo::DemoSummary;
+use crate::Error;
+use html::{escape, table, Page, Section};
+use tcp::TcpItem;
+
+/// One input of a report.
+#[derive(Clone, Debug)]
+pub struct Input {
+    /// Its name in headings and legends (plain text).
+    pub label: String,
+    /// Where it came from (file name), for the inputs table.
+    pub source: String,
+    pub document: Document,
+}
+
+/// What a report shows.
+#[derive(Clone, Debug, Default)]
+pub struct ReportContent<'a> {
+    pub title: &'a str,
+    pub subtitle: &'a str,
+    pub inputs: &'a [Input],
+    /// The demo's summary, shown first (else the first demo summary among the inputs).
+    pub demo: Option<&'a DemoSummary>,
+    /// The 3D view fragment ([`cell_view::cell_view_section`]), placed after the designs.
+    pub cell_view: Option<String>,
+    /// Notes for the reader (plain text), e.g. why the 3D view is missing.
+    pub notes: &'a [String],
+}
+
+fn inputs_section(inputs: &[Input], notes: &[String]) -> Section {
+    let mut s = Section::new("inputs", "Inputs");
+    let rows: Vec<Vec<String>> = inputs
+        .iter()
+        .map(|i| {
+            let about = match &i.document {
+                Document::Estimate(e) => format!(
+                    "cell <em>{}</em>, data {}",
+                    escape(&e.cell),
+                    escape(&e.data)
+                ),
+                Document::Design(d) => format!(
+                    "cell <em>{}</em>, {} poses, {}",
+                    escape(&d.cell),
+                    d.poses.len(),
+                    escape(&d.method)
+                ),
+                Document::Study(st) => format!(
+                    "study <em>{}</em>, {} robots, collision avoidance {}",
+                    escape(&st.study),
+                    st.rows.len(),
+                    if st.collisions { "on" } else { "off" }
+                ),
+                Document::Demo(d) => format!("{} poses per design, seed {}", d.poses, d.seed),
+            };
+            vec![
+                escape(&i.label),
+                i.document.kind().into(),
+                about,
+                escape(&i.source),
+            ]
+        })
+        .collect();
+    s.html(table(&["name", "kind", "about", "file"], &rows, &[]));
+    for n in notes {
+        s.html(format!("<p class=\"note\">{}</p>\n", escape(n)));
+    }
+    s
+}
+
+/// The page for `c`: the demo summary, the inputs, the TCP comparison (Figure 7), each
+/// design, the 3D view, each estimate, the studies.
+pub fn page(c: &ReportContent) -> Result<Page, Error> {
+    let mut sections = Vec::new();
+    let demo = c.demo.or_else(|| {
+        c.inputs.iter().find_map(|i| match &i.document {
+            Document::Demo(d) => Some(d.as_ref()),
+            _ => None,
+        })
+    });
+    if let Some(d) = demo {
+        sections.push(demo_summary::demo_section("summary", d)?);
+    }
+    if !c.inputs.is_empty() {
+        sections.push(inputs_section(c.inputs, c.notes));
+    }
+    let mut items = Vec::new();
+    for i in c.inputs {
+        let (tcp, predicted) = match &i.document {
+            Document::Design(d) => (d.assessment.tcp.first(), true),
+            Document::Estimate(e) => (e.tcp.first(), false),
+            Document::Study(_) | Document::Demo(_) => (None, false),
+        };
+        if let Some(t) = tcp {
+            items.push(TcpItem {
+                label: i.label.clone(),
+                predicted,
+                working: t.name.clone(),
+                covariance: t.covariance,
+            });
+        }
+    }
+    sections.extend(tcp::tcp_section("tcp", &items)?);
+    for (k, i) in c.inputs.iter().enumerate() {
+        if let Document::Design(d) = &i.document {
+            sections.push(design::design_section(
+                &format!("design-{}", k + 1),
+                &i.label,
+                d,
+            )?);
+        }
+    }
+    if let Some(view) = &c.cell_view {
+        sections.push(Section::fragment(
+            "cell-view",
+            "3D view of the cell",
+            view.clone(),
+        ));
+    }
+    for (k, i) in c.inputs.iter().enumerate() {
+        if let Document::Estimate(e) = &i.document {
+            sections.push(estimate::estimate_section(
+                &format!("estimate-{}", k + 1),
+                &i.label,
+                e,
+            )?);
+        }
+    }
+    let studies: Vec<(String, &StudyRecord)> = c
+        .inputs
+        .iter()
+        .filter_map(|i| match &i.document {
+            Document::Study(s) => Some((i.label.clone(), s)),
+            _ => None,
+        })
+        .collect();
+    if !studies.is_empty() {
+        sections.push(study::study_section("study", &studies)?);
+    }
+    Ok(Page {
+        title: c.title.into(),
+        subtitle: c.subtitle.into(),
+        sections,
+    })
+}
+
+/// The self-contained HTML report.
+pub fn render(c: &ReportContent) -> Result<String, Error> {
+    Ok(page(c)?.render())
+}
+
+/// The 3D view of the designs among `inputs` that were made for `cell` (same cell name);
+/// `None` if there are none.
+pub fn cell_view_of(cell: &Cell, inputs: &[Input]) -> Result<Option<String>, Error> {
+    let mut designs = Vec::new();
+    for i in inputs {
+        if let Document::Design(d) = &i.document {
+            if d.cell == cell.name {
+                designs.push((i.label.as_str(), d.design_for(&cell.model)?));
+            }
+        }
+    }
+    if designs.is_empty() {
+        return Ok(None);
+    }
+    let refs: Vec<(&str, &[Vec<f64>])> = designs.iter().map(|(n, q)| (*n, q.as_slice())).collect();
+    cell_view::cell_view_section(cell, &refs).map(Some)
+}

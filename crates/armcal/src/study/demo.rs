@@ -1,8 +1,8 @@
 //! The whole workflow on the paper cell in one call: plan a KPI design with collision
 //! avoidance and a random heuristic design, simulate a measurement campaign on a perturbed
 //! "true" robot for each, identify, compensate a small working program, and evaluate on
-//! held-out poses. Every intermediate file is returned for writing; the same seed gives the
-//! same files (solver times are left out of them).
+//! held-out poses. Every intermediate file and the HTML report are returned for writing; the
+//! same seed gives the same files (solver times are left out of them).
 
 use crate::compensate::program::filter_joint_program;
 use crate::compensate::IkSettings;
@@ -12,6 +12,7 @@ use crate::design::DesignModel;
 use crate::identify::{identify, ErrorStats, Estimate, IdentifyOptions, Silent};
 use crate::measure::csv;
 use crate::model::{forward_kinematics, observed_position, Data, Observed};
+use crate::report::{self, DesignRecord, Document, Input, ReportContent};
 use crate::sim::{perturbed_truth, simulate, Perturbation};
 use crate::Error;
 use serde::{Deserialize, Serialize};
@@ -28,6 +29,8 @@ pub struct Campaign {
     pub tcp_error_achieved: f64,
     /// Held-out position error of the identified model against the true robot (mm).
     pub held_out: ErrorStats,
+    /// The same, per held-out pose (mm).
+    pub held_out_errors: Vec<f64>,
 }
 
 /// The demo's numbers.
@@ -36,6 +39,8 @@ pub struct DemoSummary {
     pub seed: u64,
     pub poses: usize,
     pub nominal_held_out: ErrorStats,
+    /// The nominal model's error per held-out pose (mm).
+    pub nominal_held_out_errors: Vec<f64>,
     pub heuristic: Campaign,
     pub kpi: Campaign,
     /// Largest miss of the working program on the true robot: nominal joints and filtered
@@ -66,7 +71,7 @@ pub fn run_demo(seed: u64, progress: &dyn Fn(&str)) -> Result<Demo, Error> {
     let poses = 60;
 
     progress("planning the KPI design (collision avoidance on)");
-    let report = plan(
+    let mut plan_report = plan(
         &cell,
         &PlanSettings {
             poses,
@@ -75,6 +80,8 @@ pub fn run_demo(seed: u64, progress: &dyn Fn(&str)) -> Result<Demo, Error> {
         },
         &[],
     )?;
+    // Wall-clock time differs between runs: the demo's files leave it out (zero).
+    plan_report.time = std::time::Duration::ZERO;
     let d = DesignModel::from_cell(&cell)?;
     let set = constraint_set(&cell, true)?;
     let cons = CellConstraints::new(&set, &d.params);
@@ -84,12 +91,37 @@ pub fn run_demo(seed: u64, progress: &dyn Fn(&str)) -> Result<Demo, Error> {
     })?;
     files.push((
         "design-kpi.csv".into(),
-        csv::write_configurations(model, &report.design),
+        csv::write_configurations(model, &plan_report.design),
     ));
     files.push((
         "design-heuristic.csv".into(),
         csv::write_configurations(model, &heuristic),
     ));
+    let kpi_record = DesignRecord::new(
+        &cell,
+        Some("cell.toml"),
+        "KPI-optimal plan (exchange and refinement, collision avoidance on)",
+        &plan_report.design,
+        Some(plan_report.clone()),
+        true,
+    )?;
+    let heuristic_record = DesignRecord::new(
+        &cell,
+        Some("cell.toml"),
+        "random feasible poses (heuristic)",
+        &heuristic,
+        None,
+        true,
+    )?;
+    for (name, record) in [
+        ("design-kpi.json", &kpi_record),
+        ("design-heuristic.json", &heuristic_record),
+    ] {
+        files.push((
+            name.into(),
+            serde_json::to_string_pretty(record).map_err(|e| Error::Input(e.to_string()))?,
+        ));
+    }
 
     // Held-out configurations: feasible poses not in either design.
     let (held_out, _) = random_feasible(model, 100, seed.wrapping_add(2), 2_000_000, |q| {
@@ -106,16 +138,14 @@ pub fn run_demo(seed: u64, progress: &dyn Fn(&str)) -> Result<Demo, Error> {
             .collect()
     };
     let true_positions = positions(&truth, &mut fk);
-    let errors_of = |params: &[f64], fk: &mut Data<f64>| {
-        let p = positions(params, fk);
-        ErrorStats::of(
-            &p.iter()
-                .zip(&true_positions)
-                .map(|(a, b)| (a - b).norm())
-                .collect::<Vec<_>>(),
-        )
+    let errors_of = |params: &[f64], fk: &mut Data<f64>| -> Vec<f64> {
+        positions(params, fk)
+            .iter()
+            .zip(&true_positions)
+            .map(|(a, b)| (a - b).norm())
+            .collect()
     };
-    let nominal_held_out = errors_of(&model.nominal(), &mut fk);
+    let nominal_held_out_errors = errors_of(&model.nominal(), &mut fk);
     let work = cell.working[0].q.clone();
     let tcp = |params: &[f64], fk: &mut Data<f64>| {
         forward_kinematics(model, fk, params, &work);
@@ -148,16 +178,24 @@ pub fn run_demo(seed: u64, progress: &dyn Fn(&str)) -> Result<Demo, Error> {
             serde_json::to_string_pretty(&est).map_err(|e| Error::Input(e.to_string()))?,
         ));
         let p = est.params_for(model)?;
+        let held_out_errors = errors_of(&p, &mut fk);
         let c = Campaign {
             design: name.into(),
             tcp_sigma_predicted: est.tcp.first().map(|t| t.kpi.sqrt()).unwrap_or(f64::NAN),
             tcp_error_achieved: (tcp(&p, &mut fk) - tcp_truth).norm(),
-            held_out: errors_of(&p, &mut fk),
+            held_out: ErrorStats::of(&held_out_errors),
+            held_out_errors,
         };
         Ok((c, est))
     };
-    let (heuristic_c, _) = campaign("heuristic", &heuristic, seed.wrapping_add(10), &mut files)?;
-    let (kpi_c, kpi_est) = campaign("kpi", &report.design, seed.wrapping_add(20), &mut files)?;
+    let (heuristic_c, heuristic_est) =
+        campaign("heuristic", &heuristic, seed.wrapping_add(10), &mut files)?;
+    let (kpi_c, kpi_est) = campaign(
+        "kpi",
+        &plan_report.design,
+        seed.wrapping_add(20),
+        &mut files,
+    )?;
 
     progress("compensating a working program");
     let calibrated = kpi_est.params_for(model)?;
@@ -210,16 +248,57 @@ pub fn run_demo(seed: u64, progress: &dyn Fn(&str)) -> Result<Demo, Error> {
     let summary = DemoSummary {
         seed,
         poses,
-        nominal_held_out,
+        nominal_held_out: ErrorStats::of(&nominal_held_out_errors),
+        nominal_held_out_errors,
         heuristic: heuristic_c,
         kpi: kpi_c,
         program_miss_nominal: miss_nominal,
         program_miss_compensated: miss_comp,
-        kpi_bound_efficiency: report.bound.as_ref().map(|b| b.efficiency),
+        kpi_bound_efficiency: plan_report.bound.as_ref().map(|b| b.efficiency),
     };
     files.push((
         "summary.json".into(),
         serde_json::to_string_pretty(&summary).map_err(|e| Error::Input(e.to_string()))?,
     ));
+
+    progress("writing the report");
+    let inputs = [
+        (
+            "KPI design",
+            "design-kpi.json",
+            Document::Design(Box::new(kpi_record)),
+        ),
+        (
+            "heuristic design",
+            "design-heuristic.json",
+            Document::Design(Box::new(heuristic_record)),
+        ),
+        (
+            "KPI design",
+            "estimate-kpi.json",
+            Document::Estimate(Box::new(kpi_est)),
+        ),
+        (
+            "heuristic design",
+            "estimate-heuristic.json",
+            Document::Estimate(Box::new(heuristic_est)),
+        ),
+    ]
+    .map(|(label, source, document)| Input {
+        label: label.into(),
+        source: source.into(),
+        document,
+    });
+    let html = report::render(&ReportContent {
+        title: "armcal demo: calibrating the paper cell",
+        subtitle: &format!(
+            "KPI-optimal vs heuristic measurement poses, {poses} poses each, seed {seed}; simulated laser-tracker campaign on a perturbed robot"
+        ),
+        inputs: &inputs,
+        demo: Some(&summary),
+        cell_view: report::cell_view_of(&cell, &inputs)?,
+        notes: &[],
+    })?;
+    files.push(("report.html".into(), html));
     Ok(Demo { summary, files })
 }

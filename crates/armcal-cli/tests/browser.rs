@@ -1,0 +1,238 @@
+//! The demo's HTML report in a real browser: headless Chromium loads `report.html` from
+//! `armcal demo`, runs its scripts, and the test checks that the figures and the 3D cell view
+//! drew (from the DOM after the scripts ran) and that screenshots are not blank.
+//!
+//! Chromium is taken from `ARMCAL_CHROMIUM` or from `chromium`, `chromium-browser`,
+//! `google-chrome` on PATH. Without one the test is skipped with a message, unless
+//! `ARMCAL_REQUIRE_BROWSER=1` (set by `.ci/run`), when it fails. Screenshots are written under
+//! `target/` (`CARGO_TARGET_TMPDIR/browser/`), never into the repository.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// How long one browser or demo run may take before the test fails.
+const DEADLINE: Duration = Duration::from_secs(180);
+
+/// Canvas pixels that must differ from the background for a cell view to count as drawn
+/// (the canvas has 960 × 600 = 576 000).
+const MIN_INK_PIXELS: usize = 20_000;
+
+/// Fewest SVG figures the demo's report must have.
+const MIN_FIGURES: usize = 5;
+
+fn chromium() -> Option<PathBuf> {
+    if let Some(p) = std::env::var_os("ARMCAL_CHROMIUM").filter(|p| !p.is_empty()) {
+        return Some(PathBuf::from(p));
+    }
+    let path = std::env::var_os("PATH")?;
+    ["chromium", "chromium-browser", "google-chrome"]
+        .iter()
+        .flat_map(|name| std::env::split_paths(&path).map(move |dir| dir.join(name)))
+        .find(|p| p.is_file())
+}
+
+/// Runs `cmd` with stdout and stderr sent to files in `dir` (a browser's DOM dump is larger
+/// than a pipe holds); kills its process group and fails if it is not done by [`DEADLINE`].
+/// Returns stdout.
+fn run(mut cmd: Command, dir: &Path, what: &str) -> String {
+    use std::os::unix::process::CommandExt;
+    let out_path = dir.join(format!("{what}.stdout"));
+    let err_path = dir.join(format!("{what}.stderr"));
+    cmd.stdin(Stdio::null())
+        .stdout(std::fs::File::create(&out_path).expect("stdout file"))
+        .stderr(std::fs::File::create(&err_path).expect("stderr file"))
+        .process_group(0);
+    let mut child = cmd
+        .spawn()
+        .unwrap_or_else(|e| panic!("{what}: cannot start: {e}"));
+    let t0 = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("wait") {
+            break status;
+        }
+        if t0.elapsed() > DEADLINE {
+            // The browser forks helpers: end the whole group it leads.
+            let _ = Command::new("kill")
+                .args(["-KILL", &format!("-{}", child.id())])
+                .status();
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!(
+                "{what}: no result within {DEADLINE:?}; stderr:\n{}",
+                std::fs::read_to_string(&err_path).unwrap_or_default()
+            );
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    let stderr = std::fs::read_to_string(&err_path).unwrap_or_default();
+    assert!(status.success(), "{what} failed ({status}):\n{stderr}");
+    std::fs::read_to_string(&out_path).unwrap_or_else(|e| panic!("{what}: stdout: {e}"))
+}
+
+/// A headless Chromium command for `url` with a fresh profile: no sandbox (CI runs as root),
+/// no GPU, no network side traffic, 5 s of virtual time for the page's scripts.
+fn browser(exe: &Path, profile: &Path, extra: &[String], url: &str) -> Command {
+    let _ = std::fs::remove_dir_all(profile);
+    std::fs::create_dir_all(profile).expect("profile dir");
+    let mut cmd = Command::new(exe);
+    cmd.args([
+        "--headless",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--disable-quic",
+        "--no-first-run",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+        "--hide-scrollbars",
+        "--virtual-time-budget=5000",
+    ])
+    .arg(format!("--user-data-dir={}", profile.display()))
+    .args(extra)
+    .arg(url);
+    cmd
+}
+
+/// The value of attribute `name` in the start tag `tag` (`<canvas …>`).
+fn attribute<'a>(tag: &'a str, name: &str) -> Option<&'a str> {
+    let key = format!(" {name}=\"");
+    let start = tag.find(&key)? + key.len();
+    Some(&tag[start..start + tag[start..].find('"')?])
+}
+
+/// The `<canvas …>` start tags inside each `<section class="cell-view" …>` of a DOM dump,
+/// with the section's id.
+fn cell_view_canvases(dom: &str) -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    for (i, _) in dom.match_indices("<section class=\"cell-view\"") {
+        let section = &dom[i..i + dom[i..].find("</section>").expect("section closes")];
+        let open = &section[..section.find('>').unwrap() + 1];
+        let id = attribute(open, "id").unwrap_or("").to_string();
+        for (k, _) in section.match_indices("<canvas") {
+            let tag = &section[k..k + section[k..].find('>').unwrap() + 1];
+            out.push((id.clone(), tag.to_string()));
+        }
+    }
+    out
+}
+
+/// Decodes a PNG screenshot to (width, height, RGB pixels).
+fn decode_png(path: &Path) -> (u32, u32, Vec<[u8; 3]>) {
+    let file = std::fs::File::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut decoder = png::Decoder::new(std::io::BufReader::new(file));
+    decoder.set_transformations(png::Transformations::normalize_to_color8());
+    let mut reader = decoder.read_info().expect("PNG header");
+    let mut buf = vec![0; reader.output_buffer_size().expect("PNG size")];
+    let info = reader.next_frame(&mut buf).expect("PNG data");
+    let channels = info.color_type.samples();
+    let pixels = buf[..info.buffer_size()]
+        .chunks_exact(channels)
+        .map(|c| match channels {
+            1 | 2 => [c[0]; 3],
+            _ => [c[0], c[1], c[2]],
+        })
+        .collect();
+    (info.width, info.height, pixels)
+}
+
+/// Share of pixels that differ from the most common colour.
+fn off_dominant_share(pixels: &[[u8; 3]]) -> f64 {
+    let mut counts = std::collections::HashMap::<[u8; 3], usize>::new();
+    for p in pixels {
+        *counts.entry(*p).or_insert(0) += 1;
+    }
+    let dominant = counts.values().copied().max().unwrap_or(0);
+    1.0 - dominant as f64 / pixels.len() as f64
+}
+
+#[test]
+fn demo_report_draws_in_headless_chromium() {
+    let Some(exe) = chromium() else {
+        if std::env::var("ARMCAL_REQUIRE_BROWSER").as_deref() == Ok("1") {
+            panic!(
+                "Chromium not found (ARMCAL_REQUIRE_BROWSER=1): install Debian package \
+                 `chromium` or set ARMCAL_CHROMIUM"
+            );
+        }
+        eprintln!("skipped: Chromium not found (install Debian package `chromium`)");
+        return;
+    };
+    let work = Path::new(env!("CARGO_TARGET_TMPDIR")).join("browser");
+    std::fs::create_dir_all(&work).expect("work dir");
+    let demo_dir = work.join("demo");
+
+    let mut demo = Command::new(env!("CARGO_BIN_EXE_armcal"));
+    demo.args(["demo", "--quiet", "--out"]).arg(&demo_dir);
+    run(demo, &work, "demo");
+    let report = demo_dir.join("report.html");
+    assert!(report.is_file(), "the demo wrote no {}", report.display());
+    let html = std::fs::read_to_string(&report).expect("report.html");
+    assert!(
+        !html.contains("http://") && !html.contains("https://"),
+        "the report must not fetch anything"
+    );
+    let url = format!(
+        "file://{}",
+        report.canonicalize().expect("report path").display()
+    );
+
+    // The DOM after the scripts ran.
+    let dom = run(
+        browser(
+            &exe,
+            &work.join("profile-dom"),
+            &["--dump-dom".into()],
+            &url,
+        ),
+        &work,
+        "chromium-dump-dom",
+    );
+    let canvases = cell_view_canvases(&dom);
+    assert!(!canvases.is_empty(), "no 3D cell view in the report");
+    for (id, tag) in &canvases {
+        assert_eq!(attribute(tag, "data-drawn"), Some("1"), "{id}: {tag}");
+        let ink: usize = attribute(tag, "data-ink-pixels")
+            .and_then(|v| v.parse().ok())
+            .unwrap_or_else(|| panic!("{id}: no ink count in {tag}"));
+        assert!(
+            (MIN_INK_PIXELS..960 * 600).contains(&ink),
+            "{id}: {ink} inked pixels"
+        );
+        eprintln!("{id}: {ink} of 576000 canvas pixels drawn");
+    }
+    let figures = dom.matches("<svg").count();
+    let meta = "<meta name=\"armcal-figures\" content=\"";
+    let declared: usize = dom
+        .find(meta)
+        .map(|i| &dom[i + meta.len()..])
+        .and_then(|rest| rest[..rest.find('"')?].parse().ok())
+        .expect("the report declares its figure count in <meta name=\"armcal-figures\">");
+    assert_eq!(figures, declared, "SVG figures in the DOM");
+    assert!(declared >= MIN_FIGURES, "{declared} figures");
+    eprintln!("{figures} SVG figures drawn, {declared} declared");
+
+    // A screenshot of the page's top. The 3D view's pixels are checked through the DOM above:
+    // with a URL fragment headless Chromium's --screenshot comes out blank (Chromium 148),
+    // so the view cannot be scrolled into a fixed-size shot.
+    let shot = work.join("report.png");
+    let _ = std::fs::remove_file(&shot);
+    let extra = [
+        format!("--screenshot={}", shot.display()),
+        "--window-size=1400,3000".to_string(),
+    ];
+    run(
+        browser(&exe, &work.join("profile-shot"), &extra, &url),
+        &work,
+        "chromium-screenshot",
+    );
+    let (w, h, pixels) = decode_png(&shot);
+    assert_eq!((w, h), (1400, 3000), "{}", shot.display());
+    let share = off_dominant_share(&pixels);
+    assert!(share > 0.02, "{}: nearly one flat colour", shot.display());
+    eprintln!(
+        "{}: {w}×{h}, {:.1} % of pixels off the dominant colour",
+        shot.display(),
+        100.0 * share
+    );
+}

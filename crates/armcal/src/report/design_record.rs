@@ -1,0 +1,226 @@
+//! The design file: what `armcal plan` writes beside the design CSV (and `armcal demo` for
+//! each of its designs), and what `armcal report` reads — the poses in user units, the
+//! joint limits, the planner's report, the predicted precision and the smallest margin of
+//! every kind of constraint.
+
+use crate::cell::Cell;
+use crate::design::assess::{assess, DesignAssessment};
+use crate::design::plan::{constraint_set, PlanReport};
+use crate::geometry::ConstraintKind;
+use crate::model::Model;
+use crate::Error;
+use serde::{Deserialize, Serialize};
+
+/// A joint's name, display unit and limits (deg or mm).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct JointRange {
+    pub name: String,
+    pub unit: String,
+    pub lower: f64,
+    pub upper: f64,
+}
+
+/// The smallest margin of one kind of constraint over a design.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct KindMargin {
+    /// "incidence", "self-collision", "obstacle", "half-space", "line of sight" or
+    /// "joint limits".
+    pub kind: String,
+    /// "deg" (incidence angle below its limit, distance of a joint from its limit) or "mm"
+    /// (clearance between capsules, to a half-space, of the beam).
+    pub unit: String,
+    /// Constraints of this kind per pose.
+    pub per_pose: usize,
+    /// Smallest margin over the design (negative: violated).
+    pub value: f64,
+    /// The constraint (or joint) with the smallest margin, and its pose (1-based).
+    pub constraint: String,
+    pub pose: usize,
+}
+
+/// Everything the report shows about a design.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct DesignRecord {
+    pub cell: String,
+    /// The cell as given to the planner (a cell-file path or a built-in robot), so a report
+    /// can rebuild it for the 3D view.
+    pub cell_source: Option<String>,
+    /// How the design was made (e.g. "KPI-optimal plan").
+    pub method: String,
+    /// Whether collision and line-of-sight constraints applied (the margins include them).
+    pub collisions: bool,
+    pub joints: Vec<JointRange>,
+    /// The poses in design-file order, display units (deg, mm).
+    pub poses: Vec<Vec<f64>>,
+    /// The planner's report (its `design` in internal units: rad, mm); absent for a design
+    /// not planned by armcal.
+    pub plan: Option<PlanReport>,
+    pub assessment: DesignAssessment,
+    pub margins: Vec<KindMargin>,
+}
+
+/// Display factor (internal → display) and unit name of each joint of a model.
+fn joint_units(model: &Model) -> Vec<(f64, &'static str)> {
+    model
+        .joints
+        .iter()
+        .map(|j| (j.kind.unit().display_factor(), j.kind.unit().display_name()))
+        .collect()
+}
+
+fn kind_name(kind: ConstraintKind) -> &'static str {
+    match kind {
+        ConstraintKind::Incidence => "incidence",
+        ConstraintKind::SelfCollision => "self-collision",
+        ConstraintKind::Obstacle => "obstacle",
+        ConstraintKind::HalfSpace => "half-space",
+        ConstraintKind::LineOfSight => "line of sight",
+    }
+}
+
+const KINDS: [ConstraintKind; 5] = [
+    ConstraintKind::Incidence,
+    ConstraintKind::SelfCollision,
+    ConstraintKind::Obstacle,
+    ConstraintKind::HalfSpace,
+    ConstraintKind::LineOfSight,
+];
+
+/// The smallest margin per constraint kind over `design` (internal units), at the nominal
+/// parameters. Incidence margins are angles: with `v = cos β − cos β_max` (paper eq. 4),
+/// the margin is `β_max − β` in degrees. Joint-limit margins are `min(q − q_lo, q_hi − q)`,
+/// one entry per display unit.
+pub fn kind_margins(
+    cell: &Cell,
+    design: &[Vec<f64>],
+    collisions: bool,
+) -> Result<Vec<KindMargin>, Error> {
+    let set = constraint_set(cell, collisions)?;
+    let params = cell.model.nominal();
+    let mut ws = set.workspace();
+    let mut values = vec![0.0; set.len()];
+    let mut best: Vec<Option<KindMargin>> = vec![None; KINDS.len()];
+    let max_incidence = cell.instrument.as_ref().and_then(|i| i.max_incidence);
+    for (p, q) in design.iter().enumerate() {
+        cell.model
+            .check_joints(q)
+            .map_err(|e| Error::Input(format!("pose {}: {e}", p + 1)))?;
+        set.evaluate(&mut ws, &params, q, &mut values, None);
+        for (i, v) in values.iter().enumerate() {
+            let kind = set.kind(i);
+            let k = KINDS
+                .iter()
+                .position(|x| *x == kind)
+                .expect("every kind listed");
+            let value = match (kind, max_incidence) {
+                (ConstraintKind::Incidence, Some(m)) => {
+                    let beta = (v + m.cos()).clamp(-1.0, 1.0).acos();
+                    (m - beta).to_degrees()
+                }
+                _ => *v,
+            };
+            if best[k].as_ref().is_none_or(|b| value < b.value) {
+                best[k] = Some(KindMargin {
+                    kind: kind_name(kind).into(),
+                    unit: if kind == ConstraintKind::Incidence {
+                        "deg"
+                    } else {
+                        "mm"
+                    }
+                    .into(),
+                    per_pose: set.count(kind),
+                    value,
+                    constraint: set.name(i).to_string(),
+                    pose: p + 1,
+                });
+            }
+        }
+    }
+    let mut out: Vec<KindMargin> = best.into_iter().flatten().collect();
+    let units = joint_units(&cell.model);
+    for unit in ["deg", "mm"] {
+        let mut m: Option<KindMargin> = None;
+        for (p, q) in design.iter().enumerate() {
+            for (j, (joint, (f, u))) in cell.model.joints.iter().zip(&units).enumerate() {
+                if *u != unit {
+                    continue;
+                }
+                let value = f * (q[j] - joint.lower).min(joint.upper - q[j]);
+                if m.as_ref().is_none_or(|b| value < b.value) {
+                    m = Some(KindMargin {
+                        kind: "joint limits".into(),
+                        unit: unit.into(),
+                        per_pose: units.iter().filter(|x| x.1 == unit).count(),
+                        value,
+                        constraint: joint.name.clone(),
+                        pose: p + 1,
+                    });
+                }
+            }
+        }
+        out.extend(m);
+    }
+    Ok(out)
+}
+
+impl DesignRecord {
+    /// The record of `design` (internal units) for `cell`: predicted precision, margins and,
+    /// if it was planned, the planner's report.
+    pub fn new(
+        cell: &Cell,
+        cell_source: Option<&str>,
+        method: &str,
+        design: &[Vec<f64>],
+        plan: Option<PlanReport>,
+        collisions: bool,
+    ) -> Result<DesignRecord, Error> {
+        let units = joint_units(&cell.model);
+        Ok(DesignRecord {
+            cell: cell.name.clone(),
+            cell_source: cell_source.map(String::from),
+            method: method.into(),
+            collisions,
+            joints: cell
+                .model
+                .joints
+                .iter()
+                .zip(&units)
+                .map(|(j, (f, u))| JointRange {
+                    name: j.name.clone(),
+                    unit: (*u).into(),
+                    lower: j.lower * f,
+                    upper: j.upper * f,
+                })
+                .collect(),
+            poses: design
+                .iter()
+                .map(|q| q.iter().zip(&units).map(|(v, (f, _))| v * f).collect())
+                .collect(),
+            assessment: assess(cell, design)?,
+            margins: kind_margins(cell, design, collisions)?,
+            plan,
+        })
+    }
+
+    /// The poses in internal units (rad, mm) for `model`, whose joints must match the
+    /// record's.
+    pub fn design_for(&self, model: &Model) -> Result<Vec<Vec<f64>>, Error> {
+        let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+        let ours: Vec<&str> = self.joints.iter().map(|j| j.name.as_str()).collect();
+        if names != ours {
+            return Err(Error::Input(format!(
+                "the design (cell `{}`, joints {}) does not fit model `{}` (joints {})",
+                self.cell,
+                ours.join(", "),
+                model.name,
+                names.join(", ")
+            )));
+        }
+        let units = joint_units(model);
+        Ok(self
+            .poses
+            .iter()
+            .map(|q| q.iter().zip(&units).map(|(v, (f, _))| v / f).collect())
+            .collect())
+    }
+}

@@ -1,0 +1,112 @@
+//! The inputs of a report: armcal's JSON files, recognised by their content — an estimate
+//! (`armcal identify`, `armcal demo`), a design (`armcal plan`, `armcal demo`), a study
+//! (`armcal study paper`) or the demo's summary.
+
+use super::design_record::DesignRecord;
+use crate::identify::Estimate;
+use crate::study::demo::DemoSummary;
+use crate::study::paper::StudyRow;
+use crate::Error;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// The result file of `armcal study paper`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct StudyRecord {
+    pub study: String,
+    pub collisions: bool,
+    pub rows: Vec<StudyRow>,
+}
+
+/// One input of a report.
+#[derive(Clone, Debug)]
+pub enum Document {
+    Estimate(Box<Estimate>),
+    Design(Box<DesignRecord>),
+    Study(StudyRecord),
+    /// The `summary.json` of `armcal demo`.
+    Demo(Box<DemoSummary>),
+}
+
+const EXPECTED: &str = "expected an armcal estimate (from `armcal identify`), design (the .json \
+    `armcal plan` writes beside the design CSV), study result (`armcal study paper`) or demo \
+    summary (`armcal demo`)";
+
+impl Document {
+    /// Recognises and reads an armcal JSON document; `file` names it in errors.
+    pub fn from_json(text: &str, file: &str) -> Result<Document, Error> {
+        let fail = |message: String| Error::File {
+            file: file.into(),
+            message,
+        };
+        let value: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| fail(format!("not JSON ({e}); {EXPECTED}")))?;
+        let obj = value
+            .as_object()
+            .ok_or_else(|| fail(format!("not a JSON object; {EXPECTED}")))?;
+        let has = |keys: &[&str]| keys.iter().all(|k| obj.contains_key(*k));
+        let read = |what: &str| {
+            let what = what.to_string();
+            move |e: serde_json::Error| fail(format!("looks like an armcal {what}, but: {e}"))
+        };
+        if let Some(study) = obj.get("study") {
+            return match study.as_str() {
+                Some("paper") => Ok(Document::Study(
+                    serde_json::from_value(value).map_err(read("study result"))?,
+                )),
+                other => Err(fail(format!(
+                    "a study result of `{}`; the report covers `armcal study paper` results ({EXPECTED})",
+                    other.unwrap_or("?")
+                ))),
+            };
+        }
+        if has(&["parameters", "solver", "uncertainty", "model"]) {
+            return Ok(Document::Estimate(Box::new(
+                serde_json::from_value(value).map_err(read("estimate"))?,
+            )));
+        }
+        if has(&["assessment", "poses", "joints"]) {
+            return Ok(Document::Design(Box::new(
+                serde_json::from_value(value).map_err(read("design"))?,
+            )));
+        }
+        if has(&[
+            "nominal_held_out",
+            "heuristic",
+            "kpi",
+            "program_miss_nominal",
+        ]) {
+            return Ok(Document::Demo(Box::new(
+                serde_json::from_value(value).map_err(read("demo summary"))?,
+            )));
+        }
+        let keys: Vec<&str> = obj.keys().map(String::as_str).take(8).collect();
+        Err(fail(format!(
+            "not an armcal result (top-level fields: {}); {EXPECTED}",
+            if keys.is_empty() {
+                "none".to_string()
+            } else {
+                keys.join(", ")
+            }
+        )))
+    }
+
+    /// Reads a file.
+    pub fn from_file(path: &Path) -> Result<Document, Error> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::File {
+            file: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        Document::from_json(&text, &path.display().to_string())
+    }
+
+    /// What kind of document this is, for messages and headings.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Document::Estimate(_) => "estimate",
+            Document::Design(_) => "design",
+            Document::Study(_) => "study",
+            Document::Demo(_) => "demo summary",
+        }
+    }
+}

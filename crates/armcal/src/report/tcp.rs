@@ -1,0 +1,114 @@
+//! The TCP-precision section: C_s at the working pose for every design (predicted before
+//! measuring) and every estimate (after identification), as a table and as the projections
+//! of the 95 % confidence ellipsoids on the xy, xz and yz planes (paper Figure 7).
+
+use super::ellipse::{confidence_scale, Plane};
+use super::figures::{ellipse_figure, EllipseSeries};
+use super::html::{escape, fixed, number, table, Figure, Section};
+use crate::Error;
+use nalgebra::Matrix3;
+
+/// Probability held by the drawn confidence ellipsoids (the paper's Figure 7 uses 95 %).
+pub const CONFIDENCE: f64 = 0.95;
+
+/// One TCP covariance to compare.
+#[derive(Clone, Debug)]
+pub struct TcpItem {
+    pub label: String,
+    /// `true`: predicted by a design; `false`: from an identification.
+    pub predicted: bool,
+    /// The working pose's name.
+    pub working: String,
+    /// C_s (mm²).
+    pub covariance: Matrix3<f64>,
+}
+
+/// The section comparing `items`; `None` when there is nothing to compare.
+pub fn tcp_section(id: &str, items: &[TcpItem]) -> Result<Option<Section>, Error> {
+    if items.is_empty() {
+        return Ok(None);
+    }
+    let k = confidence_scale(3, CONFIDENCE)?;
+    let mut s = Section::new(id, "TCP precision at the working pose");
+    s.html(format!(
+        "<p class=\"note\">C_s is the covariance of the tool centre point at the working pose: predicted from the design before anything is measured (paper eq. 19 / appendix, C_s = G C_p Gᵀ), and from the identification afterwards. The figures show the projections of the {:.0} % confidence ellipsoid δᵀ C_s⁻¹ δ ≤ k² with k = √χ²₃({}) = {} onto the coordinate planes of the instrument frame, centred on the TCP (mm): dashed outlines are design predictions, solid ones identifications.</p>\n",
+        100.0 * CONFIDENCE,
+        CONFIDENCE,
+        fixed(k, 3)
+    ));
+    let rows: Vec<Vec<String>> = items
+        .iter()
+        .map(|t| {
+            let c = &t.covariance;
+            let kpi = c.trace() / 3.0;
+            let largest = c.symmetric_eigen().eigenvalues.max().max(0.0).sqrt() * k;
+            vec![
+                escape(&t.label),
+                if t.predicted {
+                    "design prediction"
+                } else {
+                    "identification"
+                }
+                .into(),
+                escape(&t.working),
+                number(kpi),
+                number(kpi.sqrt()),
+                number(c[(0, 0)].sqrt()),
+                number(c[(1, 1)].sqrt()),
+                number(c[(2, 2)].sqrt()),
+                number(largest),
+            ]
+        })
+        .collect();
+    s.html(table(
+        &[
+            "",
+            "source",
+            "working pose",
+            "(1/3) tr C_s (mm²)",
+            "TCP σ (mm)",
+            "σ_x (mm)",
+            "σ_y (mm)",
+            "σ_z (mm)",
+            "largest 95 % semi-axis (mm)",
+        ],
+        &rows,
+        &[3, 4, 5, 6, 7, 8],
+    ));
+    let mut labels: Vec<&str> = Vec::new();
+    for t in items {
+        if !labels.contains(&t.label.as_str()) {
+            labels.push(&t.label);
+        }
+    }
+    let series: Vec<EllipseSeries> = items
+        .iter()
+        .map(|t| EllipseSeries {
+            colour: labels.iter().position(|l| *l == t.label).unwrap_or(0),
+            label: format!(
+                "{} ({})",
+                t.label,
+                if t.predicted {
+                    "predicted"
+                } else {
+                    "identified"
+                }
+            ),
+            covariance: t.covariance,
+            dashed: t.predicted,
+        })
+        .collect();
+    let mut figures = Vec::new();
+    for plane in Plane::ALL {
+        let (a, b) = plane.axis_names();
+        figures.push(Figure {
+            svg: ellipse_figure(plane, &series, k)?,
+            caption: format!(
+                "{a}{b} projection of the {:.0} % confidence ellipsoid of the TCP (δ{a}, δ{b} in mm).",
+                100.0 * CONFIDENCE
+            ),
+        });
+    }
+    s.figure_row(figures);
+    Ok(Some(s))
+}
