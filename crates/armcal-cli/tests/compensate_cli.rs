@@ -1,16 +1,9 @@
 //! `armcal compensate` with bad input (rows outside the joint limits, unreachable Cartesian
 //! targets, an estimate of another robot) and with the nonparametric correction.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 mod common;
-use common::armcal;
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use common::{armcal, identify_paper_cell, scratch, simulate_paper_cell};
 
 /// The data rows of `text` whose `pose_id` is `id`.
 fn row<'a>(text: &'a str, id: &str) -> &'a str {
@@ -24,27 +17,9 @@ fn compensate_reports_bad_rows_and_applies_the_nonparametric_correction() {
     let dir = scratch("compensate-cli");
     let s = |p: &Path| p.to_str().unwrap().to_string();
     let (data, est) = (dir.join("data.csv"), dir.join("est.json"));
-    let (ok, _, err) = armcal(&[
-        "simulate",
-        "--cell",
-        "examples/paper-cell.toml",
-        "--poses",
-        "examples/paper-poses-random-60.csv",
-        "--seed",
-        "3",
-        "--out",
-        &s(&data),
-    ]);
+    let (ok, _, err) = armcal(&simulate_paper_cell("3", &s(&data)));
     assert!(ok, "{err}");
-    let (ok, _, err) = armcal(&[
-        "identify",
-        "--cell",
-        "examples/paper-cell.toml",
-        "--data",
-        &s(&data),
-        "--out",
-        &s(&est),
-    ]);
+    let (ok, _, err) = armcal(&identify_paper_cell(&s(&data), &[], &s(&est)));
     assert!(ok, "{err}");
 
     // A joint program: one good row, one with q5 = 100° beyond its 87° limit.

@@ -1,14 +1,21 @@
 //! `simulate` → `identify` → `predict` through the binary, with the file-safety rules.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 mod common;
-use common::armcal;
+use common::{armcal, identify_paper_cell, scratch, simulate_paper_cell};
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// Running `args` again fails because its output exists, naming `--force`; with `--force`
+/// appended it succeeds.
+fn refuses_to_overwrite_unless_forced(args: &[&str]) {
+    let (ok, _, err) = armcal(args);
+    assert!(
+        !ok && err.contains("exists") && err.contains("--force"),
+        "{err}"
+    );
+    let mut forced = args.to_vec();
+    forced.push("--force");
+    let (ok, _, err) = armcal(&forced);
+    assert!(ok, "{err}");
 }
 
 #[test]
@@ -18,48 +25,21 @@ fn simulate_identify_predict() {
     let est = dir.join("estimate.json");
     let pred = dir.join("pred.csv");
     let s = |p: &Path| p.to_str().unwrap().to_string();
-    let sim = [
-        "simulate",
-        "--cell",
-        "examples/paper-cell.toml",
-        "--poses",
-        "examples/paper-poses-random-60.csv",
-        "--seed",
-        "4",
-        "--out",
-        &s(&data),
-    ];
+    let (data_s, est_s) = (s(&data), s(&est));
+    let sim = simulate_paper_cell("4", &data_s);
     let (ok, out, err) = armcal(&sim);
     assert!(ok, "{err}");
     assert!(out.contains("simulated 60 measurements"), "{out}");
     let first = std::fs::read_to_string(&data).unwrap();
     // Same seed, same file; an existing file is not overwritten without --force.
-    let (ok, _, err) = armcal(&sim);
-    assert!(
-        !ok && err.contains("exists") && err.contains("--force"),
-        "{err}"
-    );
-    let mut forced = sim.to_vec();
-    forced.push("--force");
-    let (ok, _, err) = armcal(&forced);
-    assert!(ok, "{err}");
+    refuses_to_overwrite_unless_forced(&sim);
     assert_eq!(
         first,
         std::fs::read_to_string(&data).unwrap(),
         "same seed → identical file"
     );
 
-    let (ok, out, err) = armcal(&[
-        "identify",
-        "--cell",
-        "examples/paper-cell.toml",
-        "--data",
-        &s(&data),
-        "--holdout",
-        "0.3",
-        "--out",
-        &s(&est),
-    ]);
+    let (ok, out, err) = armcal(&identify_paper_cell(&data_s, &["--holdout", "0.3"], &est_s));
     assert!(ok, "{err}");
     assert!(
         out.contains("converged")
@@ -77,30 +57,18 @@ fn simulate_identify_predict() {
 
     for method in ["gn", "kalman"] {
         let e2 = dir.join(format!("est-{method}.json"));
-        let (ok, _, err) = armcal(&[
-            "identify",
-            "--cell",
-            "examples/paper-cell.toml",
-            "--data",
-            &s(&data),
-            "--method",
-            method,
-            "--out",
+        let (ok, _, err) = armcal(&identify_paper_cell(
+            &data_s,
+            &["--method", method],
             &s(&e2),
-        ]);
+        ));
         assert!(ok, "{method}: {err}");
     }
-    let (ok, _, err) = armcal(&[
-        "identify",
-        "--cell",
-        "examples/paper-cell.toml",
-        "--data",
-        &s(&data),
-        "--robust",
-        "huber",
-        "--out",
+    let (ok, _, err) = armcal(&identify_paper_cell(
+        &data_s,
+        &["--robust", "huber"],
         &s(&dir.join("r.json")),
-    ]);
+    ));
     assert!(ok, "{err}");
 
     let (ok, out, err) = armcal(&[
@@ -108,7 +76,7 @@ fn simulate_identify_predict() {
         "--cell",
         "examples/paper-cell.toml",
         "--estimate",
-        &s(&est),
+        &est_s,
         "--joints",
         "examples/paper-poses-random-60.csv",
         "--out",
@@ -134,7 +102,7 @@ fn simulate_identify_predict() {
         "--cell",
         "examples/motoman-right-cell.toml",
         "--estimate",
-        &s(&est),
+        &est_s,
         "--joints",
         "examples/paper-poses-random-60.csv",
         "--out",
@@ -147,28 +115,10 @@ fn simulate_identify_predict() {
 fn compensate_export_and_accuracy() {
     let dir = scratch("compensate");
     let s = |p: &Path| p.to_str().unwrap().to_string();
-    let (data, est) = (dir.join("data.csv"), dir.join("est.json"));
-    let (ok, _, err) = armcal(&[
-        "simulate",
-        "--cell",
-        "examples/paper-cell.toml",
-        "--poses",
-        "examples/paper-poses-random-60.csv",
-        "--seed",
-        "2",
-        "--out",
-        &s(&data),
-    ]);
+    let (data, est) = (s(&dir.join("data.csv")), dir.join("est.json"));
+    let (ok, _, err) = armcal(&simulate_paper_cell("2", &data));
     assert!(ok, "{err}");
-    let (ok, _, err) = armcal(&[
-        "identify",
-        "--cell",
-        "examples/paper-cell.toml",
-        "--data",
-        &s(&data),
-        "--out",
-        &s(&est),
-    ]);
+    let (ok, _, err) = armcal(&identify_paper_cell(&data, &[], &s(&est)));
     assert!(ok, "{err}");
     let corrected = dir.join("corrected.csv");
     let (ok, out, err) = armcal(&[
@@ -366,29 +316,10 @@ fn report_from_identify_and_plan_files() {
         dir.join("est.json"),
         dir.join("design.csv"),
     );
+    let (data_s, est_s) = (s(&data), s(&est));
     for args in [
-        vec![
-            "simulate",
-            "--cell",
-            "examples/paper-cell.toml",
-            "--poses",
-            "examples/paper-poses-random-60.csv",
-            "--seed",
-            "4",
-            "--out",
-            &s(&data),
-        ],
-        vec![
-            "identify",
-            "--cell",
-            "examples/paper-cell.toml",
-            "--data",
-            &s(&data),
-            "--holdout",
-            "0.3",
-            "--out",
-            &s(&est),
-        ],
+        simulate_paper_cell("4", &data_s).to_vec(),
+        identify_paper_cell(&data_s, &["--holdout", "0.3"], &est_s),
         vec![
             "plan",
             "--cell",
@@ -406,7 +337,7 @@ fn report_from_identify_and_plan_files() {
     }
     let out = dir.join("report");
     let design_json = dir.join("design.json");
-    let report = ["report", &s(&est), &s(&design_json), "--out", &s(&out)];
+    let report = ["report", &est_s, &s(&design_json), "--out", &s(&out)];
     let (ok, stdout, err) = armcal(&report);
     assert!(ok, "{err}");
     assert!(
@@ -431,15 +362,7 @@ fn report_from_identify_and_plan_files() {
         assert!(html.contains(needle), "{needle}");
     }
     // Never overwritten without --force.
-    let (ok, _, err) = armcal(&report);
-    assert!(
-        !ok && err.contains("exists") && err.contains("--force"),
-        "{err}"
-    );
-    let mut forced = report.to_vec();
-    forced.push("--force");
-    let (ok, _, err) = armcal(&forced);
-    assert!(ok, "{err}");
+    refuses_to_overwrite_unless_forced(&report);
     assert_eq!(
         html,
         std::fs::read_to_string(out.join("report.html")).unwrap()

@@ -1,6 +1,7 @@
 //! The HTML report: ellipse geometry, figure builders, escaping, self-containedness, the
 //! figure count, document recognition and the constraint margins of the design file.
 
+mod common;
 use armcal::cell::Cell;
 use armcal::identify::{identify, Estimate, IdentifyOptions, Silent};
 use armcal::model::identifiability::random_configurations;
@@ -15,25 +16,16 @@ use armcal::report::html::{escape, number};
 use armcal::report::{self, DesignRecord, Document, Input, ReportContent, StudyRecord};
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use armcal::study::paper::{notional_robots, StudyRow};
+use common::example_cell;
 use nalgebra::{Matrix2, Matrix3, Vector2};
-use std::path::Path;
 use std::sync::OnceLock;
-
-fn cell(name: &str) -> Cell {
-    Cell::from_file(
-        &Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../examples")
-            .join(name),
-    )
-    .unwrap()
-}
 
 /// A design record and an estimate of the paper cell (simulated, 40 random poses, 30 %
 /// held out), computed once.
 fn fixtures() -> &'static (Cell, DesignRecord, Estimate) {
     static F: OnceLock<(Cell, DesignRecord, Estimate)> = OnceLock::new();
     F.get_or_init(|| {
-        let cell = cell("paper-cell.toml");
+        let cell = example_cell("paper-cell.toml");
         let model = &cell.model;
         let truth = perturbed_truth(model, &Perturbation::default(), 3);
         let qs = random_configurations(model, 40, 7);
@@ -427,7 +419,7 @@ fn design_poses_round_trip_to_internal_units() {
 
 #[test]
 fn incidence_margin_is_the_angle_left_to_the_limit() {
-    let cell = cell("paper-cell-obstacles.toml");
+    let cell = example_cell("paper-cell-obstacles.toml");
     let model = &cell.model;
     let qs = random_configurations(model, 25, 2);
     let margins = kind_margins(&cell, &qs, true).unwrap();

@@ -1,6 +1,7 @@
 //! Running the `armcal` binary from the repository root.
 #![allow(dead_code)]
 
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// Runs `armcal` with `args`; returns (success, stdout, stderr).
@@ -15,4 +16,42 @@ pub fn armcal(args: &[&str]) -> (bool, String, String) {
         String::from_utf8_lossy(&out.stdout).into_owned(),
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
+}
+
+/// A fresh scratch directory `name` under the test target directory.
+pub fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// `armcal simulate` of the paper cell at the 60 random example poses with noise `seed`,
+/// written to `out`.
+pub fn simulate_paper_cell<'a>(seed: &'a str, out: &'a str) -> [&'a str; 9] {
+    [
+        "simulate",
+        "--cell",
+        "examples/paper-cell.toml",
+        "--poses",
+        "examples/paper-poses-random-60.csv",
+        "--seed",
+        seed,
+        "--out",
+        out,
+    ]
+}
+
+/// `armcal identify` of the paper cell from `data` with the `options`, written to `out`.
+pub fn identify_paper_cell<'a>(data: &'a str, options: &[&'a str], out: &'a str) -> Vec<&'a str> {
+    let mut args = vec![
+        "identify",
+        "--cell",
+        "examples/paper-cell.toml",
+        "--data",
+        data,
+    ];
+    args.extend_from_slice(options);
+    args.extend(["--out", out]);
+    args
 }

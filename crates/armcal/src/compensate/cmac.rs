@@ -209,17 +209,22 @@ impl Cmac {
         Ok(())
     }
 
+    /// `what` (an output-sized slice of `len` values) must hold one value per output.
+    fn check_output_len(&self, what: &str, len: usize) -> Result<()> {
+        if len != self.outputs {
+            return Err(Error::Input(format!(
+                "CMAC: {what} has {len} values, the table has {} outputs",
+                self.outputs
+            )));
+        }
+        Ok(())
+    }
+
     /// Output at `x`: the sum of the Q selected weights per output (book eq. 5.211),
     /// written to `out` (`outputs` values). Allocation-free.
     pub fn predict_into(&self, x: &[f64], out: &mut [f64]) -> Result<()> {
         self.check_input(x)?;
-        if out.len() != self.outputs {
-            return Err(Error::Input(format!(
-                "CMAC: output buffer has {} values, the table has {} outputs",
-                out.len(),
-                self.outputs
-            )));
-        }
+        self.check_output_len("output buffer", out.len())?;
         out.fill(0.0);
         for k in 0..self.levels {
             let base = self.word(k, x) * self.outputs;
@@ -243,13 +248,7 @@ impl Cmac {
     /// (1 − g), and the book found no convergence for g > 2 (§5.4.2.3).
     pub fn train(&mut self, x: &[f64], desired: &[f64], gain: f64) -> Result<f64> {
         self.check_input(x)?;
-        if desired.len() != self.outputs {
-            return Err(Error::Input(format!(
-                "CMAC: desired output has {} values, the table has {} outputs",
-                desired.len(),
-                self.outputs
-            )));
-        }
+        self.check_output_len("desired output", desired.len())?;
         if !(gain > 0.0 && gain <= 2.0) {
             return Err(Error::Input(format!(
                 "CMAC: teaching gain g = {gain}; need 0 < g ≤ 2"

@@ -18,6 +18,10 @@ use serde::{Deserialize, Serialize};
 use std::cell::RefCell;
 use std::time::{Duration, Instant};
 
+/// Relative gain below which an exchange sweep counts as no progress when the continuous
+/// refinement follows.
+const EXCHANGE_TOLERANCE_BEFORE_REFINEMENT: f64 = 1e-3;
+
 /// Settings of [`plan`].
 #[derive(Clone, Debug)]
 pub struct PlanSettings {
@@ -152,14 +156,15 @@ fn infeasible_report(
     }
 }
 
-/// One start of the planner: design, value, exchange value, exchange sweeps, and the
-/// refinement's status and iterations (if it ran).
-struct StartResult {
-    design: Vec<Vec<f64>>,
-    value: f64,
-    exchange_value: f64,
-    sweeps: usize,
-    refine: Option<(String, usize)>,
+/// The best of the planner's starts from one candidate pool: design, value, exchange value,
+/// exchange sweeps, and the refinement's status and iterations (if it ran).
+#[derive(Clone, Debug)]
+pub struct PoolDesign {
+    pub design: Vec<Vec<f64>>,
+    pub value: f64,
+    pub exchange_value: f64,
+    pub sweeps: usize,
+    pub refine: Option<(String, usize)>,
 }
 
 /// Adapts a cell's [`ConstraintSet`] to the refinement's constraint interface.
@@ -167,14 +172,19 @@ pub struct CellConstraints<'a> {
     pub set: &'a ConstraintSet,
     pub params: &'a [f64],
     ws: RefCell<ConstraintWorkspace>,
+    /// Constraints whose value does not depend on q (see [`constant_constraints`]).
+    constant: Vec<bool>,
 }
 
 impl<'a> CellConstraints<'a> {
     pub fn new(set: &'a ConstraintSet, params: &'a [f64]) -> Self {
+        let mut ws = set.workspace();
+        let constant = constant_constraints(set, &mut ws, params);
         CellConstraints {
             set,
             params,
-            ws: RefCell::new(set.workspace()),
+            ws: RefCell::new(ws),
+            constant,
         }
     }
 
@@ -209,8 +219,12 @@ const INCIDENCE_MARGIN: f64 = 1e-4;
 const DISTANCE_MARGIN: f64 = 0.05;
 
 impl CellConstraints<'_> {
-    /// The margin kept from constraint `i`'s boundary.
+    /// The margin kept from constraint `i`'s boundary (none from a constant one: no move can
+    /// widen it, and a feasible pool configuration already satisfies it).
     fn margin(&self, i: usize) -> f64 {
+        if self.constant[i] {
+            return 0.0;
+        }
         match self.set.kind(i) {
             crate::geometry::ConstraintKind::Incidence => INCIDENCE_MARGIN,
             _ => DISTANCE_MARGIN,
@@ -250,6 +264,36 @@ impl ConfigurationConstraints for CellConstraints<'_> {
             values[i] -= self.margin(i);
         }
     }
+}
+
+/// Which constraints of `set` have the same value (within 1e-9) at 16 configurations spread
+/// over the joint ranges (mid-range and a fixed low-discrepancy sequence) — a KUKA base
+/// column on joint 1 standing on the floor, a point on the joint-1 axis against the wall. No
+/// q-dependent constraint agrees that closely at 16 spread configurations by chance.
+fn constant_constraints(
+    set: &ConstraintSet,
+    ws: &mut ConstraintWorkspace,
+    params: &[f64],
+) -> Vec<bool> {
+    let (lower, upper) = set.model().joint_limits();
+    let m = set.len();
+    let mut lo = vec![f64::INFINITY; m];
+    let mut hi = vec![f64::NEG_INFINITY; m];
+    let mut values = vec![0.0; m];
+    let mut q = vec![0.0; lower.len()];
+    for k in 0..16 {
+        for (j, x) in q.iter_mut().enumerate() {
+            // Fractional parts of 0.5 + k·√(j + 2).
+            let t = (0.5 + k as f64 * (j as f64 + 2.0).sqrt()).fract();
+            *x = lower[j] + t * (upper[j] - lower[j]);
+        }
+        set.evaluate(ws, params, &q, &mut values, None);
+        for c in 0..m {
+            lo[c] = lo[c].min(values[c]);
+            hi[c] = hi[c].max(values[c]);
+        }
+    }
+    lo.iter().zip(&hi).map(|(a, b)| b - a < 1e-9).collect()
 }
 
 /// The constraint set of a cell for planning.
@@ -293,83 +337,13 @@ pub fn plan(
         }
     };
     let objective = DesignObjective::new(&d, settings.criterion, measured);
-    let (lo, hi) = d.model.joint_limits();
-    let runs: Vec<Result<StartResult, Error>> = (0..settings.starts.max(1))
-        .into_par_iter()
-        .map(|s| {
-            let ex = exchange(
-                &d,
-                settings.criterion,
-                &pool,
-                &objective.prior_rows,
-                settings.poses,
-                &ExchangeSettings {
-                    seed: settings.seed.wrapping_add(s as u64 * 7919),
-                    ..ExchangeSettings::default()
-                },
-            )?;
-            let start: Vec<Vec<f64>> = ex.chosen.iter().map(|&i| pool[i].clone()).collect();
-            if settings.exchange_only {
-                return Ok(StartResult {
-                    design: start,
-                    value: ex.value,
-                    exchange_value: ex.value,
-                    sweeps: ex.sweeps,
-                    refine: None,
-                });
-            }
-            let cons = CellConstraints::new(&set, &params);
-            let obj = DesignObjective::new(&d, settings.criterion, measured);
-            let r = refine(
-                &obj,
-                &start,
-                &lo,
-                &hi,
-                (!set.is_empty()).then_some(&cons as &dyn ConfigurationConstraints),
-                &settings.refine,
-            )?;
-            // Only a design that violates nothing counts; otherwise keep the exchange design.
-            let ok = r.q.iter().all(|q| cons.feasible(q));
-            if ok && r.value <= ex.value {
-                Ok(StartResult {
-                    design: r.q,
-                    value: r.value,
-                    exchange_value: ex.value,
-                    sweeps: ex.sweeps,
-                    refine: Some((r.status, r.iterations)),
-                })
-            } else {
-                Ok(StartResult {
-                    design: start,
-                    value: ex.value,
-                    exchange_value: ex.value,
-                    sweeps: ex.sweeps,
-                    refine: Some((
-                        format!(
-                            "{} (refined design rejected: {})",
-                            r.status,
-                            if ok { "no better" } else { "infeasible" }
-                        ),
-                        r.iterations,
-                    )),
-                })
-            }
-        })
-        .collect();
-    let mut best: Option<StartResult> = None;
-    for r in runs {
-        let r = r?;
-        if best.as_ref().is_none_or(|b| r.value < b.value) {
-            best = Some(r);
-        }
-    }
-    let StartResult {
+    let PoolDesign {
         design,
         value,
         exchange_value,
         sweeps,
         refine: refine_info,
-    } = best.expect("at least one start");
+    } = design_from_pool(&d, &set, &pool, settings, measured)?;
     let order = order_for_travel(&design);
     let design: Vec<Vec<f64>> = order.iter().map(|&i| design[i].clone()).collect();
     let cons = CellConstraints::new(&set, &params);
@@ -398,4 +372,96 @@ pub fn plan(
         blocking: Vec::new(),
         time: t0.elapsed(),
     })
+}
+
+/// Runs `settings.starts` exchange + refinement starts (in parallel) from the feasible
+/// candidate `pool` and returns the best design; a refined design that violates a
+/// constraint is replaced by its exchange design. The planner's core, shared with the
+/// paper's study (which reuses one pool for several criteria).
+pub fn design_from_pool(
+    d: &DesignModel,
+    set: &ConstraintSet,
+    pool: &[Vec<f64>],
+    settings: &PlanSettings,
+    measured: &[Vec<f64>],
+) -> Result<PoolDesign, Error> {
+    let prior_rows = DesignObjective::new(d, settings.criterion, measured).prior_rows;
+    let (lo, hi) = d.model.joint_limits();
+    let runs: Vec<Result<PoolDesign, Error>> = (0..settings.starts.max(1))
+        .into_par_iter()
+        .map(|s| {
+            let ex = exchange(
+                d,
+                settings.criterion,
+                pool,
+                &prior_rows,
+                settings.poses,
+                &ExchangeSettings {
+                    seed: settings.seed.wrapping_add(s as u64 * 7919),
+                    // The refinement moves every pose afterwards: sweeps that gain less
+                    // than 0.1 % do not change where it ends.
+                    tolerance: if settings.exchange_only {
+                        ExchangeSettings::default().tolerance
+                    } else {
+                        EXCHANGE_TOLERANCE_BEFORE_REFINEMENT
+                    },
+                    ..ExchangeSettings::default()
+                },
+            )?;
+            let start: Vec<Vec<f64>> = ex.chosen.iter().map(|&i| pool[i].clone()).collect();
+            if settings.exchange_only {
+                return Ok(PoolDesign {
+                    design: start,
+                    value: ex.value,
+                    exchange_value: ex.value,
+                    sweeps: ex.sweeps,
+                    refine: None,
+                });
+            }
+            let cons = CellConstraints::new(set, &d.params);
+            let obj = DesignObjective::new(d, settings.criterion, measured);
+            let r = refine(
+                &obj,
+                &start,
+                &lo,
+                &hi,
+                (!set.is_empty()).then_some(&cons as &dyn ConfigurationConstraints),
+                &settings.refine,
+            )?;
+            // Only a design that violates nothing counts; otherwise keep the exchange design.
+            let ok = r.q.iter().all(|q| cons.feasible(q));
+            if ok && r.value <= ex.value {
+                Ok(PoolDesign {
+                    design: r.q,
+                    value: r.value,
+                    exchange_value: ex.value,
+                    sweeps: ex.sweeps,
+                    refine: Some((r.status, r.iterations)),
+                })
+            } else {
+                Ok(PoolDesign {
+                    design: start,
+                    value: ex.value,
+                    exchange_value: ex.value,
+                    sweeps: ex.sweeps,
+                    refine: Some((
+                        format!(
+                            "{} (refined design rejected: {})",
+                            r.status,
+                            if ok { "no better" } else { "infeasible" }
+                        ),
+                        r.iterations,
+                    )),
+                })
+            }
+        })
+        .collect();
+    let mut best: Option<PoolDesign> = None;
+    for r in runs {
+        let r = r?;
+        if best.as_ref().is_none_or(|b| r.value < b.value) {
+            best = Some(r);
+        }
+    }
+    Ok(best.expect("at least one start"))
 }

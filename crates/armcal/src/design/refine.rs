@@ -4,14 +4,19 @@
 //! `optimization_engine` (OpEn): a projected-gradient step and L-BFGS directions on the
 //! forward–backward envelope. PANOC accepts a non-convex set if its projection can be
 //! computed; here the set is a product of per-configuration sets, and each configuration
-//! is projected on its own (see [`FeasibleSet`]). Every iterate is therefore feasible (up
+//! is projected on its own (see `FeasibleSet`). Every iterate is therefore feasible (up
 //! to the projection's accuracy, checked strictly by the planner), and an early stop still
 //! gives a usable design.
 //!
 //! PANOC runs in rounds of `check_every` iterations; the refinement stops when a round
-//! improves φ by less than `min_relative_improvement` (relative), when PANOC's
-//! fixed-point residual reaches `tolerance`, or at the iteration or time limit. The
-//! objective is divided by its value at the start so the tolerances are relative.
+//! improves φ by less than `min_relative_improvement` (relative, scaled by the round's
+//! length), when PANOC's fixed-point residual reaches `tolerance`, or at the iteration or
+//! time limit. A round that ends worse than it started is retried from the best design
+//! with a third of its length; when even the shortest round does, PANOC has stalled (with
+//! many poses on curved constraint boundaries its envelope line search fails) and
+//! projected-gradient steps with an Armijo test on φ use the remaining iterations
+//! (`projected_gradient`). The objective is divided by its value at the start so the
+//! tolerances are relative.
 
 use crate::design::objective::DesignObjective;
 use crate::design::small_cholesky;
@@ -49,7 +54,7 @@ pub trait ConfigurationConstraints {
 pub struct RefineSettings {
     /// PANOC tolerance on the fixed-point residual (relative objective).
     pub tolerance: f64,
-    /// PANOC iterations in all.
+    /// PANOC iterations and projected-gradient steps in all.
     pub max_iterations: usize,
     /// Iterations per round; the improvement is checked after each round.
     pub check_every: usize,
@@ -87,10 +92,14 @@ pub struct RefineResult {
 }
 
 /// Corrections per configuration and projection.
-const MAX_CORRECTIONS: usize = 20;
+const MAX_CORRECTIONS: usize = 6;
 /// Each correction aims this far beyond the boundary (as a multiple of the violation), so
 /// that the linearisation error of a curved constraint rarely needs a second correction.
 const OVERSHOOT: f64 = 1.05;
+/// Bisection steps of [`ProjectionBuffers::retreat`].
+const RETREAT_STEPS: usize = 4;
+/// Shortest PANOC round (iterations) after rounds that ended worse than they started.
+const MIN_ROUND: usize = 5;
 /// Safety factor on the observed gradient bounds (see [`FeasibleSet`]).
 const LIPSCHITZ_SAFETY: f64 = 2.0;
 /// A configuration farther than this (rad or mm, 1-norm) from its anchor is evaluated in full
@@ -133,6 +142,12 @@ struct ProjectionBuffers {
     anchored: Vec<bool>,
     /// `L_c` per constraint.
     lipschitz: Vec<f64>,
+    /// Per configuration: the last configuration that passed a full evaluation.
+    safe: Vec<f64>,
+    has_safe: Vec<bool>,
+    /// Joints free in a correction, and the correction.
+    free: Vec<bool>,
+    step: Vec<f64>,
 }
 
 impl FeasibleSet<'_> {
@@ -174,85 +189,186 @@ impl FeasibleSet<'_> {
         }
     }
 
-    /// Projects configuration `index`.
+    /// Projects configuration `index`. If the corrections do not reach the set (joint limits
+    /// and constraints pulling against each other), the configuration returns to the last
+    /// one that passed a full evaluation, so every iterate stays feasible.
     fn project_configuration(
         &self,
         cons: &dyn ConfigurationConstraints,
         index: usize,
         q: &mut [f64],
     ) {
-        let k = q.len();
         let b = &mut *self.buffers.borrow_mut();
-        let m = b.values.len();
         self.clamp(q);
         for _ in 0..MAX_CORRECTIONS {
-            let anchor = &b.anchors[index * k..(index + 1) * k];
-            let moved: f64 = if b.anchored[index] {
-                q.iter().zip(anchor).map(|(x, a)| (x - a).abs()).sum()
-            } else {
-                f64::INFINITY
-            };
-            b.near.clear();
-            if moved <= REANCHOR_DISTANCE {
-                let av = &b.anchor_values[index * m..(index + 1) * m];
-                b.near
-                    .extend((0..m).filter(|&c| av[c] - b.lipschitz[c] * moved < 0.0));
-                if b.near.is_empty() {
-                    return;
-                }
-            }
-            b.violated.clear();
-            if moved > REANCHOR_DISTANCE || 3 * b.near.len() > m {
-                cons.evaluate(q, &mut b.values, None);
-                b.anchors[index * k..(index + 1) * k].copy_from_slice(q);
-                b.anchor_values[index * m..(index + 1) * m].copy_from_slice(&b.values);
-                b.anchored[index] = true;
-                b.violated.extend((0..m).filter(|&c| b.values[c] < 0.0));
-                if b.violated.is_empty() {
-                    return;
-                }
-                cons.evaluate_rows(q, &b.violated, &mut b.values, Some(&mut b.jacobian));
-            } else {
-                // One forward kinematics for the values and gradients of the near ones.
-                cons.evaluate_rows(q, &b.near, &mut b.values, Some(&mut b.jacobian));
-                b.violated
-                    .extend(b.near.iter().copied().filter(|&c| b.values[c] < 0.0));
-                if b.violated.is_empty() {
-                    return;
-                }
-            }
-            let nv = b.violated.len();
-            // Normal matrix J_v J_vᵀ, lightly regularised (dependent constraints).
-            let mut trace = 0.0;
-            for (r, &cr) in b.violated.iter().enumerate() {
-                for (s, &cs) in b.violated.iter().enumerate().take(r + 1) {
-                    let gr = &b.jacobian[cr * k..(cr + 1) * k];
-                    let gs = &b.jacobian[cs * k..(cs + 1) * k];
-                    let v: f64 = gr.iter().zip(gs).map(|(x, y)| x * y).sum();
-                    b.normal[r * nv + s] = v;
-                    b.normal[s * nv + r] = v;
-                }
-                trace += b.normal[r * nv + r];
-                b.rhs[r] = -OVERSHOOT * b.values[cr];
-            }
-            if trace <= 0.0 {
-                return; // no gradient to follow; the planner's check rejects the pose
-            }
-            for r in 0..nv {
-                b.normal[r * nv + r] += 1e-10 * trace / nv as f64;
-            }
-            if !small_cholesky::factor(&mut b.normal[..nv * nv], nv) {
+            if !b.violated_at(cons, index, q) {
                 return;
             }
-            small_cholesky::solve(&b.normal[..nv * nv], &mut b.rhs[..nv], nv);
-            for (r, &cr) in b.violated.iter().enumerate() {
-                let y = b.rhs[r];
-                for (x, g) in q.iter_mut().zip(&b.jacobian[cr * k..(cr + 1) * k]) {
-                    *x += g * y;
-                }
+            if !b.correct(q, self.lower, self.upper) {
+                break;
             }
             self.clamp(q);
         }
+        if b.has_safe[index] {
+            b.retreat(cons, index, q);
+        }
+    }
+}
+
+impl ProjectionBuffers {
+    /// Moves `q`, which the corrections could not make feasible, back along the segment to
+    /// the last fully checked feasible configuration `s` of `index`: to the farthest point
+    /// `s + t (q − s)`, `t ∈ {1/2, 1/4, …}`, that passes a full evaluation (`s` itself if
+    /// none does). Bisection keeps the projection continuous in `q` far more than a jump
+    /// back to `s` would.
+    fn retreat(&mut self, cons: &dyn ConfigurationConstraints, index: usize, q: &mut [f64]) {
+        let k = q.len();
+        let m = self.values.len();
+        self.step.copy_from_slice(q);
+        q.copy_from_slice(&self.safe[index * k..(index + 1) * k]);
+        let mut t = 1.0;
+        for _ in 0..RETREAT_STEPS {
+            t *= 0.5;
+            let safe = &self.safe[index * k..(index + 1) * k];
+            for ((x, s), target) in q.iter_mut().zip(safe).zip(&self.step) {
+                *x = s + t * (target - s);
+            }
+            cons.evaluate(q, &mut self.values, None);
+            if self.values.iter().all(|&v| v >= 0.0) {
+                self.safe[index * k..(index + 1) * k].copy_from_slice(q);
+                self.anchors[index * k..(index + 1) * k].copy_from_slice(q);
+                self.anchor_values[index * m..(index + 1) * m].copy_from_slice(&self.values);
+                self.anchored[index] = true;
+                return;
+            }
+        }
+        q.copy_from_slice(&self.safe[index * k..(index + 1) * k]);
+    }
+
+    /// Fills `violated` with the constraints violated at `q` (and their values and gradients
+    /// in `values`, `jacobian`); whether there are any. Evaluates only the constraints the
+    /// anchor's bound does not clear, or everything (and re-anchors) when the configuration
+    /// moved far or many are near.
+    fn violated_at(
+        &mut self,
+        cons: &dyn ConfigurationConstraints,
+        index: usize,
+        q: &[f64],
+    ) -> bool {
+        let k = q.len();
+        let m = self.values.len();
+        let moved: f64 = if self.anchored[index] {
+            let anchor = &self.anchors[index * k..(index + 1) * k];
+            q.iter().zip(anchor).map(|(x, a)| (x - a).abs()).sum()
+        } else {
+            f64::INFINITY
+        };
+        self.near.clear();
+        if moved <= REANCHOR_DISTANCE {
+            let av = &self.anchor_values[index * m..(index + 1) * m];
+            let l = &self.lipschitz;
+            self.near
+                .extend((0..m).filter(|&c| av[c] - l[c] * moved < 0.0));
+            if self.near.is_empty() {
+                return false;
+            }
+        }
+        self.violated.clear();
+        if moved > REANCHOR_DISTANCE || 3 * self.near.len() > m {
+            cons.evaluate(q, &mut self.values, None);
+            self.anchors[index * k..(index + 1) * k].copy_from_slice(q);
+            self.anchor_values[index * m..(index + 1) * m].copy_from_slice(&self.values);
+            self.anchored[index] = true;
+            let values = &self.values;
+            self.violated.extend((0..m).filter(|&c| values[c] < 0.0));
+            if self.violated.is_empty() {
+                self.safe[index * k..(index + 1) * k].copy_from_slice(q);
+                self.has_safe[index] = true;
+                return false;
+            }
+            cons.evaluate_rows(
+                q,
+                &self.violated,
+                &mut self.values,
+                Some(&mut self.jacobian),
+            );
+        } else {
+            // One forward kinematics for the values and gradients of the near ones.
+            cons.evaluate_rows(q, &self.near, &mut self.values, Some(&mut self.jacobian));
+            let values = &self.values;
+            self.violated
+                .extend(self.near.iter().copied().filter(|&c| values[c] < 0.0));
+        }
+        !self.violated.is_empty()
+    }
+
+    /// One minimum-norm correction of `q` on the `violated` constraints, with the joints that
+    /// sit at a limit and would be pushed beyond it held fixed (their Jacobian columns left
+    /// out, the projection onto the box and the linearised constraints); false if there is no
+    /// direction to follow.
+    fn correct(&mut self, q: &mut [f64], lower: &[f64], upper: &[f64]) -> bool {
+        let k = q.len();
+        let nv = self.violated.len();
+        self.free.fill(true);
+        for _ in 0..=k {
+            // Normal matrix J_v J_vᵀ over the free joints, lightly regularised (dependent
+            // constraints).
+            let mut trace = 0.0;
+            for (r, &cr) in self.violated.iter().enumerate() {
+                for (s, &cs) in self.violated.iter().enumerate().take(r + 1) {
+                    let gr = &self.jacobian[cr * k..(cr + 1) * k];
+                    let gs = &self.jacobian[cs * k..(cs + 1) * k];
+                    let v: f64 = (0..k)
+                        .filter(|&j| self.free[j])
+                        .map(|j| gr[j] * gs[j])
+                        .sum();
+                    self.normal[r * nv + s] = v;
+                    self.normal[s * nv + r] = v;
+                }
+                trace += self.normal[r * nv + r];
+                self.rhs[r] = -OVERSHOOT * self.values[cr];
+            }
+            if trace <= 0.0 {
+                return false;
+            }
+            for r in 0..nv {
+                self.normal[r * nv + r] += 1e-10 * trace / nv as f64;
+            }
+            if !small_cholesky::factor(&mut self.normal[..nv * nv], nv) {
+                return false;
+            }
+            small_cholesky::solve(&self.normal[..nv * nv], &mut self.rhs[..nv], nv);
+            self.step.fill(0.0);
+            for (r, &cr) in self.violated.iter().enumerate() {
+                let y = self.rhs[r];
+                for (d, g) in self
+                    .step
+                    .iter_mut()
+                    .zip(&self.jacobian[cr * k..(cr + 1) * k])
+                {
+                    *d += g * y;
+                }
+            }
+            let mut blocked = false;
+            for j in 0..k {
+                let x = q[j] + self.step[j];
+                if self.free[j]
+                    && ((x < lower[j] && q[j] <= lower[j]) || (x > upper[j] && q[j] >= upper[j]))
+                {
+                    self.free[j] = false;
+                    blocked = true;
+                }
+            }
+            if !blocked {
+                for ((x, d), free) in q.iter_mut().zip(&self.step).zip(&self.free) {
+                    if *free {
+                        *x += d;
+                    }
+                }
+                return true;
+            }
+        }
+        false
     }
 }
 
@@ -302,6 +418,10 @@ pub fn refine(
             anchor_values: vec![0.0; m * nconf],
             anchored: vec![false; nconf],
             lipschitz: vec![0.0; m],
+            safe: vec![0.0; nu],
+            has_safe: vec![false; nconf],
+            free: vec![true; k],
+            step: vec![0.0; k],
         }),
     };
     let mut u: Vec<f64> = start.concat();
@@ -332,12 +452,13 @@ pub fn refine(
     let mut history = vec![start_value];
     let mut iterations = 0;
     let mut cache = PANOCCache::new(nu, settings.tolerance, settings.lbfgs_memory);
+    // PANOC descends on its envelope, not on φ itself, and with a non-convex set a round can
+    // end worse than it started: then the round restarts from the best design with a third
+    // of its length, down to MIN_ROUND iterations.
+    let mut round_length = settings.check_every.max(1);
     let (converged, status) = loop {
         let remaining = settings.max_duration.saturating_sub(t0.elapsed());
-        let round = settings
-            .check_every
-            .max(1)
-            .min(settings.max_iterations - iterations);
+        let round = round_length.min(settings.max_iterations - iterations);
         if round == 0 {
             break (false, "iteration limit".to_string());
         }
@@ -357,24 +478,52 @@ pub fn refine(
         value = objective.value_and_gradient(&mut ws.borrow_mut(), &u, None)?;
         history.push(value);
         if value > previous {
-            // PANOC descends on the envelope, not on φ itself: keep the better design.
             u.copy_from_slice(&best_u);
             value = previous;
-            break (true, "converged (no further descent)".to_string());
+            if round_length <= MIN_ROUND {
+                break (true, "converged (no further descent)".to_string());
+            }
+            round_length = (round_length / 3).max(MIN_ROUND);
+            continue;
         }
         best_u.copy_from_slice(&u);
         if s.exit_status() == ExitStatus::Converged {
             break (true, "converged".to_string());
         }
-        if previous - value < settings.min_relative_improvement * previous.abs() {
+        let expected =
+            settings.min_relative_improvement * round as f64 / settings.check_every.max(1) as f64;
+        if previous - value < expected * previous.abs() {
             break (
                 true,
                 format!(
                     "converged (a round of {round} iterations improved by less than {:e})",
-                    settings.min_relative_improvement
+                    expected
                 ),
             );
         }
+    };
+    // Where PANOC stalls (its line search on the envelope fails when many configurations sit
+    // on curved constraint boundaries), projected gradient steps with an Armijo test on φ
+    // itself continue monotonically, within the remaining iteration budget.
+    let stalled = status.ends_with("(no further descent)");
+    let (converged, status) = if stalled && iterations < settings.max_iterations {
+        let budget = settings.max_iterations - iterations;
+        let (v, n) = projected_gradient(
+            objective,
+            &mut ws.borrow_mut(),
+            &set,
+            &mut u,
+            value,
+            budget,
+            settings.max_duration.saturating_sub(t0.elapsed()),
+        )?;
+        iterations += n;
+        value = v;
+        history.push(value);
+        best_u.copy_from_slice(&u);
+        (true, format!("{status}; then {n} projected-gradient steps"))
+    } else {
+        (converged, status)
     };
     // The skipped evaluations rest on estimated bounds: project the result once more with
     // every constraint evaluated.
@@ -394,4 +543,61 @@ pub fn refine(
         history,
         time: t0.elapsed(),
     })
+}
+
+/// Projected gradient descent on φ with an Armijo test, from the feasible design `u` with
+/// value `value`: `u⁺ = Π(u − α ∇φ)`, accepted if `φ(u⁺) ≤ φ(u) − 10⁻⁴ ∇φ·(u − u⁺)`; α
+/// grows by 1.5 after an accepted step and shrinks by 0.3 after a rejected one, starting
+/// with a largest joint move of 0.05 rad. Returns the value and the accepted steps.
+fn projected_gradient(
+    objective: &DesignObjective,
+    ws: &mut crate::design::ObjectiveWorkspace,
+    set: &FeasibleSet,
+    u: &mut [f64],
+    mut value: f64,
+    max_steps: usize,
+    max_duration: Duration,
+) -> Result<(f64, usize), Error> {
+    let t0 = Instant::now();
+    let mut g = vec![0.0; u.len()];
+    let mut trial = u.to_vec();
+    objective.value_and_gradient(ws, u, Some(&mut g))?;
+    let gmax = g.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    if gmax == 0.0 {
+        return Ok((value, 0));
+    }
+    let mut alpha = 0.05 / gmax;
+    let mut steps = 0;
+    let mut trials = 0;
+    while steps < max_steps && trials < 4 * max_steps && t0.elapsed() < max_duration {
+        trials += 1;
+        for ((t, x), gi) in trial.iter_mut().zip(u.iter()).zip(&g) {
+            *t = x - alpha * gi;
+        }
+        set.project(&mut trial)
+            .map_err(|e| Error::Input(format!("pose refinement failed: {e:?}")))?;
+        let decrease: f64 = g
+            .iter()
+            .zip(u.iter())
+            .zip(&trial)
+            .map(|((gi, x), t)| gi * (x - t))
+            .sum();
+        // A singular trial design counts as no descent.
+        let v = objective
+            .value_and_gradient(ws, &trial, None)
+            .unwrap_or(f64::INFINITY);
+        if v <= value - 1e-4 * decrease && v < value {
+            u.copy_from_slice(&trial);
+            value = v;
+            steps += 1;
+            alpha *= 1.5;
+            objective.value_and_gradient(ws, u, Some(&mut g))?;
+        } else {
+            alpha *= 0.3;
+            if alpha * gmax < 1e-8 {
+                break;
+            }
+        }
+    }
+    Ok((value, steps))
 }

@@ -872,6 +872,43 @@ mod tests {
         assert!(compared > 1000);
     }
 
+    /// `evaluate_rows` gives the same values and Jacobian rows as `evaluate` and leaves the
+    /// other entries alone; the early-exit `feasible` agrees with the smallest margin.
+    #[test]
+    fn row_subsets_and_early_exit_agree_with_the_full_evaluation() {
+        let c = cell();
+        let set = ConstraintSet::new(&c, &ConstraintOptions::default()).unwrap();
+        let params = c.model.nominal();
+        let (m, dof) = (set.len(), set.dof());
+        let mut ws = set.workspace();
+        let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(11);
+        let rows: Vec<usize> = (0..m).filter(|r| r % 3 == 1).collect();
+        let (mut feasible, mut infeasible) = (0, 0);
+        for _ in 0..300 {
+            let q = random_q(&set, &mut rng);
+            let (mut v, mut jac) = (vec![0.0; m], vec![0.0; m * dof]);
+            set.evaluate(&mut ws, &params, &q, &mut v, Some(&mut jac));
+            let (mut vs, mut js) = (vec![7.0; m], vec![7.0; m * dof]);
+            set.evaluate_rows(&mut ws, &params, &q, &rows, &mut vs, Some(&mut js));
+            for r in 0..m {
+                if rows.contains(&r) {
+                    assert_eq!(vs[r], v[r]);
+                    assert_eq!(js[r * dof..(r + 1) * dof], jac[r * dof..(r + 1) * dof]);
+                } else {
+                    assert_eq!(vs[r], 7.0);
+                }
+            }
+            let ok = set.feasible(&mut ws, &params, &q);
+            assert_eq!(ok, v.iter().all(|x| *x >= 0.0), "{q:?}");
+            if ok {
+                feasible += 1;
+            } else {
+                infeasible += 1;
+            }
+        }
+        assert!(feasible > 0 && infeasible > 0, "{feasible} / {infeasible}");
+    }
+
     #[test]
     fn bad_options_are_rejected() {
         let cell = cell();

@@ -31,15 +31,15 @@ pub fn colour(i: usize) -> RGBColor {
 /// Width of the full-width figures (px; the page scales them to its column).
 const WIDE: u32 = 1100;
 
+/// A drawing area of an SVG figure.
+type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
+
 fn drawing_error<E: std::fmt::Display>(e: E) -> Error {
     Error::Input(format!("drawing a figure: {e}"))
 }
 
 /// Draws into an SVG string of `size` px and strips what inline SVG does not need.
-fn svg(
-    size: (u32, u32),
-    draw: impl FnOnce(&DrawingArea<SVGBackend, Shift>) -> Result<(), Error>,
-) -> Result<String, Error> {
+fn svg(size: (u32, u32), draw: impl FnOnce(&Area) -> Result<(), Error>) -> Result<String, Error> {
     ensure_registered()?;
     let mut buf = String::new();
     {
@@ -106,12 +106,7 @@ pub enum Mark {
 }
 
 /// Draws one legend mark of `colour` with its left end at `(x, y)` (pixels of `area`).
-fn draw_mark(
-    area: &DrawingArea<SVGBackend, Shift>,
-    (x, y): (i32, i32),
-    mark: Mark,
-    c: RGBColor,
-) -> Result<(), Error> {
+fn draw_mark(area: &Area, (x, y): (i32, i32), mark: Mark, c: RGBColor) -> Result<(), Error> {
     let style = c.stroke_width(2);
     match mark {
         Mark::Line => area.draw(&PathElement::new(vec![(x, y), (x + 24, y)], style)),
@@ -130,7 +125,7 @@ fn draw_mark(
 /// A legend in a strip of its own (never over the data): entries side by side, wrapping to
 /// further rows, or one per row when `column`.
 fn draw_legend(
-    area: &DrawingArea<SVGBackend, Shift>,
+    area: &Area,
     entries: &[(String, Mark, RGBColor)],
     column: bool,
 ) -> Result<(), Error> {
@@ -166,6 +161,17 @@ fn legend_height(n: usize, column: bool) -> u32 {
     } else {
         24
     }
+}
+
+/// Draws `title` at the top of `root` and splits the rest into a legend strip of
+/// `legend_h` px above the plot area; returns (legend strip, plot area).
+fn titled_with_legend_strip<'a>(
+    root: &Area<'a>,
+    title: &str,
+    legend_h: u32,
+) -> Result<(Area<'a>, Area<'a>), Error> {
+    let body = root.titled(title, (FAMILY, TITLE)).map_err(drawing_error)?;
+    Ok(body.split_vertically(legend_h))
 }
 
 /// Starts `chart`'s mesh in the report's style: the embedded font for tick labels
@@ -275,8 +281,8 @@ pub fn cdf_figure(
 ) -> Result<String, Error> {
     let (_, hi) = range_of(series.iter().flat_map(|s| s.1.iter().copied()), 0.05);
     svg((WIDE, 420), |root| {
-        let body = root.titled(title, (FAMILY, TITLE)).map_err(drawing_error)?;
-        let (legend_area, plot_area) = body.split_vertically(legend_height(series.len(), false));
+        let (legend_area, plot_area) =
+            titled_with_legend_strip(root, title, legend_height(series.len(), false))?;
         let mut chart = ChartBuilder::on(&plot_area)
             .margin(12)
             .x_label_area_size(46)
@@ -350,12 +356,15 @@ pub fn bar_figure(
         }
     };
     svg((WIDE, 400), |root| {
-        let body = root.titled(title, (FAMILY, TITLE)).map_err(drawing_error)?;
-        let (legend_area, plot_area) = body.split_vertically(if with_legend {
-            legend_height(series.len(), false)
-        } else {
-            0
-        });
+        let (legend_area, plot_area) = titled_with_legend_strip(
+            root,
+            title,
+            if with_legend {
+                legend_height(series.len(), false)
+            } else {
+                0
+            },
+        )?;
         let mut chart = ChartBuilder::on(&plot_area)
             .margin(12)
             .x_label_area_size(40)
@@ -501,8 +510,8 @@ pub fn series_figure(
         0.08,
     );
     svg((WIDE, 420), |root| {
-        let body = root.titled(title, (FAMILY, TITLE)).map_err(drawing_error)?;
-        let (legend_area, plot_area) = body.split_vertically(legend_height(series.len(), false));
+        let (legend_area, plot_area) =
+            titled_with_legend_strip(root, title, legend_height(series.len(), false))?;
         let mut chart = ChartBuilder::on(&plot_area)
             .margin(12)
             .x_label_area_size(46)

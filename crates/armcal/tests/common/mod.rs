@@ -1,9 +1,11 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
+use armcal::cell::Cell;
 use armcal::model::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use std::path::Path;
 
 pub fn rng(seed: u64) -> ChaCha8Rng {
     ChaCha8Rng::seed_from_u64(seed)
@@ -143,4 +145,14 @@ pub fn assert_close(a: f64, b: f64, tol: f64, what: &str) {
         "{what}: analytic {a:.12e} vs reference {b:.12e} (rel. error {:.3e})",
         (a - b).abs() / scale
     );
+}
+
+/// The cell file `name` of the repository's `examples/` folder.
+pub fn example_cell(name: &str) -> Cell {
+    Cell::from_file(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../examples")
+            .join(name),
+    )
+    .unwrap()
 }
