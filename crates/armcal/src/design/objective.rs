@@ -1,11 +1,19 @@
 //! The design objective φ(q₁…q_N) = φ(M₀ + Σ_i J_iᵀWJ_i) and its exact gradient w.r.t. all
 //! N×k joint values: `∂φ/∂q_ij = 2 ⟨W^{1/2}J_i Φ, W^{1/2} ∂J_i/∂q_j⟩_F`, O(N·n_p²) with the
 //! mixed derivatives of the foundation — no finite differences, no Hessian.
+//!
+//! Solvers such as PANOC ask for φ and then for ∇φ at the same point; the workspace keeps
+//! the last point with its whitened Jacobians `W^{1/2}J_i` and `Φ = ∂φ/∂M`, so the gradient
+//! call there only adds the mixed derivatives ∂J_i/∂q_j (no second factorisation of M).
 
 use crate::design::criteria::{evaluate, Criterion};
 use crate::design::information::{DesignModel, InformationWorkspace};
 use crate::Error;
 use nalgebra::DMatrix;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Source of [`DesignObjective`] identities, which tie a workspace's cache to its objective.
+static NEXT_OBJECTIVE_ID: AtomicU64 = AtomicU64::new(0);
 
 /// A criterion on a design model, with the information of poses already measured.
 pub struct DesignObjective<'a> {
@@ -13,15 +21,28 @@ pub struct DesignObjective<'a> {
     pub criterion: Criterion,
     /// Whitened Jacobian rows of configurations already measured (design augmentation).
     pub prior_rows: DMatrix<f64>,
+    /// Identity of this objective (see [`ObjectiveWorkspace`]).
+    id: u64,
 }
 
-/// Buffers for [`DesignObjective::value_and_gradient`].
+/// Buffers for [`DesignObjective::value_and_gradient`], and a cache of its last evaluation:
+/// the point `q`, φ, `Φ`, the Jacobians `W^{1/2}J_i` and (if a gradient was asked for) their
+/// derivatives, of the objective `owner` at exactly (bitwise) that `q`.
 pub struct ObjectiveWorkspace {
     info: InformationWorkspace,
     jacs: Vec<DMatrix<f64>>,
     jacs_dq: Vec<Vec<DMatrix<f64>>>,
     /// `W^{1/2}J_i Φ` of one configuration.
     j_phi: DMatrix<f64>,
+    owner: u64,
+    cached_q: Vec<f64>,
+    /// Whether `cached_q`, `value`, `phi` and `jacs` belong together.
+    cached: bool,
+    /// φ and `Φ` at `cached_q`.
+    value: f64,
+    phi: DMatrix<f64>,
+    /// Whether `jacs_dq` holds the derivatives at `cached_q`.
+    cached_dq: bool,
 }
 
 impl<'a> DesignObjective<'a> {
@@ -37,6 +58,7 @@ impl<'a> DesignObjective<'a> {
             design,
             criterion,
             prior_rows,
+            id: NEXT_OBJECTIVE_ID.fetch_add(1, Ordering::Relaxed),
         }
     }
 
@@ -47,11 +69,18 @@ impl<'a> DesignObjective<'a> {
             jacs: vec![DMatrix::zeros(d.rows(), d.n()); n_configs],
             jacs_dq: vec![vec![DMatrix::zeros(d.rows(), d.n()); d.dof()]; n_configs],
             j_phi: DMatrix::zeros(d.rows(), d.n()),
+            owner: self.id,
+            cached_q: Vec::with_capacity(n_configs * d.dof()),
+            cached: false,
+            value: f64::NAN,
+            phi: DMatrix::zeros(d.n(), d.n()),
+            cached_dq: false,
         }
     }
 
     /// φ at the configurations `q` (N×k values, configuration after configuration) and, if
-    /// asked, its gradient (same layout).
+    /// asked, its gradient (same layout). At the point of the previous call on `ws` nothing
+    /// is recomputed but the Jacobian derivatives, when first asked for.
     pub fn value_and_gradient(
         &self,
         ws: &mut ObjectiveWorkspace,
@@ -59,37 +88,68 @@ impl<'a> DesignObjective<'a> {
         gradient: Option<&mut [f64]>,
     ) -> Result<f64, Error> {
         let k = self.design.dof();
-        let rows = self.design.rows();
         let nconf = q.len() / k;
-        let np = self.prior_rows.nrows();
-        let mut stacked = DMatrix::zeros(np + rows * nconf, self.design.n());
-        stacked.rows_mut(0, np).copy_from(&self.prior_rows);
-        for i in 0..nconf {
-            let qi = &q[i * k..(i + 1) * k];
-            if gradient.is_some() {
-                self.design.jacobian_dq(&mut ws.info, qi);
-                for (dst, src) in ws.jacs_dq[i].iter_mut().zip(&ws.info.jac_dq) {
-                    dst.copy_from(src);
-                }
-            } else {
-                self.design.jacobian(&mut ws.info, qi);
-            }
-            ws.jacs[i].copy_from(&ws.info.jac);
-            stacked
-                .rows_mut(np + rows * i, rows)
-                .copy_from(&ws.info.jac);
-        }
-        let r = triangular_factor(stacked);
-        let cv = evaluate(self.criterion, &r, self.design)?;
-        if let Some(g) = gradient {
+        let hit = ws.owner == self.id
+            && ws.cached
+            && ws.cached_q.len() == q.len()
+            && ws
+                .cached_q
+                .iter()
+                .zip(q)
+                .all(|(a, b)| a.to_bits() == b.to_bits());
+        if !hit {
+            ws.owner = self.id;
+            ws.cached = false;
+            ws.cached_dq = false;
+            ws.cached_q.clear();
+            ws.cached_q.extend_from_slice(q);
+            let rows = self.design.rows();
+            let np = self.prior_rows.nrows();
+            let mut stacked = DMatrix::zeros(np + rows * nconf, self.design.n());
+            stacked.rows_mut(0, np).copy_from(&self.prior_rows);
             for i in 0..nconf {
-                ws.j_phi.gemm(1.0, &ws.jacs[i], &cv.gradient, 0.0);
-                for j in 0..k {
-                    g[i * k + j] = 2.0 * ws.j_phi.dot(&ws.jacs_dq[i][j]);
+                let qi = &q[i * k..(i + 1) * k];
+                if gradient.is_some() {
+                    self.jacobian_and_derivatives(ws, i, qi);
+                } else {
+                    self.design.jacobian(&mut ws.info, qi);
+                    ws.jacs[i].copy_from(&ws.info.jac);
                 }
+                stacked.rows_mut(np + rows * i, rows).copy_from(&ws.jacs[i]);
+            }
+            let r = triangular_factor(stacked);
+            let cv = evaluate(self.criterion, &r, self.design)?;
+            ws.value = cv.value;
+            ws.phi.copy_from(&cv.gradient);
+            ws.cached = true;
+            ws.cached_dq = gradient.is_some();
+        }
+        let Some(g) = gradient else {
+            return Ok(ws.value);
+        };
+        if !ws.cached_dq {
+            for i in 0..nconf {
+                self.jacobian_and_derivatives(ws, i, &q[i * k..(i + 1) * k]);
+            }
+            ws.cached_dq = true;
+        }
+        for i in 0..nconf {
+            ws.j_phi.gemm(1.0, &ws.jacs[i], &ws.phi, 0.0);
+            for j in 0..k {
+                g[i * k + j] = 2.0 * ws.j_phi.dot(&ws.jacs_dq[i][j]);
             }
         }
-        Ok(cv.value)
+        Ok(ws.value)
+    }
+
+    /// `W^{1/2}J_i` and `W^{1/2}∂J_i/∂q_j` of configuration `i` into `ws.jacs[i]`,
+    /// `ws.jacs_dq[i]`.
+    fn jacobian_and_derivatives(&self, ws: &mut ObjectiveWorkspace, i: usize, qi: &[f64]) {
+        self.design.jacobian_dq(&mut ws.info, qi);
+        ws.jacs[i].copy_from(&ws.info.jac);
+        for (dst, src) in ws.jacs_dq[i].iter_mut().zip(&ws.info.jac_dq) {
+            dst.copy_from(src);
+        }
     }
 
     /// Information matrix of configurations (prior included).
@@ -111,4 +171,48 @@ pub fn triangular_factor(a: DMatrix<f64>) -> DMatrix<f64> {
         a
     };
     a.qr().r()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cell::Cell;
+    use crate::model::identifiability::random_configurations;
+    use std::path::Path;
+
+    /// The cached evaluation (value, then gradient at the same point; then other points and
+    /// another objective on the same workspace) agrees with evaluations on fresh workspaces.
+    #[test]
+    fn cached_evaluations_match_fresh_ones() {
+        let cell = Cell::from_file(
+            &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-cell.toml"),
+        )
+        .unwrap();
+        let d = DesignModel::from_cell(&cell).unwrap();
+        let q = random_configurations(&d.model, 30, 3).concat();
+        let mut q2 = q.clone();
+        q2[4] += 1e-3;
+        let a = DesignObjective::new(&d, Criterion::Kpi, &[]);
+        let b = DesignObjective::new(&d, Criterion::D, &[]);
+        let fresh = |obj: &DesignObjective, x: &[f64]| {
+            let mut g = vec![0.0; x.len()];
+            let v = obj
+                .value_and_gradient(&mut obj.workspace(30), x, Some(&mut g))
+                .unwrap();
+            (v, g)
+        };
+        let mut ws = a.workspace(30);
+        let mut g = vec![0.0; q.len()];
+        for (obj, x) in [(&a, &q), (&a, &q2), (&b, &q2), (&a, &q2)] {
+            let v = obj.value_and_gradient(&mut ws, x, None).unwrap();
+            let w = obj.value_and_gradient(&mut ws, x, Some(&mut g)).unwrap();
+            let (vf, gf) = fresh(obj, x);
+            assert_eq!(v, w);
+            assert!((v - vf).abs() <= 1e-12 * vf.abs(), "{v} vs {vf}");
+            let gmax = gf.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            for (x, y) in g.iter().zip(&gf) {
+                assert!((x - y).abs() <= 1e-9 * gmax, "{x} vs {y}");
+            }
+        }
+    }
 }
