@@ -2,12 +2,28 @@
 //! every pose within the joint limits.
 
 use armcal::cell::Cell;
-use armcal::design::exchange::{exchange, ExchangeSettings};
+use armcal::design::exchange::{exchange, ExchangeResult, ExchangeSettings};
 use armcal::design::refine::{refine, RefineSettings};
 use armcal::design::{Criterion, DesignModel, DesignObjective};
 use armcal::model::identifiability::random_configurations;
 use nalgebra::DMatrix;
 use std::path::Path;
+
+/// The 60-pose KPI exchange design from `pool`: the exchange result and its configurations,
+/// the start of a refinement.
+fn kpi_exchange_start(d: &DesignModel, pool: &[Vec<f64>]) -> (ExchangeResult, Vec<Vec<f64>>) {
+    let ex = exchange(
+        d,
+        Criterion::Kpi,
+        pool,
+        &DMatrix::zeros(0, d.n()),
+        60,
+        &ExchangeSettings::default(),
+    )
+    .unwrap();
+    let start = ex.chosen.iter().map(|&i| pool[i].clone()).collect();
+    (ex, start)
+}
 
 #[test]
 fn refinement_improves_the_exchange_design_within_limits() {
@@ -17,16 +33,7 @@ fn refinement_improves_the_exchange_design_within_limits() {
     .unwrap();
     let d = DesignModel::from_cell(&cell).unwrap();
     let pool = random_configurations(&d.model, 1000, 5);
-    let ex = exchange(
-        &d,
-        Criterion::Kpi,
-        &pool,
-        &DMatrix::zeros(0, d.n()),
-        60,
-        &ExchangeSettings::default(),
-    )
-    .unwrap();
-    let start: Vec<Vec<f64>> = ex.chosen.iter().map(|&i| pool[i].clone()).collect();
+    let (ex, start) = kpi_exchange_start(&d, &pool);
     let obj = DesignObjective::new(&d, Criterion::Kpi, &[]);
     let (lo, hi) = d.model.joint_limits();
     let r = refine(&obj, &start, &lo, &hi, None, &RefineSettings::default()).unwrap();
@@ -75,16 +82,7 @@ fn constrained_refinement_descends_and_stays_feasible() {
     let set = constraint_set(&cell, true).unwrap();
     let cons = CellConstraints::new(&set, &d.params);
     let (pool, _) = random_feasible(&d.model, 400, 1, 2_000_000, |q| cons.feasible(q)).unwrap();
-    let ex = exchange(
-        &d,
-        Criterion::Kpi,
-        &pool,
-        &DMatrix::zeros(0, d.n()),
-        60,
-        &ExchangeSettings::default(),
-    )
-    .unwrap();
-    let start: Vec<Vec<f64>> = ex.chosen.iter().map(|&i| pool[i].clone()).collect();
+    let (ex, start) = kpi_exchange_start(&d, &pool);
     let obj = DesignObjective::new(&d, Criterion::Kpi, &[]);
     let (lo, hi) = d.model.joint_limits();
     let r = refine(

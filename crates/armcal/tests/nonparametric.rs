@@ -9,7 +9,7 @@ use armcal::compensate::nonparametric::{
 use armcal::compensate::program::filter_joint_program_corrected;
 use armcal::compensate::{IkSettings, IkStatus};
 use armcal::identify::{identify, IdentifyOptions, Silent};
-use armcal::measure::{MeasurementKind, NoiseModel};
+use armcal::measure::{Dataset, MeasurementKind, NoiseModel};
 use armcal::model::identifiability::random_configurations;
 use armcal::model::{forward_kinematics, Data};
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
@@ -102,17 +102,25 @@ fn sag(q: &[f64]) -> Vector3<f64> {
     Vector3::new(0.0, 0.0, -0.3 * q[1].cos() - 0.15 * (q[1] + q[2]).cos())
 }
 
-fn rms(v: &[Vector3<f64>]) -> f64 {
-    (v.iter().map(|e| e.norm_squared()).sum::<f64>() / v.len() as f64).sqrt()
+/// A parametric calibration of the paper cell whose truth also sags (see [`sag`]).
+struct SaggingCalibration {
+    cell: Cell,
+    truth: Vec<f64>,
+    /// The 200 calibration configurations and their measurements.
+    train: Vec<Vec<f64>>,
+    data: Dataset,
+    /// The identified parameters.
+    calibrated: Vec<f64>,
 }
 
-#[test]
-fn polynomial_correction_of_the_residual_beats_parametric_alone() {
+/// Simulates 200 measurements of a perturbed paper robot with a 10 µm tracker (so the sag,
+/// a few tenths of a mm, is well above noise), adds the sag the kinematic model cannot
+/// represent (measured values are in the instrument frame), and identifies.
+fn sagging_calibration() -> SaggingCalibration {
     let mut cell = Cell::from_file(
         &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-cell.toml"),
     )
     .unwrap();
-    // A tracker of 10 µm per axis, so the sag (a few tenths of a mm) is well above noise.
     let noise = NoiseModel::Constant {
         sigma: [0.01; 3],
         sigma_angle: 1e-5,
@@ -121,10 +129,6 @@ fn polynomial_correction_of_the_residual_beats_parametric_alone() {
     let model = &cell.model;
     let truth = perturbed_truth(model, &Perturbation::default(), 21);
     let train = random_configurations(model, 200, 22);
-    let test = random_configurations(model, 100, 23);
-
-    // Parametric calibration on measurements that include the sag (which the kinematic
-    // model cannot represent): measured values are in the instrument frame.
     let mut data = simulate(model, &truth, &train, Some(&noise), 24).unwrap();
     let mut fk = Data::new(model);
     forward_kinematics(model, &mut fk, &truth, &train[0]);
@@ -136,6 +140,30 @@ fn polynomial_correction_of_the_residual_beats_parametric_alone() {
     }
     let est = identify(&cell, &data, &IdentifyOptions::default(), &mut Silent).unwrap();
     let calibrated = est.params_for(model).unwrap();
+    SaggingCalibration {
+        cell,
+        truth,
+        train,
+        data,
+        calibrated,
+    }
+}
+
+fn rms(v: &[Vector3<f64>]) -> f64 {
+    (v.iter().map(|e| e.norm_squared()).sum::<f64>() / v.len() as f64).sqrt()
+}
+
+#[test]
+fn polynomial_correction_of_the_residual_beats_parametric_alone() {
+    let SaggingCalibration {
+        cell,
+        truth,
+        train,
+        data: _,
+        calibrated,
+    } = sagging_calibration();
+    let model = &cell.model;
+    let test = random_configurations(model, 100, 23);
 
     // Remaining error of the reflector position in the world (= robot base, fixed) frame:
     // true position (with sag) minus the calibrated model's prediction.
@@ -196,29 +224,14 @@ fn polynomial_correction_of_the_residual_beats_parametric_alone() {
 #[test]
 fn program_filtering_with_the_residual_correction_beats_parametric_alone() {
     // As above: the truth sags under gravity, which the kinematic model cannot represent.
-    let mut cell = Cell::from_file(
-        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-cell.toml"),
-    )
-    .unwrap();
-    let noise = NoiseModel::Constant {
-        sigma: [0.01; 3],
-        sigma_angle: 1e-5,
-    };
-    cell.instrument.as_mut().unwrap().noise = noise.clone();
+    let SaggingCalibration {
+        cell,
+        truth,
+        train: _,
+        data,
+        calibrated,
+    } = sagging_calibration();
     let model = &cell.model;
-    let truth = perturbed_truth(model, &Perturbation::default(), 21);
-    let train = random_configurations(model, 200, 22);
-    let mut data = simulate(model, &truth, &train, Some(&noise), 24).unwrap();
-    let mut fk = Data::new(model);
-    forward_kinematics(model, &mut fk, &truth, &train[0]);
-    let to_instrument = fk.instrument.rot.transpose();
-    for m in &mut data.measurements {
-        if let MeasurementKind::Position { value, .. } = &mut m.kind {
-            *value += to_instrument * sag(&data.configurations[m.config]);
-        }
-    }
-    let est = identify(&cell, &data, &IdentifyOptions::default(), &mut Silent).unwrap();
-    let calibrated = est.params_for(model).unwrap();
 
     // A held-out program of 100 configurations, filtered with the parametric model alone and
     // with the correction fitted on the calibration data; the truth (with its sag) executes

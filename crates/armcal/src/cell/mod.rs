@@ -50,6 +50,22 @@ pub enum Obstacle {
     },
 }
 
+/// The unit normal of the half-space `name` with the (possibly unnormalised) `normal`; an
+/// error when the normal is zero or not finite.
+pub fn half_space_unit_normal(
+    name: &str,
+    normal: &[f64; 3],
+) -> Result<nalgebra::Vector3<f64>, Error> {
+    let n = nalgebra::Vector3::from(*normal);
+    let norm = n.norm();
+    if !(norm > 0.0 && norm.is_finite()) {
+        return Err(Error::Model(format!(
+            "half-space `{name}` has no valid normal"
+        )));
+    }
+    Ok(n / norm)
+}
+
 /// Which columns of a data file feed which joints, and the unit of each.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DataColumns {

@@ -63,7 +63,7 @@
 //! Constraints that need the tracker (incidence, line of sight) are left out when the model
 //! has no instrument frame; incidence also needs `instrument.max_incidence` in the cell.
 
-use crate::cell::{Cell, Obstacle};
+use crate::cell::{half_space_unit_normal, Cell, Obstacle};
 use crate::geometry::segment_distance::{point_segment_distance, segment_distance};
 use crate::model::{forward_kinematics, Data, Model, Twist};
 use crate::Error;
@@ -271,15 +271,8 @@ impl ConstraintSet {
                     normal,
                     offset,
                 } => {
-                    let n = Vector3::from(*normal);
-                    let norm = n.norm();
-                    if !(norm > 0.0 && norm.is_finite()) {
-                        return Err(Error::Model(format!(
-                            "half-space `{name}` has no valid normal"
-                        )));
-                    }
                     half_spaces.push(HalfSpace {
-                        normal: n / norm,
+                        normal: half_space_unit_normal(name, normal)?,
                         offset: *offset,
                     });
                     half_space_names.push(name.clone());

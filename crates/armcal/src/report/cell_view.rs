@@ -21,7 +21,7 @@
 //! 200 mm margin.
 
 use super::html::escape;
-use crate::cell::{Cell, Obstacle};
+use crate::cell::{half_space_unit_normal, Cell, Obstacle};
 use crate::design::plan::constraint_set;
 use crate::geometry::ConstraintKind;
 use crate::model::{forward_kinematics, Data};
@@ -358,14 +358,7 @@ fn scene(cell: &Cell, designs: &[(&str, &[Vec<f64>])]) -> Result<Scene, Error> {
                 normal,
                 offset,
             } => {
-                let n = Vector3::from(*normal);
-                let norm = n.norm();
-                if !(norm > 0.0 && norm.is_finite()) {
-                    return Err(Error::Model(format!(
-                        "half-space `{name}` has no valid normal"
-                    )));
-                }
-                half_spaces.push((name, n / norm, *offset));
+                half_spaces.push((name, half_space_unit_normal(name, normal)?, *offset));
             }
         }
     }
