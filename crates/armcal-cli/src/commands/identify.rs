@@ -96,6 +96,9 @@ pub fn print_summary(e: &Estimate) {
             println!("  - {r}");
         }
     }
+    if let Some(d) = &e.rank_deficit {
+        println!("\nbelow the generic count: {d}");
+    }
     if !e.strong_correlations.is_empty() {
         println!("\nstrongly correlated pairs (|ρ| > 0.95):");
         for (a, b, r) in &e.strong_correlations {

@@ -13,8 +13,9 @@
 //! fixed, as for the original model.
 
 use armcal::cell::Cell;
-use armcal::model::convert::{dh_to_mdh, to_zrp, zrp_to_dh};
-use armcal::model::identifiability::{self, Identifiability, IdentifiabilityOptions, Measurement};
+use armcal::model::complete::{in_form, LinkForm};
+use armcal::model::identifiability::{self, IdentifiabilityOptions, Measurement};
+use armcal::model::rank_deficit::rank_deficit;
 use armcal::model::{Model, Segment, Status};
 
 #[derive(clap::Args)]
@@ -43,13 +44,9 @@ pub struct Args {
 /// documentation.
 fn converted(cell: &Cell, convention: &str) -> anyhow::Result<Model> {
     let original = &cell.model;
-    let spec = match convention {
-        "zrp" => to_zrp(original, &original.nominal()),
-        "dh" => zrp_to_dh(&original.spec(), None)?,
-        "mdh" => dh_to_mdh(&zrp_to_dh(&original.spec(), None)?)?,
-        other => anyhow::bail!("unknown convention `{other}`; use dh, mdh or zrp"),
-    };
-    let mut model = Model::from_spec(&spec)?;
+    let form = LinkForm::from_name(convention)
+        .ok_or_else(|| anyhow::anyhow!("unknown convention `{convention}`; use dh, mdh or zrp"))?;
+    let mut model = Model::from_spec(&in_form(&original.spec(), form)?.spec)?;
     for i in 0..model.param_count() {
         let p = model.registry.get(i);
         let status = match p.segment {
@@ -84,25 +81,29 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         seed: a.seed,
         ..cell.identifiability_options()
     };
-    let conversion: Option<(Model, Identifiability)> = match a.convention.as_deref() {
+    // The analysis runs on the parameters the cell declared free, before the automatic
+    // reduction, so that every excluded parameter gets its reason.
+    let (model, report, deficit) = match a.convention.as_deref() {
         Some(c) => {
             let mut m = converted(&cell, c)?;
             let report = identifiability::analyze(&m, &m.nominal(), &opts)?;
+            let deficit = rank_deficit(
+                &m,
+                &m.nominal(),
+                report.identifiable.len(),
+                measurement,
+                None,
+            )?;
             if cell.auto_free {
                 report.apply(&mut m)?;
             }
-            Some((m, report))
+            (std::borrow::Cow::Owned(m), report, deficit)
         }
-        None => None,
-    };
-    let (model, report) = match conversion {
-        Some((m, r)) => (std::borrow::Cow::Owned(m), r),
-        // The analysis runs on the parameters the cell declared free, before the automatic
-        // reduction, so that every excluded parameter gets its reason.
-        None => (
-            std::borrow::Cow::Borrowed(&cell.model),
-            cell.identifiability(&opts)?,
-        ),
+        None => {
+            let report = cell.identifiability(&opts)?;
+            let deficit = cell.rank_deficit(&report, &cell.model.nominal(), None)?;
+            (std::borrow::Cow::Borrowed(&cell.model), report, deficit)
+        }
     };
     if a.json {
         let params: Vec<_> = model
@@ -121,15 +122,28 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
             "cell": cell.name,
             "source": cell.robot.source,
             "convention": a.convention,
+            "form": cell.form.name(),
+            "form_changes": cell.form_changes,
+            "form_incomplete": cell.form_incomplete,
             "joints": model.joints,
             "parameters": params,
             "identifiability": report,
+            "rank_deficit": deficit,
         });
         println!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
     }
     println!("{} ({})", cell.name, cell.origin);
     println!("source: {}", cell.robot.source);
+    for c in &cell.form_changes {
+        println!(
+            "complete, minimal form (convention = \"{}\"): {c}",
+            cell.form.name()
+        );
+    }
+    for c in &cell.form_incomplete {
+        println!("incomplete: {c}");
+    }
     if let Some(c) = &a.convention {
         println!(
             "converted to {c} (forward kinematics unchanged); chain parameters all free, \
@@ -197,6 +211,9 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         report.condition_number
     );
     println!("  {}", report.identifiable.join(", "));
+    if let Some(d) = &deficit {
+        println!("below the generic count: {d}");
+    }
     if !report.excluded.is_empty() {
         println!("not identifiable ({}):", report.excluded.len());
         for e in &report.excluded {

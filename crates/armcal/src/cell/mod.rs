@@ -6,7 +6,9 @@
 mod raw;
 
 pub use crate::measure::NoiseModel;
+use crate::model::complete::{self, FormChange, Formed, LinkForm};
 use crate::model::identifiability::{self, IdentifiabilityOptions, Measurement};
+use crate::model::rank_deficit::{rank_deficit, RankDeficit};
 use crate::model::{LinkGeometry, LinkSpec, Model, ModelSpec, Status};
 use crate::robots::{self, Capsule, Robot};
 use crate::Error;
@@ -95,6 +97,12 @@ pub struct Cell {
     pub data_columns: Option<DataColumns>,
     /// Things the user should know that do not stop the cell from loading.
     pub warnings: Vec<String>,
+    /// The link form the cell asked for (`[robot] convention`, default `auto`).
+    pub form: LinkForm,
+    /// Links that form changed (Hayati / β across nearly parallel axes).
+    pub form_changes: Vec<FormChange>,
+    /// Nearly parallel axes the model still has no tilt parameter for, with the fix.
+    pub form_incomplete: Vec<String>,
 }
 
 impl Cell {
@@ -114,11 +122,14 @@ impl Cell {
         raw::parse(text, file, dir)
     }
 
-    /// A cell with only a library robot: the tool frame is measured as a full pose, all
-    /// parameters free.
+    /// A cell with only a library robot in its complete, minimal form ([`LinkForm::Auto`]):
+    /// the tool frame is measured as a full pose, all parameters free.
     pub fn from_robot(name: &str) -> Result<Cell, Error> {
-        let robot = robots::robot(name)?;
-        let model = Model::from_spec(&robot.spec)?;
+        let mut robot = robots::robot(name)?;
+        let given = Model::from_spec(&robot.spec)?;
+        let spec = robot.spec.clone();
+        let shaped = shape_robot(&mut robot, &given, spec, LinkForm::Auto, &mut Vec::new())?;
+        let model = Model::from_spec(&shaped.spec)?;
         let declared_free = model.registry.free();
         Ok(Cell {
             name: robot.name.clone(),
@@ -134,6 +145,9 @@ impl Cell {
             declared_free,
             data_columns: None,
             warnings: Vec::new(),
+            form: LinkForm::Auto,
+            form_changes: shaped.changes,
+            form_incomplete: shaped.incomplete,
         })
     }
 
@@ -154,13 +168,38 @@ impl Cell {
         &self,
         opts: &IdentifiabilityOptions,
     ) -> Result<identifiability::Identifiability, Error> {
+        let declared = self.declared_model();
+        identifiability::analyze(&declared, &declared.nominal(), opts)
+    }
+
+    /// Why `report` (an analysis of this cell's declared free set) finds fewer parameters
+    /// than the generic count, if it does; `configurations` are the data's, if the analysis
+    /// was at a data set's configurations.
+    pub fn rank_deficit(
+        &self,
+        report: &identifiability::Identifiability,
+        params: &[f64],
+        configurations: Option<&[Vec<f64>]>,
+    ) -> Result<Option<RankDeficit>, Error> {
+        rank_deficit(
+            &self.declared_model(),
+            params,
+            report.identifiable.len(),
+            report.measurement,
+            configurations,
+        )
+    }
+
+    /// The model with every parameter the cell declared free (or with a prior) free again,
+    /// before any automatic reduction.
+    pub fn declared_model(&self) -> Model {
         let mut declared = self.model.clone();
         for &i in &self.declared_free {
             if !declared.registry.get(i).status.is_free() {
                 declared.registry.set_status(i, Status::Free);
             }
         }
-        identifiability::analyze(&declared, &declared.nominal(), opts)
+        declared
     }
 
     /// Default analysis options for this cell (its measurement type).
@@ -200,6 +239,24 @@ pub(crate) fn assemble_spec(
         links,
         targets,
     }
+}
+
+/// Puts the cell's assembled chain `spec` (robot, base and tool overrides, instrument,
+/// targets; `given` is its model) into the link `form`, and re-expresses the robot's and
+/// the tool's capsules in the new frames; `robot` then holds the formed chain.
+pub(crate) fn shape_robot(
+    robot: &mut Robot,
+    given: &Model,
+    spec: ModelSpec,
+    form: LinkForm,
+    tool_capsules: &mut Vec<Capsule>,
+) -> Result<Formed, Error> {
+    let formed = complete::in_form(&spec, form)?;
+    let model = Model::from_spec(&formed.spec)?;
+    robot.capsules = robots::transfer_capsules(given, &model, &robot.capsules)?;
+    *tool_capsules = robots::transfer_capsules(given, &model, tool_capsules)?;
+    robot.spec.links = formed.spec.links.clone();
+    Ok(formed)
 }
 
 /// Applies `fixed` patterns, then `free` patterns (which win), then priors.

@@ -2,6 +2,7 @@
 //! that give file, line and field.
 
 use super::*;
+use crate::model::complete::LinkForm;
 use crate::model::identifiability::Measurement;
 use crate::model::{Convention, Joint, JointKind, LinkGeometry, LinkSpec, Unit};
 use serde::Deserialize;
@@ -41,6 +42,8 @@ struct RawRobot {
     limits: Option<BTreeMap<String, [f64; 2]>>,
     #[serde(default)]
     capsules: Vec<Spanned<toml::Table>>,
+    /// `auto` (default), `as-given`, `dh`, `mdh` or `zrp` ([`LinkForm`]).
+    convention: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -167,15 +170,38 @@ fn unit_triple(
     }
 }
 
-fn check_unused(t: &toml::Table, used: &[String], allowed: &[&str]) -> Result<(), String> {
+/// Every key of `t` must be one the parser read (`used`) or one of `allowed`. The error for
+/// an unknown key lists what is valid there: `valid` (the fields with their unit suffixes,
+/// e.g. `theta_deg|theta_rad`) and `allowed`.
+fn check_unused(
+    t: &toml::Table,
+    used: &[String],
+    allowed: &[&str],
+    valid: &[String],
+) -> Result<(), String> {
     for k in t.keys() {
         if !used.iter().any(|u| u == k) && !allowed.contains(&k.as_str()) {
+            let fields: Vec<String> = valid
+                .iter()
+                .cloned()
+                .chain(allowed.iter().map(|a| a.to_string()))
+                .collect();
             return Err(format!(
-                "unknown field `{k}` (mind the unit suffix: _mm, _m, _deg, _rad)"
+                "unknown field `{k}`; valid here: {} (mind the unit suffix: _mm, _m, _deg, _rad)",
+                fields.join(", ")
             ));
         }
     }
     Ok(())
+}
+
+/// The spellings of a field with its unit suffixes: `theta_deg|theta_rad`.
+fn unit_spellings(field: &str, unit: Unit) -> String {
+    match unit {
+        Unit::Mm => format!("{field}_mm|{field}_m"),
+        Unit::Rad => format!("{field}_deg|{field}_rad"),
+        Unit::Unitless => field.to_string(),
+    }
 }
 
 /// A frame table `{ xyz_mm = [...], rpy_deg = [...] }` (both optional, zero by default).
@@ -183,7 +209,11 @@ fn frame(t: &toml::Table, allowed: &[&str]) -> Result<LinkGeometry, String> {
     let mut used = Vec::new();
     let xyz = unit_triple(t, "xyz", Unit::Mm, &mut used)?.unwrap_or([0.0; 3]);
     let rpy = unit_triple(t, "rpy", Unit::Rad, &mut used)?.unwrap_or([0.0; 3]);
-    check_unused(t, &used, allowed)?;
+    let valid = [
+        unit_spellings("xyz", Unit::Mm),
+        unit_spellings("rpy", Unit::Rad),
+    ];
+    check_unused(t, &used, allowed, &valid)?;
     Ok(LinkGeometry::frame6(xyz, rpy))
 }
 
@@ -205,12 +235,16 @@ fn inline_link(t: &toml::Table, index: usize) -> Result<LinkSpec, String> {
         .map(str::to_string)
         .unwrap_or_else(|| format!("j{index}"));
     let conv_name = string_field(t, "convention")?.ok_or("missing `convention`")?;
-    let convention = Convention::from_name(conv_name).ok_or_else(|| {
+    let mut convention = Convention::from_name(conv_name).ok_or_else(|| {
         format!(
             "unknown convention `{conv_name}`; known: {}",
             Convention::ALL.map(|c| c.name()).join(", ")
         )
     })?;
+    // A modified-DH link with β (book §2.6) is written `convention = "mdh"` + `beta_deg`.
+    if convention == Convention::Mdh && (t.contains_key("beta_deg") || t.contains_key("beta_rad")) {
+        convention = Convention::MdhBeta;
+    }
     let kind = match string_field(t, "joint")? {
         None | Some("fixed") => None,
         Some("revolute") => Some(JointKind::Revolute),
@@ -278,6 +312,14 @@ fn inline_link(t: &toml::Table, index: usize) -> Result<LinkSpec, String> {
             })
         }
     };
+    let mut valid: Vec<String> = convention
+        .fields(kind)
+        .iter()
+        .map(|(f, u)| unit_spellings(f, *u))
+        .collect();
+    if convention == Convention::Mdh {
+        valid.push(unit_spellings("beta", Unit::Rad));
+    }
     check_unused(
         t,
         &used,
@@ -289,6 +331,7 @@ fn inline_link(t: &toml::Table, index: usize) -> Result<LinkSpec, String> {
             "axis",
             "joint_name",
         ],
+        &valid,
     )?;
     Ok(LinkSpec {
         name,
@@ -309,7 +352,13 @@ fn capsule(t: &toml::Table, frame_required: bool) -> Result<Capsule, String> {
     if frame_required && frame.is_none() {
         return Err("missing `frame` (the chain frame the capsule moves with)".into());
     }
-    check_unused(t, &used, &["frame", "name", "kind"])?;
+    let valid = ["a", "b"].map(|k| unit_spellings(k, Unit::Mm));
+    let valid = [
+        valid[0].clone(),
+        valid[1].clone(),
+        unit_spellings("radius", Unit::Mm),
+    ];
+    check_unused(t, &used, &["frame", "name", "kind"], &valid)?;
     Ok(Capsule {
         frame: frame.unwrap_or("tool").to_string(),
         a,
@@ -345,7 +394,8 @@ fn obstacle(t: &toml::Table, i: usize) -> Result<Obstacle, String> {
             if norm < 1e-12 {
                 return Err("`normal` must be non-zero".into());
             }
-            check_unused(t, &used, &["kind", "name"])?;
+            let valid = ["normal".to_string(), unit_spellings("offset", Unit::Mm)];
+            check_unused(t, &used, &["kind", "name"], &valid)?;
             Ok(Obstacle::HalfSpace {
                 name,
                 normal: n.map(|x| x / norm),
@@ -361,6 +411,15 @@ fn obstacle(t: &toml::Table, i: usize) -> Result<Obstacle, String> {
 
 fn noise(t: &toml::Table) -> Result<NoiseModel, String> {
     let mut used = vec!["model".to_string()];
+    let valid: Vec<String> = match string_field(t, "model")? {
+        Some("constant") => vec![
+            unit_spellings("sigma", Unit::Mm),
+            unit_spellings("sigma_angle", Unit::Rad),
+        ],
+        Some("range") => vec![unit_spellings("a", Unit::Mm), "b_um_per_m".into()],
+        Some("per-measurement") => vec![unit_spellings("floor", Unit::Mm)],
+        _ => Vec::new(),
+    };
     let n = match string_field(t, "model")? {
         Some("constant") => {
             let is_array = ["sigma_mm", "sigma_m"]
@@ -413,7 +472,7 @@ fn noise(t: &toml::Table) -> Result<NoiseModel, String> {
         }
         None => return Err("missing `model` (constant, range or per-measurement)".into()),
     };
-    check_unused(t, &used, &[])?;
+    check_unused(t, &used, &[], &valid)?;
     Ok(n)
 }
 
@@ -587,7 +646,8 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
             let xyz = unit_triple(tt, "xyz", Unit::Mm, &mut used)
                 .and_then(|v| v.ok_or_else(|| "missing `xyz_mm`".to_string()))
                 .map_err(|e| ctx.err(t.span(), &field, e))?;
-            check_unused(tt, &used, &[]).map_err(|e| ctx.err(t.span(), &field, e))?;
+            check_unused(tt, &used, &[], &[unit_spellings("xyz", Unit::Mm)])
+                .map_err(|e| ctx.err(t.span(), &field, e))?;
             LinkGeometry::point(xyz)
         };
         targets.push(LinkSpec {
@@ -604,10 +664,34 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
         tool,
         targets,
     );
-    let mut model = Model::from_spec(&spec).map_err(|e| Error::File {
+    let model_error = |e: Error| Error::File {
         file: file.to_string(),
         message: e.to_string(),
-    })?;
+    };
+    let mut tool_capsules = Vec::new();
+    for (i, c) in raw.tool_capsules.iter().enumerate() {
+        tool_capsules.push(
+            capsule(c.get_ref(), false)
+                .map_err(|e| ctx.err(c.span(), &format!("tool_capsules[{i}]"), e))?,
+        );
+    }
+    let form = match &rr.convention {
+        None => LinkForm::Auto,
+        Some(c) => LinkForm::from_name(c).ok_or_else(|| {
+            ctx.err(
+                rspan.clone(),
+                "robot.convention",
+                format!(
+                    "`{c}`; use {}",
+                    LinkForm::ALL.map(LinkForm::name).join(", ")
+                ),
+            )
+        })?,
+    };
+    let given = Model::from_spec(&spec).map_err(model_error)?;
+    let shaped = shape_robot(&mut robot, &given, spec, form, &mut tool_capsules)
+        .map_err(|e| ctx.err(rspan.clone(), "robot.convention", e))?;
+    let mut model = Model::from_spec(&shaped.spec).map_err(model_error)?;
 
     // Parameters.
     let all_frames = (0..model.targets.len()).all(|k| model.target_is_frame(k));
@@ -659,7 +743,9 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
             let mut used = Vec::new();
             let s = unit_value(t, "sigma", unit, &mut used)
                 .and_then(|v| v.ok_or_else(|| "missing `sigma_deg` / `sigma_mm`".into()))
-                .and_then(|v| check_unused(t, &used, &[]).map(|_| v))
+                .and_then(|v| {
+                    check_unused(t, &used, &[], &[unit_spellings("sigma", unit)]).map(|_| v)
+                })
                 .map_err(|e| ctx.err(span.clone(), &format!("parameters.priors.{name}"), e))?;
             if s <= 0.0 {
                 return Err(ctx.err(
@@ -759,7 +845,13 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
             ));
         }
         let used: Vec<String> = vec![key.into()];
-        check_unused(t, &used, &["name", "weight"]).map_err(|e| ctx.err(w.span(), &field, e))?;
+        check_unused(
+            t,
+            &used,
+            &["name", "weight"],
+            &["joints_deg|joints_rad".into()],
+        )
+        .map_err(|e| ctx.err(w.span(), &field, e))?;
         working.push(WorkingPose { name, q, weight });
     }
 
@@ -771,12 +863,7 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
         );
     }
     let mut capsules = robot.capsules.clone();
-    for (i, c) in raw.tool_capsules.iter().enumerate() {
-        capsules.push(
-            capsule(c.get_ref(), false)
-                .map_err(|e| ctx.err(c.span(), &format!("tool_capsules[{i}]"), e))?,
-        );
-    }
+    capsules.extend(tool_capsules);
     for (i, c) in capsules.iter().enumerate() {
         if model.link_index(&c.frame).is_none() {
             return Err(Error::File {
@@ -818,6 +905,9 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
         declared_free: Vec::new(),
         data_columns,
         warnings,
+        form,
+        form_changes: shaped.changes,
+        form_incomplete: shaped.incomplete,
     };
     cell.declared_free = cell.model.registry.free();
     if cell.auto_free {

@@ -20,6 +20,8 @@ pub use uncertainty::{ErrorStats, Observability, ParameterUncertainty, TcpCovari
 
 use crate::cell::Cell;
 use crate::measure::{Dataset, MeasurementKind};
+use crate::model::identifiability::{IdentifiabilityOptions, Measurement};
+use crate::model::rank_deficit::RankDeficit;
 use crate::model::{Model, ModelSpec, Segment, Status as ParamStatus};
 use crate::Error;
 use nalgebra::{DVector, Matrix3};
@@ -143,6 +145,10 @@ pub struct Estimate {
     pub parameters: Vec<ParameterEstimate>,
     /// Why each parameter not estimated was left out (identifiability analysis).
     pub fixed_reasons: Vec<(String, String)>,
+    /// Why fewer parameters than the generic count were identified (at the fit, from these
+    /// data), if so.
+    #[serde(default)]
+    pub rank_deficit: Option<RankDeficit>,
     pub solver: SolverReport,
     pub uncertainty: ParameterUncertainty,
     /// Names of the free parameters, the order of C_p.
@@ -161,14 +167,18 @@ pub struct Estimate {
     pub configurations: usize,
 }
 
-/// The cell's model with its free set for `data`, and the reason for every parameter left
-/// out. With `free = "auto"` the free set is the minimal identifiable set *at the data's
+/// The cell's model with its free set for `data`, decided at the parameters `at` (the
+/// frames-first estimate or a fit, not the nominal: a target whose nominal offset is
+/// unknown and written as `[0, 0, 0]` lies on the last joint axis there, where two
+/// parameters of that joint have no effect), and the reason for every parameter left out.
+/// With `free = "auto"` the free set is the minimal identifiable set *at the data's
 /// configurations*; parameters these data cannot identify although the cell could (e.g. a
 /// joint that never moves, or all poses alike) are marked "from these data". Too few
 /// residual rows for the cell's identifiable set is an error.
 pub fn identifiable_model(
     cell: &Cell,
     data: &Dataset,
+    at: &[f64],
 ) -> Result<(Model, Vec<(String, String)>), Error> {
     if !cell.auto_free {
         return Ok((cell.model.clone(), Vec::new()));
@@ -184,15 +194,10 @@ pub fn identifiable_model(
             generic.identifiable.len().div_ceil(data.rows().max(1) / data.configurations.len().max(1))
         )));
     }
-    let mut declared = cell.model.clone();
-    for &i in &cell.declared_free {
-        if !declared.registry.get(i).status.is_free() {
-            declared.registry.set_status(i, ParamStatus::Free);
-        }
-    }
+    let mut declared = cell.declared_model();
     let report = crate::model::identifiability::analyze_at(
         &declared,
-        &declared.nominal(),
+        at,
         &data.configurations,
         &cell.identifiability_options(),
     )?;
@@ -215,17 +220,34 @@ pub fn identifiable_model(
 }
 
 /// Starting point of the full fit: the nominal robot with the instrument, target, base and
-/// tool frames fitted first (a two-stage fit). A tracker placed only roughly in the cell, or
-/// not at all, is then no obstacle for the full calibration.
+/// tool frames fitted first (a two-stage fit), by LM whatever the final solver. A tracker
+/// placed only roughly in the cell, or not at all, and a target whose offset is unknown are
+/// then no obstacle for the full calibration. The frames fitted are those of `model`'s free
+/// set that these data identify at the nominal (base and instrument, tool and target
+/// overlap); with no free frame parameter the start is the nominal.
 pub fn frames_first_start(
     model: &Model,
     data: &Dataset,
     noise: &crate::measure::NoiseModel,
     opts: &IdentifyOptions,
 ) -> Result<Vec<f64>, Error> {
-    let frames = frames_only(model);
+    let mut frames = frames_only(model);
+    if frames.registry.free().is_empty() {
+        return Ok(model.nominal());
+    }
+    let measurement = data_measurement(data);
+    let report = crate::model::identifiability::analyze_at(
+        &frames,
+        &frames.nominal(),
+        &data.configurations,
+        &IdentifiabilityOptions {
+            measurement,
+            ..Default::default()
+        },
+    )?;
+    report.apply(&mut frames)?;
     let mut problem = Problem::new(&frames, data, noise)?;
-    if problem.free.is_empty() || problem.free.len() == model.registry.free().len() {
+    if problem.free.is_empty() {
         return Ok(model.nominal());
     }
     let stage = IdentifyOptions {
@@ -235,6 +257,16 @@ pub fn frames_first_start(
     };
     let (sol, _, _) = solve(&mut problem, &model.nominal(), &stage, &mut Silent)?;
     Ok(sol.params)
+}
+
+/// The measurement type of a data set for the identifiability analysis, from its first
+/// measurement: pose, distance between poses, or (for every other kind) position.
+fn data_measurement(data: &Dataset) -> Measurement {
+    match data.measurements.first().map(|m| &m.kind) {
+        Some(MeasurementKind::Pose { .. }) => Measurement::Pose,
+        Some(MeasurementKind::Distance { .. }) => Measurement::Distance,
+        _ => Measurement::Position,
+    }
 }
 
 /// Runs one solver on a problem.
@@ -368,14 +400,24 @@ pub fn identify(
         ((0..data.configurations.len()).collect(), Vec::new())
     };
     let train = data.subset(&train_idx);
-    // With `free = "auto"` the free set is the minimal identifiable set *for these
-    // configurations*: parameters the data cannot separate are fixed, with their reason.
-    let (fitted_model, reasons) = identifiable_model(cell, &train)?;
-    let model = &fitted_model;
+    let fit = fit_free_set(cell, &train, &noise, opts, observer)?;
+    let (model, reasons) = (&fit.model, fit.reasons);
+    let (sol, outliers, robust_scale) = (fit.solution, fit.outliers, fit.robust_scale);
     let mut problem = Problem::new(model, &train, &noise)?;
-    let start = frames_first_start(model, &train, &noise, opts)?;
-    let (sol, outliers, robust_scale) = solve(&mut problem, &start, opts, observer)?;
+    problem.row_weights = fit.row_weights;
     let names = problem.free_names();
+    let rank_deficit = if cell.auto_free {
+        let declared = cell.declared_model();
+        crate::model::rank_deficit::rank_deficit(
+            &declared,
+            &sol.params,
+            names.len(),
+            cell.measurement,
+            Some(&train.configurations),
+        )?
+    } else {
+        None
+    };
     // Covariance from the unweighted whitened Jacobian (robust weights only pick data).
     let unc = uncertainty::parameter_uncertainty(&sol.jacobian, &sol.residual, &names)?;
     let working: Vec<Vec<f64>> = cell.working.iter().map(|w| w.q.clone()).collect();
@@ -434,6 +476,7 @@ pub fn identify(
         model: model.spec_at(&sol.params),
         parameters,
         fixed_reasons: reasons,
+        rank_deficit,
         solver: SolverReport {
             method: opts.method,
             robust: opts.robust,
@@ -455,6 +498,58 @@ pub fn identify(
         measurements: train.measurements.len(),
         configurations: train.configurations.len(),
     })
+}
+
+/// A fit with its free set, as [`fit_free_set`] decided it.
+struct FreeSetFit {
+    model: Model,
+    reasons: Vec<(String, String)>,
+    /// The problem's final row weights (a robust fit's IRLS weights).
+    row_weights: Vec<f64>,
+    solution: Solution,
+    outliers: Vec<Outlier>,
+    robust_scale: Option<f64>,
+}
+
+/// The fit with the free set decided where the fit is, never at the nominal: frames first
+/// ([`frames_first_start`] on every parameter the cell declared free), the identifiable set
+/// at that estimate ([`identifiable_model`]), the fit, and the identifiable set again at
+/// the fit. When it grew there (the start sat at a special geometry the fit left), the fit
+/// is repeated from there with the larger set; the set grows every time, so this ends.
+fn fit_free_set(
+    cell: &Cell,
+    train: &Dataset,
+    noise: &crate::measure::NoiseModel,
+    opts: &IdentifyOptions,
+    observer: &mut dyn Observer,
+) -> Result<FreeSetFit, Error> {
+    let declared = if cell.auto_free {
+        cell.declared_model()
+    } else {
+        cell.model.clone()
+    };
+    let mut at = frames_first_start(&declared, train, noise, opts)?;
+    let mut decided = identifiable_model(cell, train, &at)?;
+    loop {
+        let (model, reasons) = decided;
+        let mut problem = Problem::new(&model, train, noise)?;
+        let (solution, outliers, robust_scale) = solve(&mut problem, &at, opts, observer)?;
+        let row_weights = problem.row_weights.clone();
+        drop(problem);
+        let recheck = identifiable_model(cell, train, &solution.params)?;
+        if recheck.0.registry.free().len() <= model.registry.free().len() {
+            return Ok(FreeSetFit {
+                model,
+                reasons,
+                row_weights,
+                solution,
+                outliers,
+                robust_scale,
+            });
+        }
+        at = solution.params;
+        decided = recheck;
+    }
 }
 
 /// Held-out errors of the nominal model, the frames-only fit and the full calibration.

@@ -189,16 +189,16 @@ fn fixed_link(name: &str, geometry: LinkGeometry) -> LinkSpec {
 
 /// A joint axis in the world at q = 0: direction (unit) and, for a revolute joint, the point
 /// of the axis nearest the world origin.
-struct Axis {
-    kind: JointKind,
-    dir: Vector3<f64>,
-    point: Vector3<f64>,
+pub(crate) struct Axis {
+    pub(crate) kind: JointKind,
+    pub(crate) dir: Vector3<f64>,
+    pub(crate) point: Vector3<f64>,
 }
 
 /// The joint axes in the world and the world pose of the tool, at q = 0. The world twist of
 /// a revolute joint is `(ω, p × ω)` for any point `p` of its axis, so `ω × v / |ω|²` is the
 /// axis point nearest the origin; a prismatic joint's twist is `(0, û)`.
-fn axes_at_zero(model: &Model, params: &[f64]) -> (Vec<Axis>, Pose<f64>) {
+pub(crate) fn axes_at_zero(model: &Model, params: &[f64]) -> (Vec<Axis>, Pose<f64>) {
     let mut data = Data::<f64>::new(model);
     forward_kinematics(model, &mut data, params, &vec![0.0; model.dof()]);
     let axes = model

@@ -47,6 +47,14 @@ pub enum Convention {
     Hayati,
     /// Craig's modified DH `Rx(α) Tx(a) Rz(θ+q) Tz(d)`.
     Mdh,
+    /// Craig's modified DH with Hayati's β for a link whose axis is (nearly) parallel to the
+    /// previous one: `Rx(α) Tx(a) Ry(β) Rz(θ+q) Tz(d)` (book §2.6). `Rx(α)` and `Ry(β)` tilt
+    /// the axis about two perpendicular directions, so a small tilt of a parallel axis never
+    /// moves a common normal far away; the previous link's `d` and this link's `d` then move
+    /// the same frame along the common direction, and the identifiability analysis keeps one.
+    /// `β = 0` is exactly [`Convention::Mdh`]. In cell files: `convention = "mdh"` with
+    /// `beta_deg`.
+    MdhBeta,
     /// Stone's S-model `Rz(β+q) Tz(r) Tx(l) Rx(α) Rz(γ) Tz(b)` (book eq. 4.304 with the
     /// `Tz(b)` the OCR lost, errata 8). Prismatic: `Tz(r+q)`.
     SModel,
@@ -82,10 +90,11 @@ pub enum Motion {
 }
 
 impl Convention {
-    pub const ALL: [Convention; 9] = [
+    pub const ALL: [Convention; 10] = [
         Convention::Dh,
         Convention::Hayati,
         Convention::Mdh,
+        Convention::MdhBeta,
         Convention::SModel,
         Convention::Frame6,
         Convention::BookType3,
@@ -99,6 +108,7 @@ impl Convention {
             Convention::Dh => "dh",
             Convention::Hayati => "hayati",
             Convention::Mdh => "mdh",
+            Convention::MdhBeta => "mdh_beta",
             Convention::SModel => "s_model",
             Convention::Frame6 => "frame6",
             Convention::BookType3 => "book_type3",
@@ -127,6 +137,13 @@ impl Convention {
             ],
             Convention::Hayati => &[("theta", Rad), ("a", Mm), ("alpha", Rad), ("beta", Rad)],
             Convention::Mdh => &[("alpha", Rad), ("a", Mm), ("theta", Rad), ("d", Mm)],
+            Convention::MdhBeta => &[
+                ("alpha", Rad),
+                ("a", Mm),
+                ("beta", Rad),
+                ("theta", Rad),
+                ("d", Mm),
+            ],
             Convention::SModel => &[
                 ("beta", Rad),
                 ("r", Mm),
@@ -201,6 +218,7 @@ impl Convention {
             Convention::Hayati if prismatic => &[(Rz, 0), (Tz, 1), (Tx, 2), (Rx, 3), (Ry, 4)],
             Convention::Hayati => &[(Rz, 0), (Tx, 1), (Rx, 2), (Ry, 3)],
             Convention::Mdh => &[(Rx, 0), (Tx, 1), (Rz, 2), (Tz, 3)],
+            Convention::MdhBeta => &[(Rx, 0), (Tx, 1), (Ry, 2), (Rz, 3), (Tz, 4)],
             Convention::SModel => &[(Rz, 0), (Tz, 1), (Tx, 2), (Rx, 3), (Rz, 4), (Tz, 5)],
             Convention::Frame6 => &[(Tx, 0), (Ty, 1), (Tz, 2), (Rz, 5), (Ry, 4), (Rx, 3)],
             Convention::BookType3 => &[(Rz, 5), (Ry, 4), (Rx, 3), (Tx, 0), (Ty, 1), (Tz, 2)],
@@ -235,6 +253,7 @@ impl Convention {
             Convention::Dh => Some(if prismatic { 1 } else { 0 }),
             Convention::Hayati => Some(if prismatic { 1 } else { 0 }),
             Convention::Mdh => Some(if prismatic { 3 } else { 2 }),
+            Convention::MdhBeta => Some(if prismatic { 4 } else { 3 }),
             Convention::SModel => Some(if prismatic { 1 } else { 0 }),
             Convention::BookType3 => Some(if prismatic { 2 } else { 5 }),
             Convention::Urdf | Convention::Zrp => Some(6),
@@ -282,6 +301,11 @@ impl LinkGeometry {
     /// Craig's modified DH `Rx(α) Tx(a) Rz(θ+q) Tz(d)`; mm and rad.
     pub fn mdh(alpha: f64, a: f64, theta: f64, d: f64) -> Self {
         Self::new(Convention::Mdh, vec![alpha, a, theta, d])
+    }
+
+    /// Modified DH with β `Rx(α) Tx(a) Ry(β) Rz(θ+q) Tz(d)`; mm and rad.
+    pub fn mdh_beta(alpha: f64, a: f64, beta: f64, theta: f64, d: f64) -> Self {
+        Self::new(Convention::MdhBeta, vec![alpha, a, beta, theta, d])
     }
 
     /// General frame from a pose (x, y, z in mm; roll, pitch, yaw in rad about x, y, z).

@@ -3,6 +3,7 @@
 
 pub mod axes;
 pub mod chain;
+pub mod complete;
 pub mod convert;
 pub mod export;
 pub mod identifiability;
@@ -10,6 +11,7 @@ pub mod jacobian;
 pub mod kinematics;
 pub mod link;
 pub mod pose;
+pub mod rank_deficit;
 pub mod registry;
 pub mod urdf;
 

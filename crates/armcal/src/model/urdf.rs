@@ -781,6 +781,7 @@ mod tests {
             Convention::Dh,
             Convention::Hayati,
             Convention::Mdh,
+            Convention::MdhBeta,
             Convention::SModel,
             Convention::BookType3,
             Convention::Urdf,

@@ -42,6 +42,49 @@ pub struct Robot {
     pub capsules: Vec<Capsule>,
 }
 
+/// `capsules`, fixed to frames of `from`, re-expressed in the same-named frames of `to`, an
+/// equivalent chain (same forward kinematics, e.g. [`crate::model::complete::in_form`]). A
+/// frame of either chain moves with the body its last joint drives, so the transform
+/// between the two frames of one name is constant; it is read at q = 0:
+/// `p_to = T_to(0)⁻¹ T_from(0) p_from`. A frame `to` does not have is an error.
+pub fn transfer_capsules(
+    from: &crate::model::Model,
+    to: &crate::model::Model,
+    capsules: &[Capsule],
+) -> Result<Vec<Capsule>, Error> {
+    use crate::model::{forward_kinematics, Data};
+    let q = vec![0.0; from.dof()];
+    let frames = |m: &crate::model::Model| {
+        let mut data = Data::new(m);
+        forward_kinematics(m, &mut data, &m.nominal(), &q);
+        data.frames
+    };
+    let (old, new) = (frames(from), frames(to));
+    capsules
+        .iter()
+        .map(|c| {
+            let missing = || {
+                Error::Model(format!(
+                    "capsule on frame `{}`: the converted chain has no frame of that name",
+                    c.frame
+                ))
+            };
+            let i = from.link_index(&c.frame).ok_or_else(missing)?;
+            let j = to.link_index(&c.frame).ok_or_else(missing)?;
+            let t = new[j].inverse().compose(&old[i]);
+            let map = |p: [f64; 3]| {
+                let v = t.transform_point(&nalgebra::Vector3::from(p));
+                [v.x, v.y, v.z]
+            };
+            Ok(Capsule {
+                a: map(c.a),
+                b: map(c.b),
+                ..c.clone()
+            })
+        })
+        .collect()
+}
+
 /// Name and summary of every built-in robot.
 pub fn list() -> Vec<(String, String)> {
     NAMES
