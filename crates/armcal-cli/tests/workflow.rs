@@ -181,26 +181,35 @@ fn compensate_export_and_accuracy() {
 fn axes_from_one_joint_sweeps() {
     let dir = scratch("axes");
     let s = |p: &Path| p.to_str().unwrap().to_string();
-    let sweeps = dir.join("sweeps.csv");
-    let (ok, _, err) = armcal(&[
-        "simulate",
-        "--cell",
-        "examples/paper-cell.toml",
-        "--poses",
-        "examples/paper-sweeps.csv",
-        "--noise-free",
-        "--out",
-        &s(&sweeps),
-    ]);
-    assert!(ok, "{err}");
-    let (ok, out, err) = armcal(&[
-        "axes",
-        "--cell",
-        "examples/paper-cell.toml",
-        "--data",
-        &s(&sweeps),
-    ]);
-    assert!(ok, "{err}");
+    // Simulates the example sweeps (noise-free or with the cell's noise) into `data` and
+    // runs `axes` on them with the `extra` options.
+    let sweep_axes = |data: &Path, noise: &[&str], extra: &[&str]| {
+        let mut sim = vec![
+            "simulate",
+            "--cell",
+            "examples/paper-cell.toml",
+            "--poses",
+            "examples/paper-sweeps.csv",
+            "--out",
+        ];
+        let data = s(data);
+        sim.push(&data);
+        sim.extend_from_slice(noise);
+        let (ok, _, err) = armcal(&sim);
+        assert!(ok, "{err}");
+        let mut args = vec![
+            "axes",
+            "--cell",
+            "examples/paper-cell.toml",
+            "--data",
+            &data,
+        ];
+        args.extend_from_slice(extra);
+        let (ok, out, err) = armcal(&args);
+        assert!(ok, "{err}");
+        (out, err)
+    };
+    let (out, err) = sweep_axes(&dir.join("sweeps.csv"), &["--noise-free"], &[]);
     // Six axes; noise-free circles fit exactly: no residual, σ's of 0, no warning.
     let column = |row: &str, from_end: usize| -> f64 {
         row.split_whitespace()
@@ -221,29 +230,8 @@ fn axes_from_one_joint_sweeps() {
     // With the cell's 1 mm tracker noise the ±30° sweeps do not fix the axes: each row
     // shows its σ's, each axis over the limits is warned about with its numbers and
     // remedies, and the JSON carries both.
-    let noisy = dir.join("noisy.csv");
     let axes_json = dir.join("axes.json");
-    let (ok, _, err) = armcal(&[
-        "simulate",
-        "--cell",
-        "examples/paper-cell.toml",
-        "--poses",
-        "examples/paper-sweeps.csv",
-        "--out",
-        &s(&noisy),
-    ]);
-    assert!(ok, "{err}");
-    let (ok, out, err) = armcal(&[
-        "axes",
-        "--cell",
-        "examples/paper-cell.toml",
-        "--data",
-        &s(&noisy),
-        "--out",
-        &s(&axes_json),
-    ]);
-    assert!(ok, "{err}");
-    eprintln!("{out}{err}");
+    let (out, err) = sweep_axes(&dir.join("noisy.csv"), &[], &["--out", &s(&axes_json)]);
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&axes_json).unwrap()).unwrap();
     for (r, j) in out

@@ -522,9 +522,12 @@ pub const MIN_NOISE_DOF: usize = 8;
 /// (revolute; a prismatic axis' location does not matter), σ̂ from fewer than
 /// [`MIN_NOISE_DOF`] degrees of freedom, a revolute sweep shorter than
 /// [`MIN_REVOLUTE_SPAN_DEG`], or a residual RMS above [`MAX_RMS_PER_RADIUS`] of the radius.
-/// It names the joint, the sweep, the σ's against their limits and the remedies, sized by
-/// the scaling of the σ's: ∝ 1/√n, ∝ 1/span² (revolute, short arc; see
-/// [`MIN_REVOLUTE_SPAN_DEG`]) or 1/span (prismatic), and for the direction ∝ 1/radius.
+/// It names the joint, the sweep, the σ's against their limits and the remedies, sized to
+/// reach the limits with the same σ̂: the sweep from the planned σ's ([`span_for_limits`]),
+/// a prismatic travel by σ ∝ 1/travel, the points by σ ∝ 1/√n (exact for repeated poses),
+/// and — when only the direction is over its limit — the target's distance from the axis by
+/// σ_dir ∝ 1/radius (exact: scaling the points by k scales the normal's columns of `J` by k
+/// and leaves the centre's and the radius' alone).
 pub fn trust_warning(a: &JointAxis) -> Option<String> {
     let revolute = a.joint.kind == JointKind::Revolute;
     let (span, unit) = if revolute {
