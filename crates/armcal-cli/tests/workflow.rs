@@ -181,33 +181,93 @@ fn compensate_export_and_accuracy() {
 fn axes_from_one_joint_sweeps() {
     let dir = scratch("axes");
     let s = |p: &Path| p.to_str().unwrap().to_string();
-    let sweeps = dir.join("sweeps.csv");
-    let (ok, _, err) = armcal(&[
-        "simulate",
-        "--cell",
-        "examples/paper-cell.toml",
-        "--poses",
-        "examples/paper-sweeps.csv",
-        "--noise-free",
-        "--out",
-        &s(&sweeps),
-    ]);
-    assert!(ok, "{err}");
-    let (ok, out, err) = armcal(&[
-        "axes",
-        "--cell",
-        "examples/paper-cell.toml",
-        "--data",
-        &s(&sweeps),
-    ]);
-    assert!(ok, "{err}");
-    // Six axes; noise-free circles fit exactly.
+    // Simulates the example sweeps (noise-free or with the cell's noise) into `data` and
+    // runs `axes` on them with the `extra` options.
+    let sweep_axes = |data: &Path, noise: &[&str], extra: &[&str]| {
+        let mut sim = vec![
+            "simulate",
+            "--cell",
+            "examples/paper-cell.toml",
+            "--poses",
+            "examples/paper-sweeps.csv",
+            "--out",
+        ];
+        let data = s(data);
+        sim.push(&data);
+        sim.extend_from_slice(noise);
+        let (ok, _, err) = armcal(&sim);
+        assert!(ok, "{err}");
+        let mut args = vec![
+            "axes",
+            "--cell",
+            "examples/paper-cell.toml",
+            "--data",
+            &data,
+        ];
+        args.extend_from_slice(extra);
+        let (ok, out, err) = armcal(&args);
+        assert!(ok, "{err}");
+        (out, err)
+    };
+    let (out, err) = sweep_axes(&dir.join("sweeps.csv"), &["--noise-free"], &[]);
+    // Six axes; noise-free circles fit exactly: no residual, σ's of 0, no warning.
+    let column = |row: &str, from_end: usize| -> f64 {
+        row.split_whitespace()
+            .rev()
+            .nth(from_end)
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    assert!(out.contains("σdir°") && out.contains("σ⊥pt mm"), "{out}");
     let rows: Vec<&str> = out.lines().filter(|l| l.starts_with('q')).collect();
     assert_eq!(rows.len(), 6, "{out}");
     for r in rows {
-        let rms: f64 = r.split_whitespace().rev().nth(2).unwrap().parse().unwrap();
-        assert!(rms < 1e-6, "{r}");
+        let (rms, sigma_dir, sigma_point) = (column(r, 4), column(r, 3), column(r, 2));
+        assert!(rms < 1e-6 && sigma_dir < 1e-6 && sigma_point < 1e-6, "{r}");
     }
+    assert!(!err.contains("not to be trusted"), "{err}");
+    // With the cell's 1 mm tracker noise the ±30° sweeps do not fix the axes: each row
+    // shows its σ's, each axis over the limits is warned about with its numbers and
+    // remedies, and the JSON carries both.
+    let axes_json = dir.join("axes.json");
+    let (out, err) = sweep_axes(&dir.join("noisy.csv"), &[], &["--out", &s(&axes_json)]);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&axes_json).unwrap()).unwrap();
+    for (r, j) in out
+        .lines()
+        .filter(|l| l.starts_with('q'))
+        .zip(json.as_array().unwrap())
+    {
+        let (sigma_dir, sigma_point) = (column(r, 3), column(r, 2));
+        let name = j["joint"].as_str().unwrap();
+        assert!(
+            (sigma_dir - j["sigma_direction_deg"].as_f64().unwrap()).abs() < 1e-3
+                && (sigma_point - j["sigma_point_mm"].as_f64().unwrap()).abs() < 1e-2,
+            "{r}"
+        );
+        // The axis lies within its σ's of the nominal one (the truth differs from it by
+        // ≈ 0.1° and 0.5 mm).
+        let (d_angle, d_line) = (column(r, 1), column(r, 0));
+        assert!(
+            d_angle < 4.0 * sigma_dir + 0.5 && d_line < 4.0 * sigma_point + 2.0,
+            "{r}"
+        );
+        if sigma_dir > 0.5 || sigma_point > 2.0 {
+            let w = j["warning"].as_str().expect("a warning");
+            let line = format!("warning: {w}");
+            assert!(err.contains(&line), "{name}: {err}");
+            // 13 points of the joint's sweep and the zero pose of each of the other five.
+            assert!(
+                w.starts_with(&format!(
+                    "{name} axis not to be trusted (18 points over 60.0°"
+                )) && w.contains(&format!("σ direction {sigma_dir:.3}°"))
+                    && w.contains("Remedy:"),
+                "{w}"
+            );
+        }
+    }
+    assert!(err.matches("warning: q").count() >= 3, "{err}");
     // Random poses move several joints at once: refused with the line named.
     let (ok, _, err) = armcal(&[
         "axes",

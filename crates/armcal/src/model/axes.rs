@@ -10,21 +10,91 @@
 //! Fits (all in the measuring instrument's frame, mm):
 //! * [`fit_plane`]: total least squares plane through the centred points (SVD, book
 //!   §4.6.2's principal axis method);
-//! * [`fit_circle`]: plane fit, then the algebraic (Kåsa) circle in the plane — linear least
-//!   squares on `x² + y² + D x + E y + F = 0` — refined by Gauss–Newton on the geometric
-//!   distances `|pᵢ − c| − r` in the plane. Kåsa alone is biased towards small radii on a
-//!   short, noisy arc; the geometric refinement removes that bias. (Stone's formulation,
-//!   book eqs. 4.284–4.290, minimises the 3-D distance to the circle with the plane and
-//!   sphere constraints; the plane-then-circle fit used here coincides with it for
-//!   noise-free points and is close to it for small noise.)
-//! * [`fit_line`]: total least squares line (first principal axis).
+//! * [`fit_circle`]: plane fit and the algebraic (Kåsa) circle in the plane — linear least
+//!   squares on `x² + y² + D x + E y + F = 0` — as the start, then Gauss–Newton on Stone's
+//!   geometric residuals (book eqs. 4.284–4.290): the 3-D distance of each point from the
+//!   circle, split into its out-of-plane part `hᵢ` and its in-plane radial part `eᵢ`, over
+//!   the centre, the normal and the radius ([`circle_residuals`]). Kåsa alone is biased
+//!   towards small radii on a short, noisy arc; the geometric refinement removes that bias.
+//! * [`fit_line`]: total least squares line (first principal axis), which minimises the
+//!   points' distances across the line.
+//!
+//! Uncertainty ([`AxisCovariance`]): both fits minimise `rᵀr` over geometric residuals `r`
+//! (two per point) whose first-order response to isotropic point noise `N(0, σ² I₃)` is the
+//! noise's components along two orthonormal directions (circle: `n` and the radial `uᵢ`;
+//! line: across the line), so `r` has covariance `σ² I`; the third component (along the
+//! circle or the line) is absorbed by the unknown position of the point on it. Linearised
+//! least squares (Seber & Wild, *Nonlinear Regression*, 1989, §2.1) then gives
+//! `Cov θ = σ̂² (JᵀJ)⁻¹` with `J = ∂r/∂θ` at the solution and `σ̂² = rᵀr / ν`,
+//! `ν = 2n − dim θ` (circle: 6 parameters, line: 4). [`identify_axes`] reports each axis'
+//! direction σ as an angle and its point σ across the axis, and warns
+//! ([`JointAxis::warning`]) when an axis is not to be trusted.
 
 use crate::model::chain::{LinkSpec, Model, ModelSpec};
 use crate::model::convert;
 use crate::model::link::{Convention, Joint, JointKind, LinkGeometry};
 use crate::model::pose::Pose;
 use crate::Error;
-use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix2, Matrix3, Vector3};
+
+/// Linearised covariance of a fitted axis (see the module documentation), expressed in the
+/// orthonormal basis `(x, y)` of the plane perpendicular to the axis direction `u`: `x` the
+/// fit's `x_axis`, `y = u × x`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AxisCovariance {
+    /// Point noise per coordinate estimated from the fit's residuals, `σ̂ = √(rᵀr / ν)`, mm.
+    pub sigma_noise: f64,
+    /// Degrees of freedom `ν` of σ̂: `2n − 6` for a circle, `2n − 4` for a line (n points).
+    pub dof: usize,
+    /// Covariance of the direction's small rotation `δu = a x + b y`: of `(a, b)`, rad².
+    pub direction: Matrix2<f64>,
+    /// Covariance of the axis point's displacement across the axis, `(x·δp, y·δp)`, mm²
+    /// (along the axis the point is not defined).
+    pub point: Matrix2<f64>,
+}
+
+impl AxisCovariance {
+    /// From the residuals `r` and Jacobian `j` at a least-squares solution whose parameters
+    /// start with the direction's `(a, b)`, and the 2 × p map `point` from the parameters to
+    /// the point's displacement across the axis: `C = σ̂² (jᵀj)⁻¹`, direction block
+    /// `C[0..2, 0..2]`, point `point · C · pointᵀ`. `None` with no degrees of freedom left
+    /// (an exact fit: σ̂ unknown) or a singular `jᵀj`.
+    fn from_least_squares(
+        j: &DMatrix<f64>,
+        r: &DVector<f64>,
+        point: &DMatrix<f64>,
+    ) -> Option<Self> {
+        let dof = r.len().checked_sub(j.ncols()).filter(|&d| d > 0)?;
+        Self::from_jacobian(j, point, (r.norm_squared() / dof as f64).sqrt(), dof)
+    }
+
+    /// As [`Self::from_least_squares`] with a given σ and ν.
+    fn from_jacobian(
+        j: &DMatrix<f64>,
+        point: &DMatrix<f64>,
+        sigma: f64,
+        dof: usize,
+    ) -> Option<Self> {
+        let c = j.tr_mul(j).cholesky()?.inverse() * (sigma * sigma);
+        let p = point * &c * point.transpose();
+        Some(AxisCovariance {
+            sigma_noise: sigma,
+            dof,
+            direction: c.fixed_view::<2, 2>(0, 0).into_owned(),
+            point: Matrix2::new(p[(0, 0)], p[(0, 1)], p[(1, 0)], p[(1, 1)]),
+        })
+    }
+
+    /// RMS angle between the fitted and the true direction, `√tr C_dir`, rad.
+    pub fn sigma_direction(&self) -> f64 {
+        self.direction.trace().sqrt()
+    }
+
+    /// RMS distance of the fitted point from the true axis, `√tr C_point`, mm.
+    pub fn sigma_point(&self) -> f64 {
+        self.point.trace().sqrt()
+    }
+}
 
 /// A circle in space.
 #[derive(Clone, Debug, PartialEq)]
@@ -36,6 +106,27 @@ pub struct Circle {
     pub radius: f64,
     /// RMS distance of the points from the circle (in-plane and out-of-plane parts), mm.
     pub rms: f64,
+    /// Unit vector in the circle's plane from the centre towards the first point.
+    pub x_axis: Vector3<f64>,
+    /// Linearised covariance of the normal and the centre (basis `x_axis`,
+    /// `normal × x_axis`); `None` for 3 points, which a circle fits exactly.
+    pub covariance: Option<AxisCovariance>,
+}
+
+/// A line in space.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Line {
+    /// Unit direction, from the first point towards the last.
+    pub direction: Vector3<f64>,
+    /// The centroid of the points.
+    pub point: Vector3<f64>,
+    /// RMS distance of the points from the line, mm.
+    pub rms: f64,
+    /// A unit vector perpendicular to `direction`.
+    pub x_axis: Vector3<f64>,
+    /// Linearised covariance of the direction and the point (basis `x_axis`,
+    /// `direction × x_axis`); `None` for 2 points, which a line fits exactly.
+    pub covariance: Option<AxisCovariance>,
 }
 
 /// Centroid and right singular vectors of the centred points, with singular values in
@@ -89,27 +180,121 @@ pub fn fit_plane(points: &[Vector3<f64>]) -> Result<(Vector3<f64>, Vector3<f64>,
     Ok((axes[2], centroid, s[2] / (points.len() as f64).sqrt()))
 }
 
-/// Total least squares line: `(unit direction, point, rms distance)`. The point is the
-/// centroid; the direction is oriented from the first point towards the last. Needs at
-/// least 2 distinct points.
-pub fn fit_line(points: &[Vector3<f64>]) -> Result<(Vector3<f64>, Vector3<f64>, f64), Error> {
+/// The orthonormal basis `(x, y = u × x)` across the unit vector `u`, `x` the part of `v`
+/// perpendicular to `u`, normalised.
+fn basis_across(u: &Vector3<f64>, v: &Vector3<f64>) -> [Vector3<f64>; 2] {
+    let x = (v - u * u.dot(v)).normalize();
+    [x, u.cross(&x)]
+}
+
+/// Total least squares line (the point is the centroid; the direction is oriented from the
+/// first point towards the last) with its covariance. Needs at least 2 distinct points.
+///
+/// Covariance: parameters `θ = (a, b, v₁, v₂)` move the direction to `(d + a x + b y)/|…|`
+/// and the point to `p + v₁ x + v₂ y`; the residuals of point i are its offsets across the
+/// line, `(x·(pᵢ − p), y·(pᵢ − p))`, in the basis carried along with the direction
+/// (`x → x − a d` to first order), so with `sᵢ = d·(pᵢ − p)` their rows of `J` are
+/// `(−sᵢ, 0, −1, 0)` and `(0, −sᵢ, 0, −1)`. As `Σ sᵢ = 0` at the centroid this gives
+/// `C_dir = σ̂² / Σ sᵢ² · I₂` and `C_point = σ̂² / n · I₂`, `ν = 2n − 4`.
+pub fn fit_line(points: &[Vector3<f64>]) -> Result<Line, Error> {
     check_finite(points, 2, "a line fit")?;
     let (centroid, axes, s) = principal_axes(points);
     if s[0] <= 0.0 {
         return Err(Error::Input("a line fit needs two distinct points".into()));
     }
+    let n = points.len();
     let mut d = axes[0];
-    if d.dot(&(points[points.len() - 1] - points[0])) < 0.0 {
+    if d.dot(&(points[n - 1] - points[0])) < 0.0 {
         d = -d;
     }
-    let rms = (s[1] * s[1] + s[2] * s[2]).sqrt() / (points.len() as f64).sqrt();
-    Ok((d, centroid, rms))
+    let basis = basis_across(&d, &any_perpendicular(&d));
+    let mut r = DVector::zeros(2 * n);
+    let mut j = DMatrix::zeros(2 * n, 4);
+    for (i, p) in points.iter().enumerate() {
+        let q = p - centroid;
+        for k in 0..2 {
+            r[2 * i + k] = basis[k].dot(&q);
+            j[(2 * i + k, k)] = -d.dot(&q);
+            j[(2 * i + k, 2 + k)] = -1.0;
+        }
+    }
+    let mut point = DMatrix::zeros(2, 4);
+    point[(0, 2)] = 1.0;
+    point[(1, 3)] = 1.0;
+    Ok(Line {
+        direction: d,
+        point: centroid,
+        rms: (s[1] * s[1] + s[2] * s[2]).sqrt() / (n as f64).sqrt(),
+        x_axis: basis[0],
+        covariance: AxisCovariance::from_least_squares(&j, &r, &point),
+    })
 }
 
+/// Stone's geometric residuals of the points from the circle `(c, n, r)` and their
+/// Jacobian. Residuals `[h₁, e₁, h₂, e₂, …]` with `dᵢ = pᵢ − c`, `hᵢ = n·dᵢ` (out of plane)
+/// and `eᵢ = |wᵢ| − r`, `wᵢ = dᵢ − n hᵢ` (in plane), so `hᵢ² + eᵢ²` is the squared distance
+/// of `pᵢ` from the circle. The Jacobian is with respect to `θ = (a, b, c, r)`, the normal
+/// moving as `n(a, b) = (n + a x + b y)/|n + a x + b y|` with `(x, y) = basis` across `n`
+/// (so `∂n/∂a = x`, `∂n/∂b = y` at `a = b = 0`), and with `uᵢ = wᵢ/|wᵢ|`:
+///
+/// `∂h/∂(a, b) = (x·d, y·d)`, `∂h/∂c = −nᵀ`, `∂h/∂r = 0`;
+/// `∂e/∂(a, b) = −h (u·x, u·y)`, `∂e/∂c = −uᵀ`, `∂e/∂r = −1`
+///
+/// (from `∂w/∂a = −x h − n (x·d)` and `∂w/∂c = −(I − n nᵀ)`, `u ⊥ n`). A point on the axis
+/// (`w = 0`) gets `u = 0`.
+pub fn circle_residuals(
+    points: &[Vector3<f64>],
+    c: &Vector3<f64>,
+    n: &Vector3<f64>,
+    r: f64,
+    basis: &[Vector3<f64>; 2],
+) -> (DVector<f64>, DMatrix<f64>) {
+    let mut res = DVector::zeros(2 * points.len());
+    let mut jac = DMatrix::zeros(2 * points.len(), 6);
+    for (i, p) in points.iter().enumerate() {
+        let d = p - c;
+        let h = n.dot(&d);
+        let w = d - n * h;
+        let rho = w.norm();
+        let u = if rho > 0.0 { w / rho } else { Vector3::zeros() };
+        res[2 * i] = h;
+        res[2 * i + 1] = rho - r;
+        for k in 0..2 {
+            jac[(2 * i, k)] = basis[k].dot(&d);
+            jac[(2 * i + 1, k)] = -h * u.dot(&basis[k]);
+        }
+        for k in 0..3 {
+            jac[(2 * i, 2 + k)] = -n[k];
+            jac[(2 * i + 1, 2 + k)] = -u[k];
+        }
+        jac[(2 * i + 1, 5)] = -1.0;
+    }
+    (res, jac)
+}
+
+/// The circle moved by the step `θ = (a, b, δc, δr)` of [`circle_residuals`].
+fn circle_step(
+    c: &Vector3<f64>,
+    n: &Vector3<f64>,
+    r: f64,
+    basis: &[Vector3<f64>; 2],
+    step: &DVector<f64>,
+) -> (Vector3<f64>, Vector3<f64>, f64) {
+    (
+        c + Vector3::new(step[2], step[3], step[4]),
+        (n + basis[0] * step[0] + basis[1] * step[1]).normalize(),
+        r + step[5],
+    )
+}
+
+/// Most Gauss–Newton steps of the geometric circle fit.
+const CIRCLE_ITERATIONS: usize = 50;
+
 /// Circle through points in space: plane fit, algebraic (Kåsa) circle in the plane, then
-/// at most 20 Gauss–Newton steps on the in-plane geometric distance (see the module
-/// documentation). The normal is oriented so that consecutive points turn positively about
-/// it. Needs at least 3 points that are not collinear.
+/// Gauss–Newton on Stone's geometric residuals ([`circle_residuals`]) with step halving,
+/// and the linearised covariance there (see the module documentation). The normal is
+/// oriented so that consecutive points turn positively about it. Needs at least 3 points
+/// that are not collinear.
 pub fn fit_circle(points: &[Vector3<f64>]) -> Result<Circle, Error> {
     check_finite(points, 3, "a circle fit")?;
     let n = points.len();
@@ -119,7 +304,7 @@ pub fn fit_circle(points: &[Vector3<f64>]) -> Result<Circle, Error> {
             "a circle fit needs points that are not collinear".into(),
         ));
     }
-    let (e1, e2, mut normal) = (axes[0], axes[1], axes[2]);
+    let (e1, e2) = (axes[0], axes[1]);
     let xy: Vec<(f64, f64)> = points
         .iter()
         .map(|p| {
@@ -138,39 +323,42 @@ pub fn fit_circle(points: &[Vector3<f64>]) -> Result<Circle, Error> {
         .svd(true, true)
         .solve(&b, 1e-14)
         .map_err(|e| Error::Input(format!("circle fit: {e}")))?;
-    let (mut cx, mut cy) = (-sol[0] / 2.0, -sol[1] / 2.0);
+    let (cx, cy) = (-sol[0] / 2.0, -sol[1] / 2.0);
     let r2 = cx * cx + cy * cy - sol[2];
     if !(r2 > 0.0 && r2.is_finite()) {
         return Err(Error::Input(
             "circle fit: the points do not lie near a circle".into(),
         ));
     }
-    let mut r = r2.sqrt();
-    // Gauss–Newton on dᵢ = |(xᵢ, yᵢ) − c| − r.
-    for _ in 0..20 {
-        let mut jtj = Matrix3::zeros();
-        let mut jtd = Vector3::zeros();
-        for &(x, y) in &xy {
-            let (dx, dy) = (x - cx, y - cy);
-            let rho = (dx * dx + dy * dy).sqrt();
-            if rho == 0.0 {
-                continue;
-            }
-            let j = Vector3::new(-dx / rho, -dy / rho, -1.0);
-            jtj += j * j.transpose();
-            jtd += j * (rho - r);
-        }
-        let Some(step) = jtj.cholesky().map(|c| c.solve(&(-jtd))) else {
+    let (mut centre, mut normal, mut r) = (centroid + e1 * cx + e2 * cy, axes[2], r2.sqrt());
+    let mut basis = [e1, e2];
+    for _ in 0..CIRCLE_ITERATIONS {
+        let (res, jac) = circle_residuals(points, &centre, &normal, r, &basis);
+        let Some(chol) = jac.tr_mul(&jac).cholesky() else {
             break;
         };
-        cx += step[0];
-        cy += step[1];
-        r += step[2];
-        if step.norm() <= 1e-15 * (r + cx.abs() + cy.abs()) {
+        let mut step = chol.solve(&(-jac.tr_mul(&res)));
+        let ss = res.norm_squared();
+        let accepted = loop {
+            let (c, u, rr) = circle_step(&centre, &normal, r, &basis, &step);
+            if circle_residuals(points, &c, &u, rr, &basis)
+                .0
+                .norm_squared()
+                <= ss
+            {
+                (centre, normal, r) = (c, u, rr);
+                break true;
+            }
+            step /= 2.0;
+            if step.norm() <= 1e-15 * (r + centre.norm()) {
+                break false;
+            }
+        };
+        basis = basis_across(&normal, &basis[0]);
+        if !accepted || step.norm() <= 1e-15 * (r + centre.norm()) {
             break;
         }
     }
-    let centre = centroid + e1 * cx + e2 * cy;
     let turn: Vector3<f64> = points
         .windows(2)
         .map(|w| (w[0] - centre).cross(&(w[1] - centre)))
@@ -178,21 +366,77 @@ pub fn fit_circle(points: &[Vector3<f64>]) -> Result<Circle, Error> {
     if turn.dot(&normal) < 0.0 {
         normal = -normal;
     }
-    let ss: f64 = points
-        .iter()
-        .map(|p| {
-            let d = p - centre;
-            let h = d.dot(&normal);
-            let rho = (d - normal * h).norm();
-            h * h + (rho - r) * (rho - r)
-        })
-        .sum();
+    let basis = basis_across(&normal, &(points[0] - centre));
+    let (res, jac) = circle_residuals(points, &centre, &normal, r, &basis);
     Ok(Circle {
         centre,
         normal,
         radius: r,
-        rms: (ss / n as f64).sqrt(),
+        rms: (res.norm_squared() / n as f64).sqrt(),
+        x_axis: basis[0],
+        covariance: AxisCovariance::from_least_squares(&jac, &res, &circle_point_map(&basis)),
     })
+}
+
+/// The map from the circle parameters `(a, b, c, r)` of [`circle_residuals`] to the centre's
+/// displacement across the axis, `(x·δc, y·δc)`.
+fn circle_point_map(basis: &[Vector3<f64>; 2]) -> DMatrix<f64> {
+    DMatrix::from_fn(2, 6, |i, j| match j {
+        2..=4 => basis[i][j - 2],
+        _ => 0.0,
+    })
+}
+
+/// Linearised covariance of [`fit_circle`] for a planned sweep: `n` points evenly spread
+/// over `span` (rad) of a circle of radius `r`, noise σ per coordinate — `σ² (JᵀJ)⁻¹` at the
+/// noise-free points (frame-invariant, so computed for the circle about z at the origin).
+pub fn planned_circle_covariance(
+    r: f64,
+    n: usize,
+    span: f64,
+    sigma: f64,
+) -> Option<AxisCovariance> {
+    let points: Vec<Vector3<f64>> = (0..n)
+        .map(|i| {
+            let t = span * i as f64 / (n.max(2) - 1) as f64;
+            Vector3::new(r * t.cos(), r * t.sin(), 0.0)
+        })
+        .collect();
+    let basis = [Vector3::x(), Vector3::y()];
+    let (_, jac) = circle_residuals(&points, &Vector3::zeros(), &Vector3::z(), r, &basis);
+    AxisCovariance::from_jacobian(
+        &jac,
+        &circle_point_map(&basis),
+        sigma,
+        (2 * n).saturating_sub(6),
+    )
+}
+
+/// The shortest sweep (rad, at most a full turn) of `n` evenly spread points at radius `r`
+/// and noise σ whose planned σ's ([`planned_circle_covariance`]) are within
+/// [`MAX_SIGMA_DIRECTION_DEG`] and [`MAX_SIGMA_POINT_MM`]; `None` if not even a full turn
+/// reaches them. Bisection to 0.1°, the σ's falling with the span.
+pub fn span_for_limits(r: f64, n: usize, sigma: f64) -> Option<f64> {
+    let within = |span: f64| {
+        planned_circle_covariance(r, n, span, sigma).is_some_and(|c| {
+            c.sigma_direction() <= MAX_SIGMA_DIRECTION_DEG.to_radians()
+                && c.sigma_point() <= MAX_SIGMA_POINT_MM
+        })
+    };
+    let full = 2.0 * std::f64::consts::PI * (n.max(2) - 1) as f64 / n.max(2) as f64;
+    if !within(full) {
+        return None;
+    }
+    let (mut lo, mut hi) = (0.0, full);
+    while hi - lo > 0.1f64.to_radians() {
+        let mid = 0.5 * (lo + hi);
+        if within(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Some(hi)
 }
 
 /// Measurements of one joint's motion: full joint vectors in which only `joint` varies,
@@ -229,6 +473,16 @@ pub struct JointAxis {
     /// The joint vector of the sweep with the swept joint set to 0: the configuration the
     /// axis belongs to.
     pub reference: Vec<f64>,
+    /// Number of points of the sweep.
+    pub points: usize,
+    /// Range of the swept joint's values (largest − smallest), rad or mm.
+    pub span: f64,
+    /// Linearised covariance of `direction` and `point` in the basis (`x_axis`,
+    /// `direction × x_axis`); `None` for an exact fit (3 points on a circle, 2 on a line).
+    pub covariance: Option<AxisCovariance>,
+    /// Why the axis is not to be trusted, how badly, and what to do ([`trust_warning`]);
+    /// `None` for a trustworthy axis.
+    pub warning: Option<String>,
 }
 
 /// The axes of all joints, in joint order.
@@ -236,6 +490,158 @@ pub struct JointAxis {
 pub struct AxesResult {
     pub model: String,
     pub axes: Vec<JointAxis>,
+}
+
+impl AxesResult {
+    /// The warnings of the axes not to be trusted, in joint order.
+    pub fn warnings(&self) -> impl Iterator<Item = &str> {
+        self.axes.iter().filter_map(|a| a.warning.as_deref())
+    }
+}
+
+/// A revolute sweep shorter than this (deg) gets a warning even when its σ's are small: the
+/// axis then rests on the arc's sagitta `r (1 − cos(span/2))` (3.4 % of the radius at 30°),
+/// and its σ's grow like 1/span² (the points' spread across the chord, which fixes the
+/// plane's tilt and the centre, is ≈ 0.15 r θ² √n for a half-span θ), so a systematic point
+/// error `e` that the residuals do not show (a target mount's eccentricity, a wobbling
+/// joint) tilts the axis by ≈ e / sagitta rad, unseen by the σ's.
+pub const MIN_REVOLUTE_SPAN_DEG: f64 = 30.0;
+/// Largest RMS direction error of a trustworthy axis, deg (9 mm at 1 m).
+pub const MAX_SIGMA_DIRECTION_DEG: f64 = 0.5;
+/// Largest RMS error of a trustworthy revolute axis' position across the axis, mm.
+pub const MAX_SIGMA_POINT_MM: f64 = 2.0;
+/// Largest residual RMS per radius of a trustworthy revolute axis: above it the target is
+/// too close to the axis for the noise.
+pub const MAX_RMS_PER_RADIUS: f64 = 0.01;
+/// Fewest degrees of freedom of σ̂ for a trustworthy σ: σ̂²ν/σ² is χ²(ν), so σ̂ is uncertain
+/// by ≈ ±1/√(2ν) (±25 % at ν = 8).
+pub const MIN_NOISE_DOF: usize = 8;
+
+/// The warning for an axis not to be trusted, or `None`: an exact fit (no σ), a σ of the
+/// direction above [`MAX_SIGMA_DIRECTION_DEG`] or of the point above [`MAX_SIGMA_POINT_MM`]
+/// (revolute; a prismatic axis' location does not matter), σ̂ from fewer than
+/// [`MIN_NOISE_DOF`] degrees of freedom, a revolute sweep shorter than
+/// [`MIN_REVOLUTE_SPAN_DEG`], or a residual RMS above [`MAX_RMS_PER_RADIUS`] of the radius.
+/// It names the joint, the sweep, the σ's against their limits and the remedies, sized to
+/// reach the limits with the same σ̂: the sweep from the planned σ's ([`span_for_limits`]),
+/// a prismatic travel by σ ∝ 1/travel, the points by σ ∝ 1/√n (exact for repeated poses),
+/// and — when only the direction is over its limit — the target's distance from the axis by
+/// σ_dir ∝ 1/radius (exact: scaling the points by k scales the normal's columns of `J` by k
+/// and leaves the centre's and the radius' alone).
+pub fn trust_warning(a: &JointAxis) -> Option<String> {
+    let revolute = a.joint.kind == JointKind::Revolute;
+    let (span, unit) = if revolute {
+        (a.span.to_degrees(), "°")
+    } else {
+        (a.span, " mm")
+    };
+    let (params, what) = if revolute { (6, "circle") } else { (4, "line") };
+    // Points for ν = 2n − params ≥ MIN_NOISE_DOF.
+    let min_points = (MIN_NOISE_DOF + params).div_ceil(2);
+    let mut problems = Vec::new();
+    let mut fixes = Vec::new();
+    let mut sigmas = String::new();
+    match &a.covariance {
+        None => {
+            problems.push(format!(
+                "{} points fit a {what} exactly, so neither the noise nor the σ's can be estimated",
+                a.points
+            ));
+            fixes.push(format!("measure at least {min_points} points"));
+        }
+        Some(cov) => {
+            let sd = cov.sigma_direction().to_degrees();
+            let sp = cov.sigma_point();
+            sigmas = format!(", σ direction {sd:.3}°");
+            if revolute {
+                sigmas += &format!(", σ point across the axis {sp:.3} mm");
+            }
+            let k_dir = sd / MAX_SIGMA_DIRECTION_DEG;
+            let k_point = if revolute {
+                sp / MAX_SIGMA_POINT_MM
+            } else {
+                0.0
+            };
+            if k_dir > 1.0 {
+                problems.push(format!(
+                    "σ direction {sd:.3}° is {k_dir:.1} × the limit {MAX_SIGMA_DIRECTION_DEG}°"
+                ));
+            }
+            if k_point > 1.0 {
+                problems.push(format!(
+                    "σ point {sp:.3} mm is {k_point:.1} × the limit {MAX_SIGMA_POINT_MM} mm"
+                ));
+            }
+            let k = k_dir.max(k_point);
+            if k > 1.0 {
+                let mut ways = vec![
+                    if !revolute {
+                        format!("a travel of about {:.0} mm (σ ∝ 1/travel)", span * k)
+                    } else if let Some(s) = span_for_limits(a.radius, a.points, cov.sigma_noise) {
+                        format!(
+                            "a sweep of {:.0}° with as many points",
+                            s.to_degrees().ceil()
+                        )
+                    } else {
+                        "(not even a full turn with as many points)".into()
+                    },
+                    format!(
+                        "about {:.0} points (σ ∝ 1/√n)",
+                        (a.points as f64 * k * k).ceil()
+                    ),
+                ];
+                if revolute && k_point <= 1.0 {
+                    ways.push(format!(
+                        "a target about {:.0} mm from the axis (σ direction ∝ 1/radius)",
+                        a.radius * k_dir
+                    ));
+                }
+                fixes.push(format!("to reach the limits: {}", ways.join(", or ")));
+            }
+            if cov.dof < MIN_NOISE_DOF {
+                problems.push(format!(
+                    "σ̂ = {:.3} mm rests on {} degrees of freedom (±{:.0} %)",
+                    cov.sigma_noise,
+                    cov.dof,
+                    100.0 / (2.0 * cov.dof as f64).sqrt()
+                ));
+                fixes.push(format!("measure at least {min_points} points"));
+            }
+        }
+    }
+    if revolute && span < MIN_REVOLUTE_SPAN_DEG {
+        let sagitta = a.radius * (1.0 - (a.span / 2.0).cos());
+        problems.push(format!(
+            "the sweep is shorter than {MIN_REVOLUTE_SPAN_DEG}°: the axis rests on the arc's \
+             {sagitta:.2} mm sagitta, so a systematic point error of e mm that the residuals do \
+             not show tilts it by about e/{sagitta:.2} rad"
+        ));
+        fixes.push(format!("sweep at least {MIN_REVOLUTE_SPAN_DEG}°"));
+    }
+    if revolute && a.rms > MAX_RMS_PER_RADIUS * a.radius {
+        problems.push(format!(
+            "the residual RMS is {:.1} % of the radius (limit {:.0} %)",
+            100.0 * a.rms / a.radius,
+            100.0 * MAX_RMS_PER_RADIUS
+        ));
+        fixes.push("put the target farther from the axis".into());
+    }
+    if problems.is_empty() {
+        return None;
+    }
+    let radius = if revolute {
+        format!(", radius {:.1} mm", a.radius)
+    } else {
+        String::new()
+    };
+    Some(format!(
+        "{} axis not to be trusted ({} points over {span:.1}{unit}{radius}, residual RMS {:.3} mm{sigmas}): {}. Remedy: {}.",
+        a.joint.name,
+        a.points,
+        a.rms,
+        problems.join("; "),
+        fixes.join("; ")
+    ))
 }
 
 /// Identifies every joint axis of `model` from one sweep per joint (circle point analysis,
@@ -248,6 +654,9 @@ pub struct AxesResult {
 /// For a zero-reference model ([`axes_to_zrp`]) every joint must be swept with all others
 /// at 0; sweeps made in the book's sequential way (joints j+1… at arbitrary values) still
 /// give correct axes here, but only those with the others at 0 build a zero-reference model.
+///
+/// Each axis carries the linearised covariance of its fit ([`AxisCovariance`]) and, if it
+/// is not to be trusted, a warning ([`trust_warning`]).
 ///
 /// Errors: a joint not swept or swept twice, mismatched lengths, a joint vector of the
 /// wrong size, another joint that moves during a sweep, or a degenerate fit.
@@ -314,6 +723,7 @@ pub fn identify_axes(model: &Model, sweeps: &[JointSweep]) -> Result<AxesResult,
             .filter(|w| s.q[w[0]][s.joint] != s.q[w[1]][s.joint])
             .count()
             + 1;
+        let span = s.q[order[order.len() - 1]][s.joint] - s.q[order[0]][s.joint];
         let joint = model.joints[s.joint].clone();
         let link = model
             .links
@@ -329,16 +739,19 @@ pub fn identify_axes(model: &Model, sweeps: &[JointSweep]) -> Result<AxesResult,
                     )));
                 }
                 let c = fit_circle(&pts).map_err(|e| Error::Input(format!("{what}: {e}")))?;
-                let d = pts[0] - c.centre;
                 JointAxis {
                     link,
                     joint,
-                    x_axis: (d - c.normal * d.dot(&c.normal)).normalize(),
+                    x_axis: c.x_axis,
                     direction: c.normal,
                     point: c.centre,
                     radius: c.radius,
                     rms: c.rms,
                     reference,
+                    points: pts.len(),
+                    span,
+                    covariance: c.covariance,
+                    warning: None,
                 }
             }
             JointKind::Prismatic => {
@@ -347,21 +760,25 @@ pub fn identify_axes(model: &Model, sweeps: &[JointSweep]) -> Result<AxesResult,
                         "{what}: a prismatic joint needs at least 2 distinct joint values"
                     )));
                 }
-                let (d, p, rms) =
-                    fit_line(&pts).map_err(|e| Error::Input(format!("{what}: {e}")))?;
+                let l = fit_line(&pts).map_err(|e| Error::Input(format!("{what}: {e}")))?;
                 JointAxis {
                     link,
                     joint,
-                    x_axis: any_perpendicular(&d),
-                    direction: d,
-                    point: p,
+                    x_axis: l.x_axis,
+                    direction: l.direction,
+                    point: l.point,
                     radius: 0.0,
-                    rms,
+                    rms: l.rms,
                     reference,
+                    points: pts.len(),
+                    span,
+                    covariance: l.covariance,
+                    warning: None,
                 }
             }
         };
-        found[s.joint] = Some(axis);
+        let warning = trust_warning(&axis);
+        found[s.joint] = Some(JointAxis { warning, ..axis });
     }
     let axes = found
         .into_iter()
@@ -559,16 +976,23 @@ mod tests {
         Model::from_spec(&spec).unwrap()
     }
 
-    /// Sweeps every joint over ±30° (clamped to its limits) in 15 steps, others at 0.
-    fn sweeps(model: &Model, truth: &[f64], sigma: f64, seed: u64) -> Vec<JointSweep> {
+    /// Sweeps every joint over ±`half_span` (deg, clamped to its limits) in 15 steps, others
+    /// at 0.
+    fn sweeps(
+        model: &Model,
+        truth: &[f64],
+        half_span: f64,
+        sigma: f64,
+        seed: u64,
+    ) -> Vec<JointSweep> {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let normal = Normal::new(0.0, 1.0).unwrap();
         let mut data = Data::<f64>::new(model);
         let (lo, hi) = model.joint_limits();
         (0..model.dof())
             .map(|j| {
-                let a = lo[j].max(-30f64.to_radians());
-                let b = hi[j].min(30f64.to_radians());
+                let a = lo[j].max(-half_span.to_radians());
+                let b = hi[j].min(half_span.to_radians());
                 let mut s = JointSweep {
                     joint: j,
                     q: vec![],
@@ -646,7 +1070,7 @@ mod tests {
     fn noise_free_axes_are_exact_and_rebuild_the_robot() {
         let model = paper_with_target();
         let truth = truth(&model);
-        let result = identify_axes(&model, &sweeps(&model, &truth, 0.0, 1)).unwrap();
+        let result = identify_axes(&model, &sweeps(&model, &truth, 30.0, 0.0, 1)).unwrap();
         let t = true_axes(&model, &truth);
         for (a, t) in result.axes.iter().zip(&t) {
             let (angle, dist) = axis_errors(a, t);
@@ -684,7 +1108,7 @@ mod tests {
         let model = paper_with_target();
         let truth = truth(&model);
         let sigma = 0.01;
-        let sw = sweeps(&model, &truth, sigma, 2);
+        let sw = sweeps(&model, &truth, 30.0, sigma, 2);
         let result = identify_axes(&model, &sw).unwrap();
         let t = true_axes(&model, &truth);
         for ((a, t), s) in result.axes.iter().zip(&t).zip(&sw) {
@@ -713,6 +1137,241 @@ mod tests {
         }
     }
 
+    /// `n` points with noise σ per coordinate on an arc of `span` (rad, starting at angle
+    /// `start`) of the circle (centre, normal, radius) = (c, z, r) of a frame tilted
+    /// arbitrarily, evenly spaced.
+    fn noisy_arc(
+        r: f64,
+        span: f64,
+        n: usize,
+        sigma: f64,
+        rng: &mut ChaCha8Rng,
+    ) -> (Vec<Vector3<f64>>, Vector3<f64>, Vector3<f64>) {
+        let rot = nalgebra::Rotation3::from_euler_angles(0.4, -0.7, 1.1);
+        let c = Vector3::new(120.0, -340.0, 910.0);
+        let normal = rot * Vector3::z();
+        let noise = Normal::new(0.0, 1.0).unwrap();
+        let pts = (0..n)
+            .map(|i| {
+                let t = 0.3 + span * i as f64 / (n - 1) as f64;
+                c + rot * Vector3::new(r * t.cos(), r * t.sin(), 0.0)
+                    + Vector3::from_fn(|_, _| sigma * noise.sample(rng))
+            })
+            .collect();
+        (pts, c, normal)
+    }
+
+    #[test]
+    fn circle_jacobian_matches_finite_differences() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        // Noisy points and a circle off the optimum, so that h ≠ 0 and the coupling terms
+        // −h (u·x, u·y) count.
+        let (pts, c, n) = noisy_arc(200.0, 1.5, 9, 3.0, &mut rng);
+        let c = c + Vector3::new(4.0, -2.0, 3.0);
+        let n = (n + Vector3::new(0.05, 0.02, -0.03)).normalize();
+        let r = 190.0;
+        let basis = basis_across(&n, &Vector3::new(0.3, 1.0, -0.2));
+        let (_, jac) = circle_residuals(&pts, &c, &n, r, &basis);
+        let h = 1e-6;
+        let mut worst = 0.0f64;
+        for k in 0..6 {
+            let mut step = DVector::zeros(6);
+            step[k] = h;
+            let (cp, np, rp) = circle_step(&c, &n, r, &basis, &step);
+            let (cm, nm, rm) = circle_step(&c, &n, r, &basis, &(-step));
+            let fd = (circle_residuals(&pts, &cp, &np, rp, &basis).0
+                - circle_residuals(&pts, &cm, &nm, rm, &basis).0)
+                / (2.0 * h);
+            let err = (fd - jac.column(k)).amax() / jac.column(k).amax();
+            worst = worst.max(err);
+            assert!(err < 1e-6, "column {k}: relative error {err:.2e}");
+        }
+        eprintln!("circle Jacobian vs central differences: worst relative error {worst:.2e}");
+    }
+
+    /// Predicted σ over the Monte Carlo spread, for (RMS angle, RMS distance across the
+    /// axis, and the direction's σ along the major and the minor axis of its covariance).
+    /// `fit` returns a fitted (direction, point, x_axis, covariance); the prediction is the
+    /// mean of the runs' covariances (each with its own σ̂), turned from each fit's basis
+    /// (x_axis, direction × x_axis) into one across the true direction `u`; the truth is the
+    /// spread of the errors about the true axis (u, p) there.
+    fn monte_carlo_ratios(
+        runs: usize,
+        fit: impl Fn(&mut ChaCha8Rng) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>, AxisCovariance),
+        (u, p): (Vector3<f64>, Vector3<f64>),
+        seed: u64,
+    ) -> [f64; 4] {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let b = basis_across(&u, &any_perpendicular(&u));
+        let mut sums = [Matrix2::<f64>::zeros(); 4];
+        for _ in 0..runs {
+            let (d, q, x, cov) = fit(&mut rng);
+            let fb = basis_across(&d, &x);
+            let rot = Matrix2::from_fn(|i, j| b[i].dot(&fb[j]));
+            let e = nalgebra::Vector2::new(b[0].dot(&d), b[1].dot(&d));
+            let f = nalgebra::Vector2::new(b[0].dot(&(q - p)), b[1].dot(&(q - p)));
+            sums[0] += e * e.transpose();
+            sums[1] += f * f.transpose();
+            sums[2] += rot * cov.direction * rot.transpose();
+            sums[3] += rot * cov.point * rot.transpose();
+        }
+        let [dir, point, pred_dir, pred_point] = sums.map(|m| m / runs as f64);
+        let eig = pred_dir.symmetric_eigen();
+        let along = |c: &Matrix2<f64>, k: usize| {
+            let v = eig.eigenvectors.column(k);
+            (v.transpose() * c * v)[(0, 0)].sqrt()
+        };
+        [
+            (pred_dir.trace() / dir.trace()).sqrt(),
+            (pred_point.trace() / point.trace()).sqrt(),
+            along(&pred_dir, 0) / along(&dir, 0),
+            along(&pred_dir, 1) / along(&dir, 1),
+        ]
+    }
+
+    #[test]
+    fn circle_axis_sigma_matches_monte_carlo() {
+        // (radius mm, span deg, points, σ mm): a clean medium sweep, 1 mm noise on a short
+        // and on a medium sweep.
+        for (r, span, n, sigma) in [
+            (250.0, 90.0f64, 15, 0.05),
+            (300.0, 24.0, 13, 1.0),
+            (800.0, 40.0, 13, 1.0),
+        ] {
+            let mut rng = ChaCha8Rng::seed_from_u64(5);
+            let (_, c, normal) = noisy_arc(r, span.to_radians(), n, 0.0, &mut rng);
+            let fit = |rng: &mut ChaCha8Rng| {
+                let (pts, _, _) = noisy_arc(r, span.to_radians(), n, sigma, rng);
+                let f = fit_circle(&pts).unwrap();
+                (f.normal, f.centre, f.x_axis, f.covariance.unwrap())
+            };
+            let ratios = monte_carlo_ratios(400, fit, (normal, c), 9);
+            eprintln!(
+                "circle r {r} mm, {span}°, {n} points, σ {sigma} mm: predicted/MC σ direction \
+                 {:.3}, point {:.3}, major {:.3}, minor {:.3}",
+                ratios[0], ratios[1], ratios[2], ratios[3]
+            );
+            for (k, q) in ratios.iter().enumerate() {
+                assert!((0.8..1.2).contains(q), "ratio {k}: {q}");
+            }
+        }
+    }
+
+    #[test]
+    fn suggested_span_reaches_the_limits() {
+        let (r, n, sigma) = (300.0, 13, 1.0);
+        let span = span_for_limits(r, n, sigma).unwrap();
+        // The warning's sweep, made with the same noise: the RMS errors of the axes fitted
+        // to it meet the tighter of the two limits.
+        let mut rng = ChaCha8Rng::seed_from_u64(8);
+        let (_, c, normal) = noisy_arc(r, span, n, 0.0, &mut rng);
+        let (mut angle2, mut dist2) = (0.0, 0.0);
+        let runs = 300;
+        for _ in 0..runs {
+            let f = fit_circle(&noisy_arc(r, span, n, sigma, &mut rng).0).unwrap();
+            angle2 += f.normal.angle(&normal).powi(2);
+            dist2 += (f.centre - c).cross(&normal).norm_squared();
+        }
+        let k_dir = (angle2 / runs as f64).sqrt().to_degrees() / MAX_SIGMA_DIRECTION_DEG;
+        let k_point = (dist2 / runs as f64).sqrt() / MAX_SIGMA_POINT_MM;
+        eprintln!(
+            "r {r} mm, {n} points, σ {sigma} mm: sweep {:.1}° gives σ direction {k_dir:.3} and σ \
+             point {k_point:.3} × their limits (Monte Carlo)",
+            span.to_degrees()
+        );
+        assert!(
+            (0.85..1.1).contains(&k_dir.max(k_point)),
+            "{k_dir} {k_point}"
+        );
+        // Shorter sweeps do not reach them; a full turn at 50 mm noise does not either.
+        let planned = planned_circle_covariance(r, n, 0.95 * span, sigma).unwrap();
+        assert!(
+            planned.sigma_direction().to_degrees() > MAX_SIGMA_DIRECTION_DEG
+                || planned.sigma_point() > MAX_SIGMA_POINT_MM
+        );
+        assert!(span_for_limits(r, n, 50.0).is_none());
+    }
+
+    #[test]
+    fn line_axis_sigma_matches_monte_carlo() {
+        let u = Vector3::new(0.3, -0.5, 0.8).normalize();
+        let p = Vector3::new(400.0, 20.0, -150.0);
+        let noise = Normal::new(0.0, 1.0).unwrap();
+        let fit = |rng: &mut ChaCha8Rng| {
+            let pts: Vec<_> = (0..10)
+                .map(|i| {
+                    p + u * (-100.0 + 20.0 * i as f64)
+                        + Vector3::from_fn(|_, _| 0.2 * noise.sample(rng))
+                })
+                .collect();
+            let l = fit_line(&pts).unwrap();
+            (l.direction, l.point, l.x_axis, l.covariance.unwrap())
+        };
+        let ratios = monte_carlo_ratios(400, fit, (u, p), 4);
+        eprintln!("line 180 mm, 10 points, σ 0.2 mm: predicted/MC {ratios:.3?}");
+        for (k, q) in ratios.iter().enumerate() {
+            assert!((0.8..1.2).contains(q), "ratio {k}: {q}");
+        }
+    }
+
+    #[test]
+    fn untrustworthy_axes_are_warned_about() {
+        let model = paper_with_target();
+        let truth = truth(&model);
+        // A long clean sweep: every axis trusted, with small σ's.
+        let clean = identify_axes(&model, &sweeps(&model, &truth, 60.0, 0.01, 3)).unwrap();
+        for a in &clean.axes {
+            let cov = a.covariance.as_ref().unwrap();
+            eprintln!(
+                "±60°, σ 0.01 mm {}: σ direction {:.4}°, σ point {:.4} mm, σ̂ {:.4} mm",
+                a.link,
+                cov.sigma_direction().to_degrees(),
+                cov.sigma_point(),
+                cov.sigma_noise
+            );
+            assert!(a.warning.is_none(), "{:?}", a.warning);
+        }
+        assert_eq!(clean.warnings().count(), 0);
+        // σ = 1 mm on ±12°: every axis warned about, with its numbers and remedies.
+        let noisy = identify_axes(&model, &sweeps(&model, &truth, 12.0, 1.0, 3)).unwrap();
+        let t = true_axes(&model, &truth);
+        for (a, t) in noisy.axes.iter().zip(&t) {
+            let w = a.warning.as_deref().expect("a warning");
+            eprintln!("{w}");
+            let cov = a.covariance.as_ref().unwrap();
+            let sd = cov.sigma_direction().to_degrees();
+            assert!(sd > MAX_SIGMA_DIRECTION_DEG, "{}: {sd}", a.link);
+            assert!(w.starts_with(&a.joint.name), "{w}");
+            for needle in [
+                "over 24.0°",
+                &format!("σ direction {sd:.3}°"),
+                "shorter than 30°",
+                "a sweep of ",
+                "° with as many points",
+                "points (σ ∝ 1/√n)",
+            ] {
+                assert!(w.contains(needle), "{needle}: {w}");
+            }
+            // The σ's say how far off the axis is: the actual error is within 4 σ.
+            let (angle, dist) = axis_errors(a, t);
+            assert!(angle < 4.0 * cov.sigma_direction(), "{}: {angle}", a.link);
+            assert!(dist < 4.0 * cov.sigma_point(), "{}: {dist}", a.link);
+        }
+        // Three points: an exact fit, no σ, a warning asking for more points.
+        let mut few = sweeps(&model, &truth, 30.0, 0.01, 3);
+        for s in &mut few {
+            s.q.truncate(3);
+            s.points.truncate(3);
+        }
+        let r = identify_axes(&model, &few).unwrap();
+        let w = r.axes[0].warning.as_deref().unwrap();
+        assert!(r.axes[0].covariance.is_none());
+        assert!(
+            w.contains("fit a circle exactly") && w.contains("at least 7 points"),
+            "{w}"
+        );
+    }
+
     #[test]
     fn circle_sign_follows_point_order() {
         let pts: Vec<Vector3<f64>> = (0..5)
@@ -730,8 +1389,8 @@ mod tests {
         assert!(fit_circle(&pts[..2]).is_err());
         let line: Vec<_> = (0..4).map(|i| Vector3::new(i as f64, 0.0, 0.0)).collect();
         assert!(fit_circle(&line).is_err());
-        let (d, _, rms) = fit_line(&line).unwrap();
-        assert!((d - Vector3::x()).norm() < 1e-12 && rms < 1e-12);
+        let l = fit_line(&line).unwrap();
+        assert!((l.direction - Vector3::x()).norm() < 1e-12 && l.rms < 1e-12);
         let (n, c, rms) = fit_plane(&pts).unwrap();
         assert!(n.cross(&Vector3::z()).norm() < 1e-12 && (c.z - 3.0).abs() < 1e-12);
         assert!(rms < 1e-12);
