@@ -154,7 +154,12 @@ pub struct Estimate {
     pub tcp_constrained: Vec<Matrix3<f64>>,
     pub observability: Observability,
     pub residuals: ResidualReport,
+    /// Measurements a robust fit left out (of the χ² test and C_p too).
     pub outliers: Vec<Outlier>,
+    /// Free angles more than 90° from nominal that no equivalent parameter set brings
+    /// closer (the estimate is reported in the equivalent set nearest the nominal).
+    #[serde(default)]
+    pub far_from_nominal: Vec<crate::model::branch::FarAngle>,
     pub robust_scale: Option<f64>,
     pub validation: Option<Validation>,
     pub measurements: usize,
@@ -375,8 +380,11 @@ pub fn identify(
     let mut problem = Problem::new(model, &train, &noise)?;
     let start = frames_first_start(model, &train, &noise, opts)?;
     let (sol, outliers, robust_scale) = solve(&mut problem, &start, opts, observer)?;
+    let branch = crate::model::branch::nearest_branch(model, &sol.params);
+    let sol = sol.in_branch(&branch, &problem.free);
     let names = problem.free_names();
-    // Covariance from the unweighted whitened Jacobian (robust weights only pick data).
+    // Covariance from the unweighted whitened Jacobian of the kept measurements (robust
+    // weights only pick data).
     let unc = uncertainty::parameter_uncertainty(&sol.jacobian, &sol.residual, &names)?;
     let working: Vec<Vec<f64>> = cell.working.iter().map(|w| w.q.clone()).collect();
     let wnames: Vec<String> = cell.working.iter().map(|w| w.name.clone()).collect();
@@ -391,8 +399,8 @@ pub fn identify(
             .collect();
         (cs, blocks)
     };
-    let observability =
-        uncertainty::observability(&sol.jacobian.rows(0, problem.data_rows()).into_owned());
+    let data_rows = sol.jacobian.nrows() - problem.priors.len();
+    let observability = uncertainty::observability(&sol.jacobian.rows(0, data_rows).into_owned());
     let residuals = residual_report(&problem, &sol.params);
     let validation = if test_idx.is_empty() {
         None
@@ -450,6 +458,7 @@ pub fn identify(
         observability,
         residuals,
         outliers,
+        far_from_nominal: branch.far,
         robust_scale,
         validation,
         measurements: train.measurements.len(),
