@@ -56,7 +56,11 @@ impl Solution {
     /// kinematics, so the same residual). The map has the diagonal Jacobian `S = diag(±1)`,
     /// so the Jacobian becomes `J S` (the columns of negated parameters change sign) and the
     /// covariance `(S JᵀJ S)⁻¹ = S C_p S`. `free`: the parameter of each column.
-    pub fn in_branch(mut self, branch: &crate::model::branch::NearestBranch, free: &[usize]) -> Solution {
+    pub fn in_branch(
+        mut self,
+        branch: &crate::model::branch::NearestBranch,
+        free: &[usize],
+    ) -> Solution {
         for (c, &i) in free.iter().enumerate() {
             if branch.signs[i] < 0.0 {
                 self.jacobian.column_mut(c).neg_mut();

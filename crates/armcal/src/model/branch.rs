@@ -70,12 +70,22 @@ fn maps(convention: Convention, kind: Option<JointKind>) -> Maps {
         },
         Convention::Hayati if prismatic => Maps {
             absorb: Some((THETA_ABSORB, false)),
-            split: Some(&[(0, 1.0, -PI), (2, -1.0, 0.0), (3, -1.0, 0.0), (4, -1.0, 0.0)]),
+            split: Some(&[
+                (0, 1.0, -PI),
+                (2, -1.0, 0.0),
+                (3, -1.0, 0.0),
+                (4, -1.0, 0.0),
+            ]),
             within: None,
         },
         Convention::Hayati => Maps {
             absorb: Some((THETA_ABSORB, false)),
-            split: Some(&[(0, 1.0, -PI), (1, -1.0, 0.0), (2, -1.0, 0.0), (3, -1.0, 0.0)]),
+            split: Some(&[
+                (0, 1.0, -PI),
+                (1, -1.0, 0.0),
+                (2, -1.0, 0.0),
+                (3, -1.0, 0.0),
+            ]),
             within: None,
         },
         Convention::Mdh => Maps {
@@ -478,7 +488,10 @@ mod tests {
                     })
                     .collect();
                 let (dt, dr) = max_pose_difference(&m, &p, &turned, &mut r);
-                assert!(dt < 1e-9 && dr < 1e-12, "{c:?} {k:?} turns: {dt:e} mm, {dr:e}");
+                assert!(
+                    dt < 1e-9 && dr < 1e-12,
+                    "{c:?} {k:?} turns: {dt:e} mm, {dr:e}"
+                );
             }
         }
     }
@@ -500,10 +513,13 @@ mod tests {
 
     /// Equal up to whole turns of the angles.
     fn same(m: &Model, a: &[f64], b: &[f64]) -> bool {
-        m.registry.iter().zip(a.iter().zip(b)).all(|(p, (x, y))| match p.unit {
-            Unit::Rad => wrap(x - y).abs() < 1e-12,
-            _ => (x - y).abs() < 1e-12 * (1.0 + y.abs()),
-        })
+        m.registry
+            .iter()
+            .zip(a.iter().zip(b))
+            .all(|(p, (x, y))| match p.unit {
+                Unit::Rad => wrap(x - y).abs() < 1e-12,
+                _ => (x - y).abs() < 1e-12 * (1.0 + y.abs()),
+            })
     }
 
     fn index(m: &Model, name: &str) -> usize {
@@ -543,7 +559,11 @@ mod tests {
             assert!(b.far.is_empty(), "{:?}", b.far);
             let flipped = ["j3.a", "j3.alpha", "j2.a", "j2.alpha", "j2.beta"];
             for (i, par) in m.registry.iter().enumerate() {
-                let expect = if flipped.contains(&par.name.as_str()) { -1.0 } else { 1.0 };
+                let expect = if flipped.contains(&par.name.as_str()) {
+                    -1.0
+                } else {
+                    1.0
+                };
                 assert_eq!(b.signs[i], expect, "{}", par.name);
             }
         }
@@ -560,7 +580,11 @@ mod tests {
         let b = nearest_branch(&m, &off);
         assert_eq!(b.far.len(), 1, "{:?}", b.far);
         assert_eq!(b.far[0].name, "j3.theta");
-        assert!(b.far[0].reason.contains("no exactly equivalent"), "{}", b.far[0].reason);
+        assert!(
+            b.far[0].reason.contains("no exactly equivalent"),
+            "{}",
+            b.far[0].reason
+        );
         assert!(same(&m, &b.params, &off));
 
         // A robot whose joint 4 is turned by 180°, fitted as j3 flipped with j4.theta at
@@ -581,9 +605,16 @@ mod tests {
         m.registry.set_status(t4, Status::Fixed);
         m.registry.set_status(t5, Status::Fixed);
         let b = nearest_branch(&m, &flipped);
-        assert!(same(&m, &b.params, &flipped), "a fixed parameter must not change");
+        assert!(
+            same(&m, &b.params, &flipped),
+            "a fixed parameter must not change"
+        );
         let names: Vec<&str> = b.far.iter().map(|f| f.name.as_str()).collect();
         assert_eq!(names, ["j3.theta", "j3.alpha"], "{:?}", b.far);
-        assert!(b.far[0].reason.contains("`j4.theta`"), "{}", b.far[0].reason);
+        assert!(
+            b.far[0].reason.contains("`j4.theta`"),
+            "{}",
+            b.far[0].reason
+        );
     }
 }
