@@ -110,6 +110,23 @@ pub fn print_summary(e: &Estimate) {
         "\nvariance factor σ̂₀² = {:.3} (χ² = {:.1}, {} dof, p = {:.3}): {}",
         u.variance_factor, u.chi2, u.dof, u.p_value, u.verdict
     );
+    if !e.outliers.is_empty() {
+        println!(
+            "  on the {} measurements kept; the {} outliers are left out of χ² and C_p",
+            e.measurements - e.outliers.len(),
+            e.outliers.len()
+        );
+    }
+    for f in &e.far_from_nominal {
+        println!(
+            "warning: {} = {:.3} deg is {:.1} deg from nominal {:.3} deg: {}",
+            f.name,
+            f.estimate_deg,
+            (f.estimate_deg - f.nominal_deg).abs(),
+            f.nominal_deg,
+            f.reason
+        );
+    }
     let r = &e.residuals;
     println!("residuals (mm)      RMS        max        p95");
     for (n, s) in [("x", &r.x), ("y", &r.y), ("z", &r.z), ("|e|", &r.norm)] {

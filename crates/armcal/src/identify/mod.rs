@@ -160,7 +160,12 @@ pub struct Estimate {
     pub tcp_constrained: Vec<Matrix3<f64>>,
     pub observability: Observability,
     pub residuals: ResidualReport,
+    /// Measurements a robust fit left out (of the χ² test and C_p too).
     pub outliers: Vec<Outlier>,
+    /// Free angles more than 90° from nominal that no equivalent parameter set brings
+    /// closer (the estimate is reported in the equivalent set nearest the nominal).
+    #[serde(default)]
+    pub far_from_nominal: Vec<crate::model::branch::FarAngle>,
     pub robust_scale: Option<f64>,
     pub validation: Option<Validation>,
     pub measurements: usize,
@@ -405,6 +410,8 @@ pub fn identify(
     let (sol, outliers, robust_scale) = (fit.solution, fit.outliers, fit.robust_scale);
     let mut problem = Problem::new(model, &train, &noise)?;
     problem.row_weights = fit.row_weights;
+    let branch = crate::model::branch::nearest_branch(model, &sol.params);
+    let sol = sol.in_branch(&branch, &problem.free);
     let names = problem.free_names();
     let rank_deficit = if cell.auto_free {
         let declared = cell.declared_model();
@@ -418,7 +425,8 @@ pub fn identify(
     } else {
         None
     };
-    // Covariance from the unweighted whitened Jacobian (robust weights only pick data).
+    // Covariance from the unweighted whitened Jacobian of the kept measurements (robust
+    // weights only pick data).
     let unc = uncertainty::parameter_uncertainty(&sol.jacobian, &sol.residual, &names)?;
     let working: Vec<Vec<f64>> = cell.working.iter().map(|w| w.q.clone()).collect();
     let wnames: Vec<String> = cell.working.iter().map(|w| w.name.clone()).collect();
@@ -433,8 +441,8 @@ pub fn identify(
             .collect();
         (cs, blocks)
     };
-    let observability =
-        uncertainty::observability(&sol.jacobian.rows(0, problem.data_rows()).into_owned());
+    let data_rows = sol.jacobian.nrows() - problem.priors.len();
+    let observability = uncertainty::observability(&sol.jacobian.rows(0, data_rows).into_owned());
     let residuals = residual_report(&problem, &sol.params);
     let validation = if test_idx.is_empty() {
         None
@@ -493,6 +501,7 @@ pub fn identify(
         observability,
         residuals,
         outliers,
+        far_from_nominal: branch.far,
         robust_scale,
         validation,
         measurements: train.measurements.len(),

@@ -3,12 +3,15 @@
 //! scale `s = 1.4826 · median(e)` (MAD), Huber `w = min(1, k/e)` (k = 1.345) or Cauchy
 //! `w = 1/(1 + (e/c)²)` (c = 2.385); Levenberg–Marquardt with fixed weights; repeat until
 //! the weights settle. Blocks whose `‖r_i‖²/s²` exceeds the χ²(rows) 99.9 % quantile are
-//! reported as outliers.
+//! reported as outliers. The solution's residual and Jacobian are then those of the kept
+//! measurements, unweighted (outlier rows removed): the variance factor and χ² test of a
+//! robust fit are computed on the data it kept, with m − n = kept rows − free parameters.
 
 use super::lm::{levenberg_marquardt, LmSettings};
 use super::problem::Problem;
 use super::solver::{Observer, Solution};
 use crate::Error;
+use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 
@@ -62,6 +65,8 @@ pub struct Outlier {
 }
 
 pub struct RobustSolution {
+    /// The final fit; its residual and Jacobian are those of the kept measurements with
+    /// weight 1 (the rows of the outliers removed, prior rows kept).
     pub solution: Solution,
     pub outliers: Vec<Outlier>,
     /// Robust scale of the whitened residuals at the end (≈ 1 if σ is right).
@@ -147,10 +152,31 @@ pub fn robust_fit(
             });
         }
     }
+    (sol.residual, sol.jacobian) = kept_rows(problem, &sol.params, &outliers);
     Ok(RobustSolution {
         solution: sol,
         outliers,
         scale,
         reweightings,
     })
+}
+
+/// Unweighted whitened residual and Jacobian at `params` without the rows of `outliers`.
+fn kept_rows(
+    problem: &mut Problem,
+    params: &[f64],
+    outliers: &[Outlier],
+) -> (DVector<f64>, DMatrix<f64>) {
+    let ones = vec![1.0; problem.data_rows()];
+    let weights = std::mem::replace(&mut problem.row_weights, ones);
+    let (r, j) = problem.residual_and_jacobian(params);
+    problem.row_weights = weights;
+    let mut dropped = vec![false; problem.rows()];
+    for o in outliers {
+        let row = problem.row_of[o.measurement];
+        let k = problem.data.measurements[o.measurement].kind.rows();
+        dropped[row..row + k].fill(true);
+    }
+    let keep: Vec<usize> = (0..problem.rows()).filter(|&i| !dropped[i]).collect();
+    (r.select_rows(&keep), j.select_rows(&keep))
 }

@@ -51,6 +51,24 @@ impl Solution {
     pub fn cost(&self) -> f64 {
         0.5 * self.residual.norm_squared()
     }
+
+    /// The same solution in the equivalent parameters `branch` (identical forward
+    /// kinematics, so the same residual). The map has the diagonal Jacobian `S = diag(±1)`,
+    /// so the Jacobian becomes `J S` (the columns of negated parameters change sign) and the
+    /// covariance `(S JᵀJ S)⁻¹ = S C_p S`. `free`: the parameter of each column.
+    pub fn in_branch(
+        mut self,
+        branch: &crate::model::branch::NearestBranch,
+        free: &[usize],
+    ) -> Solution {
+        for (c, &i) in free.iter().enumerate() {
+            if branch.signs[i] < 0.0 {
+                self.jacobian.column_mut(c).neg_mut();
+            }
+        }
+        self.params.clone_from(&branch.params);
+        self
+    }
 }
 
 /// Receives progress from solvers (argmin / clarabel style): no solver prints.

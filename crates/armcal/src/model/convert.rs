@@ -259,7 +259,7 @@ pub fn to_zrp(model: &Model, params: &[f64]) -> ModelSpec {
 }
 
 /// `a` wrapped into (−π, π].
-fn wrap(a: f64) -> f64 {
+pub(crate) fn wrap(a: f64) -> f64 {
     let w = (a + PI).rem_euclid(2.0 * PI) - PI;
     if w == -PI {
         PI

@@ -121,8 +121,28 @@ pub fn estimate_section(id: &str, label: &str, e: &Estimate) -> Result<Section, 
     if let Some(scale) = e.robust_scale {
         rows.push((
             "robust scale",
-            format!("{} ({} outliers flagged)", number(scale), e.outliers.len()),
+            format!(
+                "{} ({} outliers flagged, left out of χ² and C_p)",
+                number(scale),
+                e.outliers.len()
+            ),
         ));
+    }
+    if !e.far_from_nominal.is_empty() {
+        let list: Vec<String> = e
+            .far_from_nominal
+            .iter()
+            .map(|f| {
+                format!(
+                    "{} = {}° (nominal {}°): {}",
+                    f.name,
+                    fixed(f.estimate_deg, 3),
+                    fixed(f.nominal_deg, 3),
+                    f.reason
+                )
+            })
+            .collect();
+        rows.push(("angles far from nominal", escape(&list.join("; "))));
     }
     s.html(facts(&rows));
 
