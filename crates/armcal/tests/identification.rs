@@ -197,6 +197,21 @@ fn every_method_from_an_unplaced_tracker_reaches_lms_estimate_on_precise_data() 
         let data = simulate(&cell.model, &truth, &qs, Some(&noise), 3).unwrap();
         let est = every_method(&cell, &data);
         let lm = &est[0];
+        // Gauss–Newton without the frames-first start: converged only at LM's cost.
+        let (model, _) = identifiable_model(&cell, &data).unwrap();
+        let mut problem = Problem::new(&model, &data, &noise).unwrap();
+        let opts = IdentifyOptions {
+            method: Method::GaussNewton,
+            ..Default::default()
+        };
+        let (gn, _, _) = solve(&mut problem, &model.nominal(), &opts, &mut Silent).unwrap();
+        let lm_cost = 0.5 * lm.uncertainty.chi2;
+        assert!(
+            !gn.status.is_converged() || gn.cost() <= lm_cost * (1.0 + 1e-9),
+            "frames only {frames_only}: GN from the nominal {} at cost {} (LM {lm_cost})",
+            gn.status,
+            gn.cost()
+        );
         for other in &est[1..] {
             for (a, b) in lm.parameters.iter().zip(&other.parameters) {
                 if let Some(sigma) = a.sigma {
