@@ -73,7 +73,7 @@ fn gauss_newton_kalman_and_lm_agree_on_noisy_data() {
             model.registry.get(i).name
         );
         assert!(
-            (lm[i] - kf[i]).abs() < 1e-4 * sol_sigma[c],
+            (lm[i] - kf[i]).abs() < 1e-6 * sol_sigma[c],
             "Kalman {}",
             model.registry.get(i).name
         );

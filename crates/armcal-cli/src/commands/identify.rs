@@ -161,7 +161,17 @@ pub fn print_summary(e: &Estimate) {
             "\nheld-out validation: {} configurations (fit on {}): {}",
             v.test_configurations, v.train_configurations, v.test_data
         );
-        println!("  validation pose ids: {}", v.test_ids.join(", "));
+        const SHOWN: usize = 12;
+        let more = v.test_ids.len().saturating_sub(SHOWN);
+        println!(
+            "  validation pose ids: {}{} (both sides: `validation` in the estimate)",
+            v.test_ids[..v.test_ids.len() - more].join(", "),
+            if more > 0 {
+                format!(", … and {more} more")
+            } else {
+                String::new()
+            }
+        );
         println!("  model                     mean       RMS       max       p95   (mm)");
         for (n, s) in [
             ("nominal", &v.nominal),
