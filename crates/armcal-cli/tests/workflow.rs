@@ -448,3 +448,72 @@ fn report_from_identify_and_plan_files() {
     }
     assert!(!dir.join("r2").join("report.html").exists());
 }
+
+#[test]
+fn identify_validates_on_a_test_file_and_checks_the_holdout_flag() {
+    let dir = scratch("test-file");
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let (data, test, est) = (
+        s(&dir.join("data.csv")),
+        dir.join("test.csv"),
+        s(&dir.join("est.json")),
+    );
+    let test_s = s(&test);
+    assert!(armcal(&simulate_paper_cell("4", &data)).0);
+    // Same robot (seed), other poses: the joint sweeps.
+    let mut sweeps = simulate_paper_cell("4", &test_s);
+    sweeps[4] = "examples/paper-sweeps.csv";
+    let (ok, _, err) = armcal(&sweeps);
+    assert!(ok, "{err}");
+    // The user's own test file, with its own pose ids.
+    let renamed: String = std::fs::read_to_string(&test)
+        .unwrap()
+        .lines()
+        .enumerate()
+        .map(|(k, l)| {
+            if k == 0 {
+                format!("{l}\n")
+            } else {
+                format!("T{l}\n")
+            }
+        })
+        .collect();
+    std::fs::write(&test, renamed).unwrap();
+    let (ok, out, err) = armcal(&identify_paper_cell(&data, &["--test", &test_s], &est));
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("held-out validation: 78 configurations (fit on 60)"),
+        "{out}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&est).unwrap()).unwrap();
+    let v = &json["validation"];
+    assert!(
+        v["test_data"].as_str().unwrap().ends_with("test.csv"),
+        "{v}"
+    );
+    assert_eq!(v["test_ids"][0], "T1");
+    assert_eq!(v["train_ids"][0], "1");
+    assert!(v["calibrated"]["rms"].as_f64().unwrap() < v["nominal"]["rms"].as_f64().unwrap());
+    // A fraction and a test file together, and fractions outside [0, 1), name the flag.
+    let (ok, _, err) = armcal(&identify_paper_cell(
+        &data,
+        &["--holdout", "0.3", "--test", &test_s, "--force"],
+        &est,
+    ));
+    assert!(
+        !ok && err.contains("--holdout") && err.contains("--test"),
+        "{err}"
+    );
+    for h in ["NaN", "-0.1", "1.0"] {
+        let (ok, _, err) = armcal(&identify_paper_cell(
+            &data,
+            &["--holdout", h, "--force"],
+            &est,
+        ));
+        assert!(
+            !ok && err.contains("--holdout") && err.contains("[0, 1)"),
+            "{h}: {err}"
+        );
+    }
+}

@@ -59,9 +59,9 @@ fn robust_variance_factor_uses_the_kept_measurements() {
 /// The fit `identify` ran before mapping: the same steps without the branch choice.
 fn unmapped(cell: &Cell, data: &Dataset, opts: &IdentifyOptions) -> (Model, Solution, Vec<f64>) {
     let noise = cell.instrument.as_ref().unwrap().noise.clone();
-    let (model, _) = identifiable_model(cell, data).unwrap();
+    let start = frames_first_start(&cell.declared_model(), data, &noise, opts).unwrap();
+    let (model, _) = identifiable_model(cell, data, &start).unwrap();
     let mut problem = Problem::new(&model, data, &noise).unwrap();
-    let start = frames_first_start(&model, data, &noise, opts).unwrap();
     let (sol, _, _) = solve(&mut problem, &start, opts, &mut Silent).unwrap();
     let weights = problem.row_weights.clone();
     (model, sol, weights)

@@ -13,9 +13,12 @@ pub struct Args {
     /// Data file (CSV).
     #[arg(long)]
     pub data: PathBuf,
-    /// Fraction of configurations held out for validation.
-    #[arg(long, default_value_t = 0.0)]
+    /// Fraction of configurations held out at random for validation, in [0, 1).
+    #[arg(long, default_value_t = 0.0, value_parser = holdout_fraction, allow_negative_numbers = true)]
     pub holdout: f64,
+    /// Validate on this data file of the same cell instead (the whole --data is fitted).
+    #[arg(long, conflicts_with = "holdout")]
+    pub test: Option<PathBuf>,
     /// Robust estimation (IRLS) with this loss.
     #[arg(long, value_parser = ["huber", "cauchy"])]
     pub robust: Option<String>,
@@ -36,10 +39,12 @@ pub struct Args {
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let cell = load_cell(&a.cell)?;
     let data = load_data(&cell, &a.data)?;
+    let test = a.test.as_deref().map(|t| load_data(&cell, t)).transpose()?;
     let opts = IdentifyOptions {
         method: Method::from_name(&a.method).expect("clap checked"),
         robust: a.robust.as_deref().and_then(Loss::from_name),
         holdout: a.holdout,
+        test,
         seed: a.seed,
         ..Default::default()
     };
@@ -57,6 +62,17 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// `--holdout`: a fraction in [0, 1).
+fn holdout_fraction(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(h) if (0.0..1.0).contains(&h) => Ok(h),
+        Ok(h) => Err(format!(
+            "{h} is not a fraction in [0, 1) (0: no held-out validation)"
+        )),
+        Err(e) => Err(format!("not a number: {e}")),
+    }
 }
 
 /// The human-readable summary of an estimate.
@@ -162,8 +178,19 @@ pub fn print_summary(e: &Estimate) {
     }
     if let Some(v) = &e.validation {
         println!(
-            "\nheld-out validation: {} configurations (fit on {})",
-            v.test_configurations, v.train_configurations
+            "\nheld-out validation: {} configurations (fit on {}): {}",
+            v.test_configurations, v.train_configurations, v.test_data
+        );
+        const SHOWN: usize = 12;
+        let more = v.test_ids.len().saturating_sub(SHOWN);
+        println!(
+            "  validation pose ids: {}{} (both sides: `validation` in the estimate)",
+            v.test_ids[..v.test_ids.len() - more].join(", "),
+            if more > 0 {
+                format!(", … and {more} more")
+            } else {
+                String::new()
+            }
         );
         println!("  model                     mean       RMS       max       p95   (mm)");
         for (n, s) in [

@@ -7,7 +7,9 @@
 //! explicit criteria and an observer, which are a few lines here.
 
 use super::problem::Problem;
-use super::solver::{gradient_cosine, Iterate, Observer, Solution, Status, Tolerances};
+use super::solver::{
+    gradient_cosine, no_decrease_status, Iterate, Observer, Solution, Status, Tolerances,
+};
 use crate::Error;
 use nalgebra::DVector;
 use std::time::Instant;
@@ -121,17 +123,12 @@ pub fn levenberg_marquardt(
         }
         if !accepted {
             // No step reduces the cost: at a minimum to machine precision, or stuck.
-            status = if gradient_cosine(&it.j, &it.r) < 1e-6 {
-                Status::Converged {
-                    criterion: "no further decrease possible (at machine precision)".into(),
-                }
-            } else {
-                Status::Diverged {
-                    reason: format!(
-                        "no step reduces the cost (damping μ = {mu:.1e}); the start may be too far from a solution or the model may not fit the data"
-                    ),
-                }
-            };
+            status = no_decrease_status(
+                &it,
+                format!(
+                    "no step reduces the cost (damping μ = {mu:.1e}); the start may be too far from a solution or the model may not fit the data"
+                ),
+            );
             break;
         }
         if status.is_converged() {

@@ -55,8 +55,11 @@ impl Method {
 pub struct IdentifyOptions {
     pub method: Method,
     pub robust: Option<Loss>,
-    /// Fraction of configurations held out for validation (0: none).
+    /// Fraction of configurations held out for validation, in [0, 1) (0: none).
     pub holdout: f64,
+    /// Validation data of the same cell (the user's own held-out file): the whole `data`
+    /// is fitted and validated on these configurations. Excludes `holdout`.
+    pub test: Option<Dataset>,
     pub seed: u64,
     pub lm: LmSettings,
 }
@@ -67,6 +70,7 @@ impl Default for IdentifyOptions {
             method: Method::Lm,
             robust: None,
             holdout: 0.0,
+            test: None,
             seed: 1,
             lm: LmSettings::default(),
         }
@@ -113,7 +117,8 @@ pub struct ResidualReport {
 /// One measurement's residual, `model − measured` (mm; the robust weights undone).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct MeasurementResidual {
-    /// Configuration number in the fitted data (1-based) and its `pose_id`.
+    /// The configuration's number in the data file (1-based, in the file's order, also
+    /// when part of the file was held out) and its `pose_id` in the file.
     pub pose: usize,
     pub pose_id: String,
     /// Position residual x, y, z (mm); `None` for distance and plane measurements.
@@ -125,11 +130,22 @@ pub struct MeasurementResidual {
 /// Held-out validation (position error on configurations not used in the fit, mm).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Validation {
+    /// What the fit was validated on: a held-out fraction of the data file, or the user's
+    /// test data file.
+    #[serde(default)]
+    pub test_data: String,
     pub train_configurations: usize,
     pub test_configurations: usize,
+    /// The `pose_id`s of the fitted configurations (data file) and of the validation
+    /// configurations (data file, or the test file), in file order.
+    #[serde(default)]
+    pub train_ids: Vec<String>,
+    #[serde(default)]
+    pub test_ids: Vec<String>,
     /// Nominal model, nothing fitted.
     pub nominal: ErrorStats,
-    /// Nominal robot with only the base, tool, instrument and target frames fitted.
+    /// Nominal robot with only the base, tool, instrument and target frames fitted (for a
+    /// cell whose only free parameters are frames: the calibration itself).
     pub frames_only: ErrorStats,
     /// Full calibration.
     pub calibrated: ErrorStats,
@@ -224,12 +240,14 @@ pub fn identifiable_model(
     Ok((declared, reasons))
 }
 
-/// Starting point of the full fit: the nominal robot with the instrument, target, base and
-/// tool frames fitted first (a two-stage fit), by LM whatever the final solver. A tracker
-/// placed only roughly in the cell, or not at all, and a target whose offset is unknown are
-/// then no obstacle for the full calibration. The frames fitted are those of `model`'s free
-/// set that these data identify at the nominal (base and instrument, tool and target
-/// overlap); with no free frame parameter the start is the nominal.
+/// Starting point of the full fit, the same for every method: the nominal robot with the
+/// instrument, target, base and tool frames fitted first by Levenberg–Marquardt (a
+/// two-stage fit; robust if `opts.robust`). A tracker placed only roughly in the cell, or
+/// not at all, and a target whose offset is unknown are then no obstacle for the full
+/// calibration. The frames fitted are those of `model`'s free set that these data identify
+/// at the nominal (base and instrument, tool and target overlap); with no free frame
+/// parameter the start is the nominal. When the free parameters are only frames this stage
+/// is the whole fit, and the chosen method refines it.
 pub fn frames_first_start(
     model: &Model,
     data: &Dataset,
@@ -256,9 +274,10 @@ pub fn frames_first_start(
         return Ok(model.nominal());
     }
     let stage = IdentifyOptions {
-        robust: opts.robust,
         method: Method::Lm,
-        ..opts.clone()
+        robust: opts.robust,
+        lm: opts.lm.clone(),
+        ..Default::default()
     };
     let (sol, _, _) = solve(&mut problem, &model.nominal(), &stage, &mut Silent)?;
     Ok(sol.params)
@@ -334,7 +353,97 @@ pub fn holdout_split(n: usize, fraction: f64, seed: u64) -> (Vec<usize>, Vec<usi
     (train, test)
 }
 
-fn residual_report(problem: &Problem, params: &[f64]) -> ResidualReport {
+/// The data a fit uses and the data it is validated on: `opts.holdout` of the
+/// configurations held out at random (seeded), or the whole data fitted and validated on
+/// `opts.test`, or no validation. A fraction outside [0, 1), or both a fraction and test
+/// data, is an error.
+struct Split {
+    train: Dataset,
+    /// Index in the data file of each training configuration.
+    train_configs: Vec<usize>,
+    /// Validation data and what it is.
+    test: Option<(Dataset, String)>,
+}
+
+impl Split {
+    fn of(data: &Dataset, opts: &IdentifyOptions) -> Result<Split, Error> {
+        let h = opts.holdout;
+        if !(0.0..1.0).contains(&h) {
+            return Err(Error::Input(format!(
+                "the holdout fraction {h} must be in [0, 1) (0: no held-out validation)"
+            )));
+        }
+        let all: Vec<usize> = (0..data.configurations.len()).collect();
+        match (&opts.test, h > 0.0) {
+            (Some(_), true) => Err(Error::Input(
+                "give either a holdout fraction or test data for validation, not both".into(),
+            )),
+            (Some(test), false) => Ok(Split {
+                train: data.clone(),
+                train_configs: all,
+                test: Some((test.clone(), test.source.clone())),
+            }),
+            (None, true) => {
+                let (train, test) = holdout_split(all.len(), h, opts.seed);
+                if test.is_empty() {
+                    return Err(Error::Input(format!(
+                        "the holdout fraction {h} of {} configurations holds out none; hold out a larger fraction",
+                        all.len()
+                    )));
+                }
+                Ok(Split {
+                    train: data.subset(&train),
+                    train_configs: train,
+                    test: Some((
+                        data.subset(&test),
+                        format!(
+                            "{} of the {} configurations of {} held out at random (seed {})",
+                            test.len(),
+                            all.len(),
+                            data.source,
+                            opts.seed
+                        ),
+                    )),
+                })
+            }
+            (None, false) => Ok(Split {
+                train: data.clone(),
+                train_configs: all,
+                test: None,
+            }),
+        }
+    }
+
+    /// Validation of the fit `calibrated` of `model` on the test data (`None` without).
+    fn validate(
+        &self,
+        model: &Model,
+        calibrated: &[f64],
+        opts: &IdentifyOptions,
+        noise: &crate::measure::NoiseModel,
+    ) -> Result<Option<Validation>, Error> {
+        let Some((test, source)) = &self.test else {
+            return Ok(None);
+        };
+        let frames = frames_first_start(model, &self.train, noise, opts)?;
+        let eval = Problem::new(model, test, noise)?;
+        let mut ws = eval.workspace();
+        Ok(Some(Validation {
+            test_data: source.clone(),
+            train_configurations: self.train.configurations.len(),
+            test_configurations: test.configurations.len(),
+            train_ids: self.train.config_ids.clone(),
+            test_ids: test.config_ids.clone(),
+            nominal: ErrorStats::of(&eval.errors(&mut ws, &model.nominal())),
+            frames_only: ErrorStats::of(&eval.errors(&mut ws, &frames)),
+            calibrated: ErrorStats::of(&eval.errors(&mut ws, calibrated)),
+        }))
+    }
+}
+
+/// Residuals of the fit; `file_configs[c]` is the data-file index of the fitted data's
+/// configuration `c` (pose numbers are reported in the file's numbering).
+fn residual_report(problem: &Problem, params: &[f64], file_configs: &[usize]) -> ResidualReport {
     let mut ws = problem.workspace();
     let n = problem.rows();
     let mut r = DVector::zeros(n);
@@ -359,7 +468,7 @@ fn residual_report(problem: &Problem, params: &[f64]) -> ResidualReport {
             None
         };
         per_measurement.push(MeasurementResidual {
-            pose: m.config + 1,
+            pose: file_configs[m.config] + 1,
             pose_id: problem
                 .data
                 .config_ids
@@ -393,22 +502,12 @@ pub fn identify(
         .as_ref()
         .map(|i| i.noise.clone())
         .unwrap_or_default();
-    let (train_idx, test_idx) = if opts.holdout > 0.0 {
-        if opts.holdout >= 1.0 || opts.holdout.is_nan() {
-            return Err(Error::Input(format!(
-                "--holdout {} must be in [0, 1)",
-                opts.holdout
-            )));
-        }
-        holdout_split(data.configurations.len(), opts.holdout, opts.seed)
-    } else {
-        ((0..data.configurations.len()).collect(), Vec::new())
-    };
-    let train = data.subset(&train_idx);
-    let fit = fit_free_set(cell, &train, &noise, opts, observer)?;
+    let split = Split::of(data, opts)?;
+    let train = &split.train;
+    let fit = fit_free_set(cell, train, &noise, opts, observer)?;
     let (model, reasons) = (&fit.model, fit.reasons);
     let (sol, outliers, robust_scale) = (fit.solution, fit.outliers, fit.robust_scale);
-    let mut problem = Problem::new(model, &train, &noise)?;
+    let mut problem = Problem::new(model, train, &noise)?;
     problem.row_weights = fit.row_weights;
     let branch = crate::model::branch::nearest_branch(model, &sol.params);
     let sol = sol.in_branch(&branch, &problem.free);
@@ -443,20 +542,8 @@ pub fn identify(
     };
     let data_rows = sol.jacobian.nrows() - problem.priors.len();
     let observability = uncertainty::observability(&sol.jacobian.rows(0, data_rows).into_owned());
-    let residuals = residual_report(&problem, &sol.params);
-    let validation = if test_idx.is_empty() {
-        None
-    } else {
-        Some(validate(
-            model,
-            data,
-            &train_idx,
-            &test_idx,
-            &sol.params,
-            opts,
-            &noise,
-        )?)
-    };
+    let residuals = residual_report(&problem, &sol.params, &split.train_configs);
+    let validation = split.validate(model, &sol.params, opts, &noise)?;
     let free_set: std::collections::HashSet<usize> = problem.free.iter().copied().collect();
     let parameters = (0..model.param_count())
         .map(|i| {
@@ -559,30 +646,6 @@ fn fit_free_set(
         at = solution.params;
         decided = recheck;
     }
-}
-
-/// Held-out errors of the nominal model, the frames-only fit and the full calibration.
-fn validate(
-    model: &Model,
-    data: &Dataset,
-    train_idx: &[usize],
-    test_idx: &[usize],
-    calibrated: &[f64],
-    opts: &IdentifyOptions,
-    noise: &crate::measure::NoiseModel,
-) -> Result<Validation, Error> {
-    let train = data.subset(train_idx);
-    let test = data.subset(test_idx);
-    let frames = frames_first_start(model, &train, noise, opts)?;
-    let eval = Problem::new(model, &test, noise)?;
-    let mut ws = eval.workspace();
-    Ok(Validation {
-        train_configurations: train.configurations.len(),
-        test_configurations: test.configurations.len(),
-        nominal: ErrorStats::of(&eval.errors(&mut ws, &model.nominal())),
-        frames_only: ErrorStats::of(&eval.errors(&mut ws, &frames)),
-        calibrated: ErrorStats::of(&eval.errors(&mut ws, calibrated)),
-    })
 }
 
 impl Estimate {

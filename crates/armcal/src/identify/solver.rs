@@ -124,6 +124,20 @@ pub(crate) fn gradient_cosine(j: &DMatrix<f64>, r: &DVector<f64>) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The status of a solver that found no trial step lowering the cost: converged to machine
+/// precision if the residual is orthogonal to every Jacobian column to six digits (gradient
+/// cosine < 10⁻⁶), else `Diverged` with `reason` — a step that lowers nothing is never
+/// convergence by itself.
+pub(crate) fn no_decrease_status(it: &Iterate, reason: String) -> Status {
+    if gradient_cosine(&it.j, &it.r) < 1e-6 {
+        Status::Converged {
+            criterion: "no further decrease possible (at machine precision)".into(),
+        }
+    } else {
+        Status::Diverged { reason }
+    }
+}
+
 /// The state every iterative solver carries: workspace, full parameter vector, whitened
 /// residual and Jacobian at those parameters.
 pub(crate) struct Iterate {

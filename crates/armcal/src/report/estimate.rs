@@ -259,7 +259,7 @@ pub fn estimate_section(id: &str, label: &str, e: &Estimate) -> Result<Section, 
         s.figure(
             series_figure(
                 &format!("Residuals per pose — {label}"),
-                "pose (configuration number in the fitted data)",
+                "pose (configuration number in the data file)",
                 "residual (mm)",
                 &[
                     ("x".to_string(), per_pose(0)),

@@ -156,3 +156,28 @@ pub fn example_cell(name: &str) -> Cell {
     )
     .unwrap()
 }
+
+/// The paper cell with its tracker "unplaced" (nominal pose: the robot base frame, 5.4 m
+/// and ~135° from where it is), and the true parameters of the placed cell with its free
+/// parameters perturbed (seed `seed`). With `frames_only` the free parameters are only the
+/// tracker and the reflector (an explicit free list).
+pub fn unplaced_tracker_paper_cell(frames_only: bool, seed: u64) -> (Cell, Vec<f64>) {
+    let placed = example_cell("paper-cell.toml");
+    let truth =
+        armcal::sim::perturbed_truth(&placed.model, &armcal::sim::Perturbation::default(), seed);
+    let mut cell = placed.clone();
+    for i in 0..cell.model.param_count() {
+        let p = cell.model.registry.get(i);
+        if p.frame() == "tracker" {
+            cell.model.registry.set_nominal(i, 0.0);
+        }
+        if frames_only && !armcal::identify::is_frame_parameter(&placed.model, i) {
+            cell.model.registry.set_status(i, Status::Fixed);
+        }
+    }
+    if frames_only {
+        cell.auto_free = false;
+        cell.declared_free = cell.model.registry.free();
+    }
+    (cell, truth)
+}
