@@ -136,10 +136,20 @@ fn joint_layout(
     Ok(joints)
 }
 
-/// A trimming CSV reader over `text` and its header.
+/// The file line of the `r`-th record (comment and empty lines counted).
+fn line_of(record: &csv::StringRecord, r: usize) -> usize {
+    record
+        .position()
+        .map_or(r + 2, |p| usize::try_from(p.line()).unwrap_or(usize::MAX))
+}
+
+/// A trimming CSV reader over `text` and its header. Lines that start with `#` are comments
+/// (armcal writes one when an output was made with an estimate used under
+/// `--accept-unconverged`).
 fn reader<'t>(text: &'t str, file: &str) -> Result<(csv::Reader<&'t [u8]>, Vec<String>), Error> {
     let mut rdr = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
+        .comment(Some(b'#'))
         .from_reader(text.as_bytes());
     let header = rdr
         .headers()
@@ -223,8 +233,8 @@ pub fn read_configurations_str(
     let id_col = header.iter().position(|h| h == "pose_id");
     let mut out = Vec::new();
     for (r, record) in rdr.records().enumerate() {
-        let line = r + 2;
-        let record = record.map_err(|e| err(file, format!("line {line}: {e}")))?;
+        let record = record.map_err(|e| err(file, format!("line {}: {e}", r + 2)))?;
+        let line = line_of(&record, r);
         let q = record_joints(&record, &joints, &header, model, file, line)?;
         let id = id_col
             .and_then(|c| record.get(c))
@@ -351,8 +361,8 @@ pub fn read_str(
     let mut config_of: HashMap<String, usize> = HashMap::new();
     let targets: Vec<&str> = model.targets.iter().map(|t| t.spec.name.as_str()).collect();
     for (r, record) in rdr.records().enumerate() {
-        let line = r + 2;
-        let record = record.map_err(|e| err(file, format!("line {line}: {e}")))?;
+        let record = record.map_err(|e| err(file, format!("line {}: {e}", r + 2)))?;
+        let line = line_of(&record, r);
         let value = |c: &Column, what: &str| cell_value(&record, c, &header, file, line, what);
         let q = record_joints(&record, &joints, &header, model, file, line)?;
         let id = pose_col
