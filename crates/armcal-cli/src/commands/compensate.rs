@@ -114,10 +114,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let nominal = model.nominal();
     let settings = IkSettings::default();
     let text = std::fs::read_to_string(&a.targets)?;
-    let header = text
-        .lines()
-        .find(|l| !l.starts_with('#'))
-        .unwrap_or("");
+    let header = text.lines().find(|l| !l.starts_with('#')).unwrap_or("");
     let cartesian = header.split(',').any(|h| h.trim().starts_with("roll"));
     let program =
         csv::read_configurations_str(&text, &a.targets.display().to_string(), model, None)?;

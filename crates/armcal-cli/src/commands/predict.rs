@@ -48,7 +48,11 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     data.source = "prediction".into();
     write_new(
         &a.out,
-        &with_note(csv::write_string(&data, model)?, note.as_deref(), NoteStyle::Hash),
+        &with_note(
+            csv::write_string(&data, model)?,
+            note.as_deref(),
+            NoteStyle::Hash,
+        ),
         a.force,
     )?;
     println!(

@@ -157,7 +157,11 @@ impl ModelFingerprint {
                 )),
             }
         }
-        for y in b.targets.iter().filter(|y| a.targets.iter().all(|x| x.name != y.name)) {
+        for y in b
+            .targets
+            .iter()
+            .filter(|y| a.targets.iter().all(|x| x.name != y.name))
+        {
             out.push(format!(
                 "target `{}`: in this cell, not in the estimate's cell",
                 y.name

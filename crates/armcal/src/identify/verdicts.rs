@@ -49,10 +49,12 @@ impl Chi2Verdict {
             _ => (finite(u.p_value), finite(u.variance_factor)),
         };
         let sigma_ratio = variance_factor.map(f64::sqrt);
-        let test = format!(
-            "σ̂₀² = {:.3}, {} dof, p = {:.2e}",
-            u.variance_factor, u.dof, u.p_value
-        );
+        let p = if u.p_value >= 1e-3 {
+            format!("{:.3}", u.p_value)
+        } else {
+            format!("{:.1e}", u.p_value)
+        };
+        let test = format!("σ̂₀² = {:.3}, {} dof, p = {p}", u.variance_factor, u.dof);
         let k = sigma_ratio.unwrap_or(f64::NAN);
         let meaning = match outcome {
             Chi2Outcome::Consistent => format!(
