@@ -136,14 +136,14 @@ fn joint_layout(
     Ok(joints)
 }
 
+/// A CSV reader, the header, and the file line of the header and of every record after it.
+type Table<'t> = (csv::Reader<&'t [u8]>, Vec<String>, Vec<usize>);
+
 /// A trimming CSV reader over `text`, its header, and the file line (1-based) of the header
 /// and of every record after it. Lines that start with `#` are comments (armcal writes one
 /// when an output was made with an estimate used under `--accept-unconverged`); they and
 /// empty lines are skipped but counted.
-fn reader<'t>(
-    text: &'t str,
-    file: &str,
-) -> Result<(csv::Reader<&'t [u8]>, Vec<String>, Vec<usize>), Error> {
+fn reader<'t>(text: &'t str, file: &str) -> Result<Table<'t>, Error> {
     let lines = text
         .lines()
         .enumerate()
