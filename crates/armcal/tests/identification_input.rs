@@ -102,6 +102,20 @@ fn read(text: &str) -> Result<armcal::measure::Dataset, String> {
         .map_err(|e| e.to_string())
 }
 
+/// `#` lines are comments (armcal writes one on outputs made with an unconverged estimate),
+/// and line numbers in errors still count every line of the file.
+#[test]
+fn data_files_may_carry_comment_lines() {
+    let row = "1,0,-10,20,0,10,0,100,200,300\n";
+    let d = read(&format!("# armcal: a note\n{HEADER}{row}")).unwrap();
+    assert_eq!(d.measurements.len(), 1);
+    let e = read(&format!(
+        "# armcal: a note\n{HEADER}{row}# another\n2,0,-10,NaN,0,10,0,100,200,300\n"
+    ))
+    .unwrap_err();
+    assert!(e.contains("line 5") && e.contains("q3_deg"), "{e}");
+}
+
 #[test]
 fn bad_data_files_give_clear_errors() {
     let row = "1,0,-10,20,0,10,0,100,200,300\n";

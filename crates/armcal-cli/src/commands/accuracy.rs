@@ -1,9 +1,8 @@
 //! `armcal accuracy`: ISO 9283 accuracy and repeatability, and the model's errors, from a
 //! data file.
 
-use super::output::{load_cell, load_data};
+use super::output::{load_cell, load_data, load_estimate, AcceptUnconverged};
 use armcal::evaluate::report::accuracy_report;
-use armcal::identify::Estimate;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -19,20 +18,28 @@ pub struct Args {
     pub estimate: Option<PathBuf>,
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub accept: AcceptUnconverged,
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
     let data = load_data(&cell, &a.data)?;
-    let params = match &a.estimate {
-        Some(p) => Estimate::from_file(p)?.params_for(model)?,
-        None => model.nominal(),
+    let (params, note) = match &a.estimate {
+        Some(p) => {
+            let (est, note) = load_estimate(p, &a.accept, Some(model))?;
+            (est.params_for(model)?, note)
+        }
+        None => (model.nominal(), None),
     };
     let rep = accuracy_report(model, &params, &data);
     if a.json {
         println!("{}", serde_json::to_string_pretty(&rep)?);
         return Ok(());
+    }
+    if let Some(n) = &note {
+        println!("{n}");
     }
     let e = &rep.errors;
     println!(

@@ -2,12 +2,13 @@
 //! calibrated model, optionally with a nonparametric correction of the error it leaves
 //! (book §5.4).
 
-use super::output::{load_cell, load_data, write_new};
+use super::output::{
+    load_cell, load_data, load_estimate, with_note, write_new, AcceptUnconverged, NoteStyle,
+};
 use anyhow::bail;
 use armcal::compensate::nonparametric::{CorrectionInputs, ResidualCorrection};
 use armcal::compensate::program::{corrected_cartesian_targets, filter_joint_program_corrected};
 use armcal::compensate::{IkResult, IkSettings, IkStatus};
-use armcal::identify::Estimate;
 use armcal::measure::{csv, MeasurementKind};
 use armcal::model::{JointKind, Model, Pose};
 use armcal::nalgebra::Vector3;
@@ -45,6 +46,8 @@ pub struct Args {
     /// error), `joints` (all joints) or `position` (TCP position, world frame).
     #[arg(long, default_value = "arm-joints", value_parser = ["arm-joints", "joints", "position"], requires = "nonparametric")]
     pub nonparametric_inputs: String,
+    #[command(flatten)]
+    pub accept: AcceptUnconverged,
 }
 
 fn joints_header(model: &Model) -> String {
@@ -106,11 +109,12 @@ fn correction_columns(c: &Vector3<f64>, with: bool) -> String {
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
-    let calibrated = Estimate::from_file(&a.estimate)?.params_for(model)?;
+    let (est, note) = load_estimate(&a.estimate, &a.accept, Some(model))?;
+    let calibrated = est.params_for(model)?;
     let nominal = model.nominal();
     let settings = IkSettings::default();
     let text = std::fs::read_to_string(&a.targets)?;
-    let header = text.lines().next().unwrap_or("");
+    let header = text.lines().find(|l| !l.starts_with('#')).unwrap_or("");
     let cartesian = header.split(',').any(|h| h.trim().starts_with("roll"));
     let program =
         csv::read_configurations_str(&text, &a.targets.display().to_string(), model, None)?;
@@ -223,7 +227,11 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
             ));
         }
     }
-    write_new(&a.out, &out, a.force)?;
+    write_new(
+        &a.out,
+        &with_note(out, note.as_deref(), NoteStyle::Hash),
+        a.force,
+    )?;
     println!(
         "{} {} filtered through the calibrated model → {} ({} not converged; see the status column)",
         program.len(),

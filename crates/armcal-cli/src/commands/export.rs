@@ -1,9 +1,8 @@
 //! `armcal export`: the calibrated model as a cell file (DH, modified-DH or zero-reference
 //! links), a parameter table, JSON or URDF.
 
-use super::output::write_new;
+use super::output::{load_estimate, with_note, write_new, AcceptUnconverged, NoteStyle};
 use anyhow::Context;
-use armcal::identify::Estimate;
 use armcal::model::{convert, export, urdf, Model};
 use std::path::PathBuf;
 
@@ -21,10 +20,13 @@ pub struct Args {
     pub out: PathBuf,
     #[arg(long)]
     pub force: bool,
+    #[command(flatten)]
+    pub accept: AcceptUnconverged,
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
-    let est = Estimate::from_file(&a.estimate)?;
+    let (est, note) = load_estimate(&a.estimate, &a.accept, None)?;
+    let note = note.as_deref();
     let model = Model::from_spec(&est.model).context("rebuilding the identified model")?;
     let params = model.nominal();
     let spec = match a.format.as_str() {
@@ -38,13 +40,25 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         _ => est.model.clone(),
     };
     match a.format.as_str() {
-        "json" => write_new(&a.out, &serde_json::to_string_pretty(&spec)?, a.force)?,
-        "urdf" => write_new(&a.out, &urdf::to_urdf(&spec)?, a.force)?,
+        "json" => write_new(
+            &a.out,
+            &with_note(serde_json::to_string_pretty(&spec)?, note, NoteStyle::Json),
+            a.force,
+        )?,
+        "urdf" => write_new(
+            &a.out,
+            &with_note(urdf::to_urdf(&spec)?, note, NoteStyle::Xml),
+            a.force,
+        )?,
         _ => {
-            write_new(&a.out, &export::to_cell_toml(&spec)?, a.force)?;
+            write_new(
+                &a.out,
+                &with_note(export::to_cell_toml(&spec)?, note, NoteStyle::Hash),
+                a.force,
+            )?;
             write_new(
                 &a.out.with_extension("csv"),
-                &export::to_table_csv(&spec),
+                &with_note(export::to_table_csv(&spec), note, NoteStyle::Hash),
                 a.force,
             )?;
         }

@@ -2,7 +2,9 @@
 
 use super::output::{load_cell, load_data, write_new};
 use anyhow::bail;
-use armcal::identify::{identify, Estimate, IdentifyOptions, Loss, Method, Silent};
+use armcal::identify::{
+    identify, Estimate, IdentifyOptions, LmSettings, Loss, Method, Silent, Tolerances,
+};
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -25,6 +27,11 @@ pub struct Args {
     /// Solver.
     #[arg(long, default_value = "lm", value_parser = ["lm", "gn", "kalman"])]
     pub method: String,
+    /// Iteration limit of Levenberg–Marquardt and Gauss–Newton (per run: the frames-first
+    /// stage and each robust reweighting are runs of their own; the Kalman filter keeps its
+    /// own limit).
+    #[arg(long, default_value_t = Tolerances::default().max_iterations)]
+    pub max_iterations: usize,
     /// Seed of the held-out split.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -46,7 +53,13 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         holdout: a.holdout,
         test,
         seed: a.seed,
-        ..Default::default()
+        lm: LmSettings {
+            tolerances: Tolerances {
+                max_iterations: a.max_iterations,
+                ..Default::default()
+            },
+            ..Default::default()
+        },
     };
     if a.out.exists() && !a.force {
         bail!("{} exists; pass --force to overwrite it", a.out.display());
@@ -142,6 +155,10 @@ pub fn print_summary(e: &Estimate) {
             f.nominal_deg,
             f.reason
         );
+    }
+    if let Some(v) = &e.verdicts {
+        println!("χ² verdict: {}", v.chi2.meaning);
+        println!("identifiability: {}", v.identifiability.meaning);
     }
     let r = &e.residuals;
     println!("residuals (mm)      RMS        max        p95");

@@ -39,3 +39,63 @@ pub fn load_data(
     }
     Ok(data)
 }
+
+/// `--accept-unconverged`, shared by the commands that use an estimate.
+#[derive(clap::Args)]
+pub struct AcceptUnconverged {
+    /// Use an estimate whose fit did not converge (or that records no verdicts); every output
+    /// then says so.
+    #[arg(long)]
+    pub accept_unconverged: bool,
+}
+
+/// Reads an estimate, refuses it if its fit did not converge (unless accepted) and, given a
+/// model, if it was identified on another model; prints its notes to stderr. Returns the
+/// estimate and the line every output made with it must carry (`None` if converged).
+pub fn load_estimate(
+    path: &Path,
+    accept: &AcceptUnconverged,
+    model: Option<&armcal::model::Model>,
+) -> anyhow::Result<(armcal::identify::Estimate, Option<String>)> {
+    let file = |e: armcal::Error| anyhow::anyhow!("{}: {e}", path.display());
+    let est = armcal::identify::Estimate::from_file(path)?;
+    let usable = est.check_usable(accept.accept_unconverged).map_err(file)?;
+    if let Some(m) = model {
+        est.check_model(m).map_err(file)?;
+    }
+    if let Some(o) = &usable.overridden {
+        eprintln!("warning: {o}");
+    }
+    for n in &usable.notes {
+        eprintln!("note: {}: {n}", path.display());
+    }
+    Ok((est, usable.overridden))
+}
+
+/// How an output format carries a note.
+#[derive(Clone, Copy)]
+pub enum NoteStyle {
+    /// A `# …` first line (CSV — armcal's readers skip it — and TOML).
+    Hash,
+    /// An XML comment before the root element (armcal's URDF has no XML declaration).
+    Xml,
+    /// A first `"armcal_note"` field of the top-level JSON object.
+    Json,
+}
+
+/// `content` carrying `note`, if any, in the format's own comment syntax.
+pub fn with_note(content: String, note: Option<&str>, style: NoteStyle) -> String {
+    let Some(note) = note else {
+        return content;
+    };
+    match style {
+        NoteStyle::Hash => format!("# {note}\n{content}"),
+        NoteStyle::Xml => format!("<!-- {} -->\n{content}", note.replace("--", "- -")),
+        // The output is a pretty-printed JSON object: the field goes right after its `{`.
+        NoteStyle::Json => content.replacen(
+            '{',
+            &format!("{{\n  \"armcal_note\": {},", serde_json::Value::from(note)),
+            1,
+        ),
+    }
+}

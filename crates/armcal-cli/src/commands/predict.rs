@@ -1,7 +1,6 @@
 //! `armcal predict`: what the (nominal or identified) model says the instrument measures.
 
-use super::output::{load_cell, write_new};
-use armcal::identify::Estimate;
+use super::output::{load_cell, load_estimate, with_note, write_new, AcceptUnconverged, NoteStyle};
 use armcal::measure::csv;
 use armcal::sim::simulate;
 use std::path::PathBuf;
@@ -22,14 +21,19 @@ pub struct Args {
     pub out: PathBuf,
     #[arg(long)]
     pub force: bool,
+    #[command(flatten)]
+    pub accept: AcceptUnconverged,
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
-    let params = match &a.estimate {
-        Some(p) => Estimate::from_file(p)?.params_for(model)?,
-        None => model.nominal(),
+    let (params, note) = match &a.estimate {
+        Some(p) => {
+            let (est, note) = load_estimate(p, &a.accept, Some(model))?;
+            (est.params_for(model)?, note)
+        }
+        None => (model.nominal(), None),
     };
     let poses = csv::read_configurations(
         &a.joints,
@@ -42,7 +46,15 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         data.config_ids[k] = id.clone();
     }
     data.source = "prediction".into();
-    write_new(&a.out, &csv::write_string(&data, model)?, a.force)?;
+    write_new(
+        &a.out,
+        &with_note(
+            csv::write_string(&data, model)?,
+            note.as_deref(),
+            NoteStyle::Hash,
+        ),
+        a.force,
+    )?;
     println!(
         "predicted {} measurements at {} configurations with the {} model → {}",
         data.measurements.len(),

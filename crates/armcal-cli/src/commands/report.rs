@@ -1,7 +1,7 @@
 //! `armcal report`: one self-contained HTML file from armcal's JSON results (estimates,
 //! designs, `study paper` results), with inline SVG figures and the 3D view of the cell.
 
-use super::output::write_new;
+use super::output::{write_new, AcceptUnconverged};
 use anyhow::bail;
 use armcal::cell::Cell;
 use armcal::report::{self, Document, Input, ReportContent};
@@ -22,6 +22,8 @@ pub struct Args {
     /// Overwrite an existing report.html.
     #[arg(long)]
     pub force: bool,
+    #[command(flatten)]
+    pub accept: AcceptUnconverged,
 }
 
 /// The cell file a design names, looked up as given (relative to the working folder, or a
@@ -43,8 +45,15 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         bail!("{} exists; pass --force to overwrite it", path.display());
     }
     let mut inputs: Vec<Input> = Vec::new();
+    let mut notes = Vec::new();
     for f in &a.files {
         let document = Document::from_file(f)?;
+        if let Document::Estimate(e) = &document {
+            let usable = e
+                .check_usable(a.accept.accept_unconverged)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", f.display()))?;
+            notes.extend(usable.overridden.map(|o| format!("{}: {o}", f.display())));
+        }
         let stem = f
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
@@ -60,7 +69,6 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
             document,
         });
     }
-    let mut notes = Vec::new();
     let first_design = a
         .files
         .iter()

@@ -2,6 +2,7 @@
 //! Levenberg–Marquardt, Gauss–Newton, recursive (Kalman) estimation, robust IRLS, priors
 //! (MAP), parameter and TCP covariances, observability indices, held-out validation.
 
+pub mod fingerprint;
 pub mod gauss_newton;
 pub mod kalman;
 pub mod lm;
@@ -9,14 +10,19 @@ pub mod problem;
 pub mod robust;
 pub mod solver;
 pub mod uncertainty;
+pub mod verdicts;
 
+pub use fingerprint::ModelFingerprint;
 pub use gauss_newton::gauss_newton;
 pub use kalman::{kalman_filter, KalmanSettings};
 pub use lm::{levenberg_marquardt, LmSettings};
 pub use problem::Problem;
 pub use robust::{robust_fit, Loss, Outlier};
 pub use solver::{Observer, Silent, Solution, Status, Tolerances};
-pub use uncertainty::{ErrorStats, Observability, ParameterUncertainty, TcpCovariance};
+pub use uncertainty::{
+    Chi2Outcome, ErrorStats, Observability, ParameterUncertainty, TcpCovariance,
+};
+pub use verdicts::{Chi2Verdict, IdentifiabilityVerdict, Verdicts};
 
 use crate::cell::Cell;
 use crate::measure::{Dataset, MeasurementKind};
@@ -186,6 +192,25 @@ pub struct Estimate {
     pub validation: Option<Validation>,
     pub measurements: usize,
     pub configurations: usize,
+    /// Solver, χ² and identifiability verdicts; `None` in files of an older armcal, which
+    /// consumers treat as unverified ([`Estimate::check_usable`]).
+    #[serde(default)]
+    pub verdicts: Option<Verdicts>,
+    /// The cell model the estimate was identified on; `None` in files of an older armcal
+    /// (then only the parameter names are checked, [`Estimate::check_model`]).
+    #[serde(default)]
+    pub fingerprint: Option<ModelFingerprint>,
+}
+
+/// Whether an estimate may be used ([`Estimate::check_usable`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Usability {
+    /// Set when the estimate is used only because the caller accepted an unconverged (or
+    /// unverified) fit: every output written with it must carry this line.
+    pub overridden: Option<String>,
+    /// What else the user should know (χ² not consistent with the stated σ, fewer parameters
+    /// than the generic count), one sentence each.
+    pub notes: Vec<String>,
 }
 
 /// The cell's model with its free set for `data`, decided at the parameters `at` (the
@@ -570,7 +595,7 @@ pub fn identify(
         data: data.source.clone(),
         model: model.spec_at(&sol.params),
         parameters,
-        fixed_reasons: reasons,
+        fixed_reasons: reasons.clone(),
         rank_deficit,
         solver: SolverReport {
             method: opts.method,
@@ -580,6 +605,17 @@ pub fn identify(
             time_ms: sol.time.as_secs_f64() * 1e3,
             history: sol.history.clone(),
         },
+        verdicts: Some(Verdicts {
+            solver: sol.status.clone(),
+            chi2: Chi2Verdict::of(&unc),
+            identifiability: IdentifiabilityVerdict::of(
+                model,
+                cell.measurement,
+                names.len(),
+                &reasons,
+            ),
+        }),
+        fingerprint: Some(ModelFingerprint::of(&cell.model)),
         free: names,
         strong_correlations: strong,
         uncertainty: unc,
@@ -661,9 +697,90 @@ impl Estimate {
         })
     }
 
-    /// The full parameter vector of `model` from this estimate (by parameter name). An
-    /// estimate of a different robot or cell is an error that names the mismatch.
+    /// Whether the estimate may be used: an estimate whose fit did not converge — or that
+    /// records no verdicts (written by an older armcal) — is an error naming the status,
+    /// unless `accept_unconverged`, when [`Usability::overridden`] says what every output must
+    /// carry. The χ² and identifiability verdicts worth knowing come back as notes.
+    pub fn check_usable(&self, accept_unconverged: bool) -> Result<Usability, Error> {
+        let flag = "pass --accept-unconverged to use it anyway";
+        let Some(v) = &self.verdicts else {
+            if !accept_unconverged {
+                return Err(Error::Input(format!(
+                    "the estimate (cell `{}`) was written by an older armcal: it records no solver, χ² or identifiability verdict and no model fingerprint; identify again, or {flag}",
+                    self.cell
+                )));
+            }
+            return Ok(Usability {
+                overridden: Some(format!(
+                    "armcal: estimate of cell `{}` unverified (no recorded verdicts), used with --accept-unconverged",
+                    self.cell
+                )),
+                notes: Vec::new(),
+            });
+        };
+        let mut usability = Usability::default();
+        if !v.solver.is_converged() {
+            if !accept_unconverged {
+                return Err(Error::Input(format!(
+                    "the fit of this estimate (cell `{}`) did not converge: {} after {} iterations; its parameters are not a least-squares solution. Identify again (check the nominal model, the data's units and joint columns, or raise --max-iterations), or {flag}",
+                    self.cell, v.solver, self.solver.iterations
+                )));
+            }
+            usability.overridden = Some(format!(
+                "armcal: estimate of cell `{}` did not converge ({}), used with --accept-unconverged",
+                self.cell, v.solver
+            ));
+        }
+        if v.chi2.outcome != Chi2Outcome::Consistent {
+            usability.notes.push(format!("χ² test: {}", v.chi2.meaning));
+        }
+        if v.identifiability.is_short() {
+            usability
+                .notes
+                .push(format!("identifiability: {}", v.identifiability.meaning));
+        }
+        Ok(usability)
+    }
+
+    /// Checks that this estimate belongs to `model`: the same parameter names and, for an
+    /// estimate that carries a [`ModelFingerprint`], the same conventions, joints, nominal
+    /// geometry, frames, targets and free set. The error names every difference.
+    pub fn check_model(&self, model: &Model) -> Result<(), Error> {
+        self.check_names(model)?;
+        let Some(f) = &self.fingerprint else {
+            return Ok(());
+        };
+        let differences = f.differences(model);
+        if differences.is_empty() {
+            return Ok(());
+        }
+        Err(Error::Input(format!(
+            "the estimate (cell `{}`) was identified on another model than `{}`: {}; identify again with this cell, or use the cell the estimate was made for",
+            self.cell,
+            model.name,
+            differences.join("; ")
+        )))
+    }
+
+    /// The full parameter vector of `model` from this estimate (by parameter name), after
+    /// [`Estimate::check_model`].
     pub fn params_for(&self, model: &Model) -> Result<Vec<f64>, Error> {
+        self.check_model(model)?;
+        let by_name: std::collections::HashMap<&str, &ParameterEstimate> = self
+            .parameters
+            .iter()
+            .map(|p| (p.name.as_str(), p))
+            .collect();
+        Ok(model
+            .registry
+            .iter()
+            .map(|p| by_name[p.name.as_str()].estimate / p.unit.display_factor())
+            .collect())
+    }
+
+    /// An estimate of a different robot or cell (other parameter names) is an error that
+    /// names the mismatch.
+    fn check_names(&self, model: &Model) -> Result<(), Error> {
         let by_name: std::collections::HashMap<&str, &ParameterEstimate> = self
             .parameters
             .iter()
@@ -702,10 +819,6 @@ impl Estimate {
                 },
             )));
         }
-        Ok(model
-            .registry
-            .iter()
-            .map(|p| by_name[p.name.as_str()].estimate / p.unit.display_factor())
-            .collect())
+        Ok(())
     }
 }

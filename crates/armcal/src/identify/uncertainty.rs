@@ -31,6 +31,48 @@ pub struct ParameterUncertainty {
     pub verdict: String,
 }
 
+/// The two-sided χ² test at 5 % of the a-posteriori variance factor: under the model (right
+/// σ, right kinematics, no outliers) `rᵀr ~ χ²(m − n)`, so `P(χ² ≥ rᵀr) < 0.025` says the
+/// residuals are too large for the stated σ and `> 0.975` too small (the global
+/// test of a least-squares adjustment).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Chi2Outcome {
+    Consistent,
+    /// Residuals too large: the stated σ is too small (or model error, or outliers).
+    SigmaTooSmall,
+    /// Residuals too small: the stated σ is too large.
+    SigmaTooLarge,
+    /// No redundancy (m = n): nothing to test.
+    Untestable,
+}
+
+impl Chi2Outcome {
+    /// The outcome for `dof` degrees of freedom and p-value `P(χ² ≥ rᵀr)`.
+    pub fn of(dof: usize, p_value: f64) -> Chi2Outcome {
+        if dof == 0 || p_value.is_nan() {
+            Chi2Outcome::Untestable
+        } else if p_value < 0.025 {
+            Chi2Outcome::SigmaTooSmall
+        } else if p_value > 0.975 {
+            Chi2Outcome::SigmaTooLarge
+        } else {
+            Chi2Outcome::Consistent
+        }
+    }
+
+    pub fn describe(self) -> &'static str {
+        match self {
+            Chi2Outcome::Consistent => "consistent with the stated σ",
+            Chi2Outcome::SigmaTooSmall => {
+                "residuals too large for the stated σ (σ too small, model error, or outliers)"
+            }
+            Chi2Outcome::SigmaTooLarge => "residuals too small for the stated σ (σ too large)",
+            Chi2Outcome::Untestable => "no redundancy (m = n): cannot test",
+        }
+    }
+}
+
 /// Covariance and tests from the whitened Jacobian `j` and residual `r` at a solution.
 /// Fails, naming the columns, if `jᵀj` is singular.
 pub fn parameter_uncertainty(
@@ -55,20 +97,13 @@ pub fn parameter_uncertainty(
     let m = j.nrows();
     let dof = m.saturating_sub(n);
     let chi2 = r.norm_squared();
-    let (p_value, verdict) = if dof == 0 {
-        (f64::NAN, "no redundancy (m = n): cannot test".to_string())
+    let p_value = if dof == 0 {
+        f64::NAN
     } else {
         let d = ChiSquared::new(dof as f64).map_err(|e| Error::Input(e.to_string()))?;
-        let p = 1.0 - d.cdf(chi2);
-        let v = if p < 0.025 {
-            "residuals too large for the stated σ (σ too small, model error, or outliers)"
-        } else if p > 0.975 {
-            "residuals too small for the stated σ (σ too large)"
-        } else {
-            "consistent with the stated σ"
-        };
-        (p, v.to_string())
+        1.0 - d.cdf(chi2)
     };
+    let verdict = Chi2Outcome::of(dof, p_value).describe().to_string();
     Ok(ParameterUncertainty {
         covariance: cov,
         sigma,

@@ -136,10 +136,23 @@ fn joint_layout(
     Ok(joints)
 }
 
-/// A trimming CSV reader over `text` and its header.
-fn reader<'t>(text: &'t str, file: &str) -> Result<(csv::Reader<&'t [u8]>, Vec<String>), Error> {
+/// A CSV reader, the header, and the file line of the header and of every record after it.
+type Table<'t> = (csv::Reader<&'t [u8]>, Vec<String>, Vec<usize>);
+
+/// A trimming CSV reader over `text`, its header, and the file line (1-based) of the header
+/// and of every record after it. Lines that start with `#` are comments (armcal writes one
+/// when an output was made with an estimate used under `--accept-unconverged`); they and
+/// empty lines are skipped but counted.
+fn reader<'t>(text: &'t str, file: &str) -> Result<Table<'t>, Error> {
+    let lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'))
+        .map(|(i, _)| i + 1)
+        .collect();
     let mut rdr = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
+        .comment(Some(b'#'))
         .from_reader(text.as_bytes());
     let header = rdr
         .headers()
@@ -147,7 +160,7 @@ fn reader<'t>(text: &'t str, file: &str) -> Result<(csv::Reader<&'t [u8]>, Vec<S
         .iter()
         .map(str::to_string)
         .collect();
-    Ok((rdr, header))
+    Ok((rdr, header, lines))
 }
 
 /// Parses the joint values of one record (internal units), with line and column in errors.
@@ -217,13 +230,13 @@ pub fn read_configurations_str(
     model: &Model,
     joint_columns: Option<&[String]>,
 ) -> Result<Vec<(String, Vec<f64>)>, Error> {
-    let (mut rdr, header) = reader(text, file)?;
+    let (mut rdr, header, lines) = reader(text, file)?;
     let mut used = vec![false; header.len()];
     let joints = joint_layout(&header, model, joint_columns, file, &mut used)?;
     let id_col = header.iter().position(|h| h == "pose_id");
     let mut out = Vec::new();
     for (r, record) in rdr.records().enumerate() {
-        let line = r + 2;
+        let line = lines.get(r + 1).copied().unwrap_or(r + 2);
         let record = record.map_err(|e| err(file, format!("line {line}: {e}")))?;
         let q = record_joints(&record, &joints, &header, model, file, line)?;
         let id = id_col
@@ -257,7 +270,7 @@ pub fn read_str(
     model: &Model,
     joint_columns: Option<&[String]>,
 ) -> Result<(Dataset, ReadReport), Error> {
-    let (mut rdr, header) = reader(text, file)?;
+    let (mut rdr, header, lines) = reader(text, file)?;
     let find = |name: &str| header.iter().position(|h| h == name);
     let mut used = vec![false; header.len()];
 
@@ -351,7 +364,7 @@ pub fn read_str(
     let mut config_of: HashMap<String, usize> = HashMap::new();
     let targets: Vec<&str> = model.targets.iter().map(|t| t.spec.name.as_str()).collect();
     for (r, record) in rdr.records().enumerate() {
-        let line = r + 2;
+        let line = lines.get(r + 1).copied().unwrap_or(r + 2);
         let record = record.map_err(|e| err(file, format!("line {line}: {e}")))?;
         let value = |c: &Column, what: &str| cell_value(&record, c, &header, file, line, what);
         let q = record_joints(&record, &joints, &header, model, file, line)?;

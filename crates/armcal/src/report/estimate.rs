@@ -115,6 +115,28 @@ pub fn estimate_section(id: &str, label: &str, e: &Estimate) -> Result<Section, 
             ),
         ),
     ];
+    match &e.verdicts {
+        Some(v) => {
+            rows.push((
+                "fit verdict",
+                if v.solver.is_converged() {
+                    escape(&v.solver.to_string())
+                } else {
+                    format!(
+                        "<span class=\"flag\">did not converge ({}): the parameters are not a least-squares solution</span>",
+                        escape(&v.solver.to_string())
+                    )
+                },
+            ));
+            rows.push(("χ² verdict", escape(&v.chi2.meaning)));
+            rows.push(("identifiability", escape(&v.identifiability.meaning)));
+        }
+        None => rows.push((
+            "fit verdict",
+            "<span class=\"flag\">none recorded (written by an older armcal): unverified</span>"
+                .into(),
+        )),
+    }
     if sol.time_ms > 0.0 {
         rows.push(("solver time", format!("{} ms", fixed(sol.time_ms, 1))));
     }

@@ -1,0 +1,139 @@
+//! What an estimate says about its own fit (issue #10 item 4): did the solver converge, do
+//! the residuals agree with the stated measurement σ (χ² test), and how many parameters
+//! were identified of the count the measurement type gives in generic geometry. The
+//! consumers of an estimate refuse one whose fit did not converge
+//! ([`super::Estimate::check_usable`]).
+
+use super::solver::Status;
+use super::uncertainty::{Chi2Outcome, ParameterUncertainty};
+use crate::model::identifiability::{expected_count, Measurement};
+use crate::model::Model;
+use serde::{Deserialize, Serialize};
+
+/// The verdicts an estimate records.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Verdicts {
+    /// How the solver ended.
+    pub solver: Status,
+    pub chi2: Chi2Verdict,
+    pub identifiability: IdentifiabilityVerdict,
+}
+
+/// The χ² test of the a-posteriori variance factor σ̂₀² = rᵀr / (m − n) and what it means
+/// for the reported σ's.
+///
+/// The reported parameter and TCP σ's come from `C_p = (F₁ᵀF₁)⁻¹` with the Jacobian
+/// whitened by the *stated* σ: they are **not** scaled by σ̂₀². With the stated σ wrong by
+/// a factor k (σ_true = k σ), E[σ̂₀²] = k² and the true covariance is k² C_p, so the
+/// reported σ's are off by k ≈ √σ̂₀².
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Chi2Verdict {
+    pub outcome: Chi2Outcome,
+    /// P(χ² ≥ rᵀr); `None` without redundancy.
+    pub p_value: Option<f64>,
+    /// σ̂₀²; `None` without redundancy.
+    pub variance_factor: Option<f64>,
+    /// √σ̂₀²: how many times larger the residuals are than the stated σ predicts.
+    pub sigma_ratio: Option<f64>,
+    pub dof: usize,
+    /// One sentence: what the verdict means for the reported σ's.
+    pub meaning: String,
+}
+
+impl Chi2Verdict {
+    pub fn of(u: &ParameterUncertainty) -> Chi2Verdict {
+        let outcome = Chi2Outcome::of(u.dof, u.p_value);
+        let finite = |x: f64| Some(x).filter(|x| x.is_finite());
+        let (p_value, variance_factor) = match outcome {
+            Chi2Outcome::Untestable => (None, None),
+            _ => (finite(u.p_value), finite(u.variance_factor)),
+        };
+        let sigma_ratio = variance_factor.map(f64::sqrt);
+        let p = if u.p_value >= 1e-3 {
+            format!("{:.3}", u.p_value)
+        } else {
+            format!("{:.1e}", u.p_value)
+        };
+        let test = format!("σ̂₀² = {:.3}, {} dof, p = {p}", u.variance_factor, u.dof);
+        let k = sigma_ratio.unwrap_or(f64::NAN);
+        let meaning = match outcome {
+            Chi2Outcome::Consistent => format!(
+                "the residuals agree with the stated σ ({test}): the reported σ's, which follow from it, stand"
+            ),
+            Chi2Outcome::SigmaTooSmall => format!(
+                "the residuals are {k:.2}× what the stated σ predicts ({test}): the stated σ is too small (or the model misses an error, or there are outliers); the reported σ's assume the stated σ (C_p is not scaled by σ̂₀²) and are then about {k:.2}× too small — multiply them by √σ̂₀² = {k:.2}"
+            ),
+            Chi2Outcome::SigmaTooLarge => format!(
+                "the residuals are only {k:.2}× what the stated σ predicts ({test}): the stated σ is too large; the reported σ's assume the stated σ (C_p is not scaled by σ̂₀²) and are then about {:.2}× too large — multiply them by √σ̂₀² = {k:.2}",
+                1.0 / k
+            ),
+            Chi2Outcome::Untestable => "no redundancy (as many residuals as parameters): the residuals cannot test the stated σ, and the reported σ's rest on it alone".to_string(),
+        };
+        Chi2Verdict {
+            outcome,
+            p_value,
+            variance_factor,
+            sigma_ratio,
+            dof: u.dof,
+            meaning,
+        }
+    }
+}
+
+/// How many parameters were identified, against the count the measurement type identifies
+/// in generic geometry ([`expected_count`]).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct IdentifiabilityVerdict {
+    pub measurement: Measurement,
+    /// Number of parameters estimated.
+    pub identified: usize,
+    /// The generic count; `None` where it depends on the target layout (several points).
+    pub expected: Option<usize>,
+    /// Parameters left out with a reason (see the estimate's `fixed_reasons`).
+    pub fixed: Vec<String>,
+    pub meaning: String,
+}
+
+impl IdentifiabilityVerdict {
+    pub fn of(
+        model: &Model,
+        measurement: Measurement,
+        identified: usize,
+        fixed_reasons: &[(String, String)],
+    ) -> IdentifiabilityVerdict {
+        let expected = expected_count(model, measurement);
+        let fixed: Vec<String> = fixed_reasons.iter().map(|(n, _)| n.clone()).collect();
+        let what = format!("{measurement:?}").to_lowercase();
+        let left_out = if fixed.is_empty() {
+            String::new()
+        } else {
+            format!("; fixed with a reason: {}", fixed.join(", "))
+        };
+        let meaning = match expected {
+            Some(e) if identified == e => format!(
+                "all {e} parameters {what} measurements identify for this robot in generic geometry are estimated{left_out}"
+            ),
+            Some(e) if identified < e => format!(
+                "{identified} of the {e} parameters {what} measurements identify for this robot in generic geometry are estimated{left_out}"
+            ),
+            Some(e) => format!(
+                "{identified} parameters estimated, more than the {e} {what} measurements identify for this robot in generic geometry (priors, or a free set that is not minimal){left_out}"
+            ),
+            None => format!(
+                "{identified} parameters estimated (the generic count for several targets depends on their layout){left_out}"
+            ),
+        };
+        IdentifiabilityVerdict {
+            measurement,
+            identified,
+            expected,
+            fixed,
+            meaning,
+        }
+    }
+
+    /// Whether fewer parameters were estimated than the generic count.
+    pub fn is_short(&self) -> bool {
+        self.expected.is_some_and(|e| self.identified < e)
+    }
+}
