@@ -596,7 +596,7 @@ pub fn identify(
         model: model.spec_at(&sol.params),
         parameters,
         fixed_reasons: reasons.clone(),
-        rank_deficit,
+        rank_deficit: rank_deficit.clone(),
         solver: SolverReport {
             method: opts.method,
             robust: opts.robust,
@@ -613,6 +613,7 @@ pub fn identify(
                 cell.measurement,
                 names.len(),
                 &reasons,
+                rank_deficit.as_ref(),
             ),
         }),
         fingerprint: Some(ModelFingerprint::of(&cell.model)),

@@ -7,6 +7,7 @@
 use super::solver::Status;
 use super::uncertainty::{Chi2Outcome, ParameterUncertainty};
 use crate::model::identifiability::{expected_count, Measurement};
+use crate::model::rank_deficit::RankDeficit;
 use crate::model::Model;
 use serde::{Deserialize, Serialize};
 
@@ -100,6 +101,7 @@ impl IdentifiabilityVerdict {
         measurement: Measurement,
         identified: usize,
         fixed_reasons: &[(String, String)],
+        deficit: Option<&RankDeficit>,
     ) -> IdentifiabilityVerdict {
         let expected = expected_count(model, measurement);
         let fixed: Vec<String> = fixed_reasons.iter().map(|(n, _)| n.clone()).collect();
@@ -114,7 +116,11 @@ impl IdentifiabilityVerdict {
                 "all {e} parameters {what} measurements identify for this robot in generic geometry are estimated{left_out}"
             ),
             Some(e) if identified < e => format!(
-                "{identified} of the {e} parameters {what} measurements identify for this robot in generic geometry are estimated{left_out}"
+                "{identified} of the {e} parameters {what} measurements identify for this robot in generic geometry are estimated, because {}{left_out}",
+                deficit.map_or_else(
+                    || "the cell's explicit free set leaves the others out".to_string(),
+                    |d| d.causes.join("; ")
+                )
             ),
             Some(e) => format!(
                 "{identified} parameters estimated, more than the {e} {what} measurements identify for this robot in generic geometry (priors, or a free set that is not minimal){left_out}"
