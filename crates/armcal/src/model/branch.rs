@@ -471,7 +471,7 @@ mod tests {
                 }
             }
         }
-        assert_eq!(checked, 8 * 16);
+        assert_eq!(checked, 10 * 18);
     }
 
     /// The maps within a link (Z-Y-X Euler angles, S-model) and whole turns are exact.
