@@ -352,12 +352,7 @@ fn capsule(t: &toml::Table, frame_required: bool) -> Result<Capsule, String> {
     if frame_required && frame.is_none() {
         return Err("missing `frame` (the chain frame the capsule moves with)".into());
     }
-    let valid = ["a", "b"].map(|k| unit_spellings(k, Unit::Mm));
-    let valid = [
-        valid[0].clone(),
-        valid[1].clone(),
-        unit_spellings("radius", Unit::Mm),
-    ];
+    let valid = ["a", "b", "radius"].map(|k| unit_spellings(k, Unit::Mm));
     check_unused(t, &used, &["frame", "name", "kind"], &valid)?;
     Ok(Capsule {
         frame: frame.unwrap_or("tool").to_string(),

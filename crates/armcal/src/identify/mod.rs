@@ -26,7 +26,7 @@ pub use verdicts::{Chi2Verdict, IdentifiabilityVerdict, Verdicts};
 
 use crate::cell::Cell;
 use crate::measure::{Dataset, MeasurementKind};
-use crate::model::identifiability::{IdentifiabilityOptions, Measurement};
+use crate::model::identifiability::{Identifiability, IdentifiabilityOptions, Measurement};
 use crate::model::rank_deficit::RankDeficit;
 use crate::model::{Model, ModelSpec, Segment, Status as ParamStatus};
 use crate::Error;
@@ -230,6 +230,18 @@ pub fn identifiable_model(
         return Ok((cell.model.clone(), Vec::new()));
     }
     let generic = cell.identifiability(&cell.identifiability_options())?;
+    identifiable_model_given(cell, data, at, &generic)
+}
+
+/// [`identifiable_model`] of an `auto` cell with the cell's generic analysis (its declared
+/// free set at the nominal, random configurations) already done, so that a fit deciding its
+/// free set more than once does it once.
+fn identifiable_model_given(
+    cell: &Cell,
+    data: &Dataset,
+    at: &[f64],
+    generic: &Identifiability,
+) -> Result<(Model, Vec<(String, String)>), Error> {
     let rows = data.rows();
     if rows < generic.identifiable.len() {
         return Err(Error::Input(format!(
@@ -661,15 +673,24 @@ fn fit_free_set(
     } else {
         cell.model.clone()
     };
+    let generic = if cell.auto_free {
+        Some(cell.identifiability(&cell.identifiability_options())?)
+    } else {
+        None
+    };
+    let decide = |at: &[f64]| match &generic {
+        Some(g) => identifiable_model_given(cell, train, at, g),
+        None => Ok((cell.model.clone(), Vec::new())),
+    };
     let mut at = frames_first_start(&declared, train, noise, opts)?;
-    let mut decided = identifiable_model(cell, train, &at)?;
+    let mut decided = decide(&at)?;
     loop {
         let (model, reasons) = decided;
         let mut problem = Problem::new(&model, train, noise)?;
         let (solution, outliers, robust_scale) = solve(&mut problem, &at, opts, observer)?;
         let row_weights = problem.row_weights.clone();
         drop(problem);
-        let recheck = identifiable_model(cell, train, &solution.params)?;
+        let recheck = decide(&solution.params)?;
         if recheck.0.registry.free().len() <= model.registry.free().len() {
             return Ok(FreeSetFit {
                 model,
