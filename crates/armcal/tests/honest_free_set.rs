@@ -308,8 +308,19 @@ fn an_inline_mdh_table_with_parallel_axes_is_completed() {
 fn the_complete_form_changes_no_pose_and_no_capsule() {
     use armcal::model::complete::{in_form, LinkForm};
     use armcal::model::{forward_kinematics, Data, Model};
-    for name in ["ur10", "irb120", "motoman-right"] {
-        let robot = robots::robot(name).unwrap();
+    // A DH table of our own whose axes 2 and 3 are 3° apart with d2 = 35 mm (the case a
+    // published, already calibrated DH table often is), followed by a frame6 tool.
+    let mut own = robots::robot("irb120").unwrap();
+    own.name = "own".into();
+    let j2 = own.spec.links.iter().position(|l| l.name == "j2").unwrap();
+    own.spec.links[j2].geometry.values[1] = 35.0;
+    own.spec.links[j2].geometry.values[3] = 3f64.to_radians();
+    let j6 = own.spec.links.iter().position(|l| l.name == "j6").unwrap();
+    own.spec.links[j6].geometry.values[3] = 0.7f64.to_radians();
+    own.spec.links[j6 + 1].geometry.values[2] = 40.0;
+    let owned = [("own", own)];
+    let builtin = ["ur10", "irb120", "motoman-right"].map(|n| (n, robots::robot(n).unwrap()));
+    for (name, robot) in builtin.into_iter().chain(owned) {
         let given = Model::from_spec(&robot.spec).unwrap();
         let formed = in_form(&robot.spec, LinkForm::Auto).unwrap();
         assert!(!formed.changes.is_empty(), "{name}");

@@ -19,9 +19,11 @@
 //! the link forms a cell can ask for (`[robot] convention = …`).
 
 use crate::model::chain::{Model, ModelSpec};
-use crate::model::convert::{self, axes_at_zero};
+use crate::model::convert::{self, axes_at_zero, hayati_link, link_pose};
 use crate::model::link::{Convention, JointKind, LinkGeometry};
+use crate::model::pose::{rot_z, Pose};
 use crate::Error;
+use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 /// Two consecutive joint axes closer than this angle (degrees) count as nearly parallel and
@@ -150,18 +152,16 @@ pub fn in_form(spec: &ModelSpec, form: LinkForm) -> Result<Formed, Error> {
 /// The complete, minimal form of a chain: for every pair of consecutive revolute joints
 /// `i`, `i+1` with nearly parallel axes ([`near_parallel_axes`]),
 /// * the DH link of joint `i` (`Rz(θ+q) Tz(d) Tx(a) Rx(α)`, whose `Rx(α)` turns axis `i`
-///   into axis `i+1`) becomes the Hayati link `Rz(θ+q) Tx(a) Rx(α) Ry(0)`. With `d = 0`
-///   that is the same transform. With `d ≠ 0` and exactly parallel axes (`α` = 0 or π),
-///   `Tz(d)` commutes with `Tx(a) Rx(α)` into `Tz(d cos α)` in front of the next link,
-///   which takes it: a DH, S-model or prismatic Hayati link adds it to its `d` (or `r`),
-///   a frame6, point or URDF link to its `z`, and a revolute Hayati link with `α` = 0 or π
-///   and `β = 0` passes it on as `Tz(d cos α)`.
+///   into axis `i+1`) becomes the Hayati link `Rz(θ′+q) Tx(a′) Rx(α′) Ry(β′)` that reaches
+///   the same axis (book eqs. 6.31–6.40), and the next link takes the screw between the two
+///   frames (see `dh_to_hayati`); for exactly parallel axes with `d = 0` the values are
+///   simply `(θ, a, α, 0)`.
 /// * the modified-DH link of joint `i+1` (`Rx(α) Tx(a) Rz(θ+q) Tz(d)`) becomes
 ///   `Rx(α) Tx(a) Ry(0) Rz(θ+q) Tz(d)`, the same transform.
 ///
-/// A pair that cannot be changed exactly (a nearly but not exactly parallel DH link with
-/// `d ≠ 0`, or a link form these rules do not cover) is left as it is and named in
-/// [`Formed::incomplete`] with what to do.
+/// A pair that cannot be changed exactly (a next link that cannot take the screw, or a link
+/// form these rules do not cover) is left as it is and named in [`Formed::incomplete`] with
+/// what to do.
 pub fn complete_minimal(spec: &ModelSpec) -> Result<Formed, Error> {
     let model = Model::from_spec(spec)?;
     let pairs = near_parallel_axes(&model, &model.nominal());
@@ -204,14 +204,14 @@ pub fn complete_minimal(spec: &ModelSpec) -> Result<Formed, Error> {
                     out = formed;
                 }
                 None => incomplete.push(format!(
-                    "the axes of {} and {} are {:.2}° apart, but DH link `{}` has d = {:.3} mm, \
-                     which the next link cannot take exactly; write `{}` as a \"hayati\" link \
-                     and add its d to the next link's",
+                    "the axes of {} and {} are {:.2}° apart, but the links after DH link `{}` \
+                     cannot be re-expressed exactly in its Hayati frame; use `[robot] \
+                     convention = \"zrp\"` (complete for any axes) or write `{}` as a \
+                     \"hayati\" link and the next one to match",
                     joints[0],
                     joints[1],
                     angle.to_degrees(),
                     first.name,
-                    first.geometry.values[1],
                     first.name
                 )),
             }
@@ -246,39 +246,59 @@ pub fn complete_minimal(spec: &ModelSpec) -> Result<Formed, Error> {
     })
 }
 
-/// `spec` with DH link `k` in Hayati form, its `d` moved into the links after it (see
-/// [`complete_minimal`]); `None` when that cannot be done exactly.
+/// `spec` with DH link `k` in Hayati form and the links after it re-expressed in its frame
+/// (see [`complete_minimal`]); `None` when that cannot be done exactly.
+///
+/// The DH frame `k` and the Hayati frame `k′` both have their z axis on the next joint axis
+/// and both move with joint `k`, so `F = T_{k′}⁻¹ T_k` is a constant screw along that axis,
+/// `F = Rz(φ) Tz(s)`. The next link takes it in front: `Rz(φ)` into its θ and `Tz(s)` into
+/// its `d` when it begins `Rz(θ+q) Tz(d)` (DH, S-model, prismatic Hayati); a frame6 or URDF
+/// origin takes all of `F`; a revolute Hayati link takes `Rz(φ)` into θ and passes `Tz(s)`
+/// on as `Tz(s cos α)` when its own axes are exactly parallel (α = 0 or π, β = 0).
 fn dh_to_hayati(spec: &ModelSpec, k: usize) -> Option<ModelSpec> {
+    let g = &spec.links[k].geometry;
+    let kind = spec.links[k].joint.as_ref().map(|j| j.kind);
+    let dh = link_pose(g, kind);
+    let next_axis = dh.rot * Vector3::z();
+    let hayati = hayati_link(next_axis, dh.trans, g.values[0], &spec.links[k].name).ok()?;
+    let f = link_pose(&hayati, kind).inverse().compose(&dh);
+    let screw = (f.rot[(2, 2)] - 1.0).abs() < 1e-12 && f.trans.xy().norm() < 1e-9;
+    if !screw {
+        return None;
+    }
+    let (mut phi, mut s) = (f.rot[(1, 0)].atan2(f.rot[(0, 0)]), f.trans.z);
     let mut out = spec.clone();
-    let [theta, d, a, alpha] = spec.links[k].geometry.values[..] else {
-        return None;
-    };
-    out.links[k].geometry = LinkGeometry::hayati(theta, a, alpha, 0.0);
-    if d == 0.0 {
-        return Some(out);
-    }
-    if alpha.sin().abs() > EXACTLY_PARALLEL {
-        return None;
-    }
-    // `carry`: a pending Tz in the frame entering link `j`.
-    let mut carry = d * alpha.cos().round();
+    out.links[k].geometry = hayati;
     for l in out.links.iter_mut().skip(k + 1) {
         let g = &mut l.geometry;
         let kind = l.joint.as_ref().map(|j| j.kind);
         match (g.convention, kind) {
             (Convention::Hayati, Some(JointKind::Revolute)) => {
+                g.values[0] += phi;
+                phi = 0.0;
+                if s == 0.0 {
+                    return Some(out);
+                }
                 let (alpha, beta) = (g.values[2], g.values[3]);
                 if alpha.sin().abs() > EXACTLY_PARALLEL || beta != 0.0 {
                     return None;
                 }
-                carry *= alpha.cos().round();
+                s *= alpha.cos().round();
             }
             (Convention::Dh | Convention::SModel | Convention::Hayati, _) => {
-                g.values[1] += carry;
+                g.values[0] += phi;
+                g.values[1] += s;
                 return Some(out);
             }
-            (Convention::Frame6 | Convention::Point | Convention::Urdf, _) => {
-                g.values[2] += carry;
+            (Convention::Frame6 | Convention::Urdf, _) => {
+                let v = &g.values;
+                let origin = Pose::from_xyz_rpy([v[0], v[1], v[2]], [v[3], v[4], v[5]]);
+                let screw = Pose {
+                    rot: rot_z(phi),
+                    trans: Vector3::new(0.0, 0.0, s),
+                };
+                let (xyz, rpy) = screw.compose(&origin).to_xyz_rpy();
+                g.values[..6].copy_from_slice(&[xyz[0], xyz[1], xyz[2], rpy[0], rpy[1], rpy[2]]);
                 return Some(out);
             }
             _ => return None,

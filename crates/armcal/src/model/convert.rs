@@ -352,7 +352,7 @@ fn dh_link(u: Vector3<f64>, p: Vector3<f64>, theta_nom: f64) -> LinkGeometry {
 /// `l = |r|` (6.37), flipped together to keep θ within 90° of `theta_nom`; then with
 /// `u″ = Rz(−θ) u = (sβ, −sα cβ, cα cβ)`, `α = atan2(−u″_y, u″_z)` and
 /// `β = asin(u″_x)` (6.38–6.39).
-fn hayati_link(
+pub(crate) fn hayati_link(
     u: Vector3<f64>,
     p: Vector3<f64>,
     theta_nom: f64,
@@ -382,7 +382,7 @@ fn hayati_link(
 }
 
 /// The pose of a link geometry at q = 0 (a one-link model evaluated at its nominal values).
-fn link_pose(g: &LinkGeometry, kind: Option<JointKind>) -> Pose<f64> {
+pub(crate) fn link_pose(g: &LinkGeometry, kind: Option<JointKind>) -> Pose<f64> {
     let joint = kind.map(|kind| crate::model::Joint {
         name: "q".into(),
         kind,
