@@ -3,7 +3,8 @@
 
 use super::output::{load_estimate, with_note, write_new, AcceptUnconverged, NoteStyle};
 use anyhow::Context;
-use armcal::model::{convert, export, urdf, Model};
+use armcal::model::complete::LinkForm;
+use armcal::model::{export, urdf, Model};
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -18,6 +19,11 @@ pub struct Args {
     /// parameter table next to it (same name, `.csv`).
     #[arg(long)]
     pub out: PathBuf,
+    /// The cell the estimate was identified in: a cell export then carries its instrument
+    /// (noise, incidence limit), capsules, working poses, obstacles, data columns, measurement
+    /// type and fixed parameters, with `free = "auto"`, so every command accepts it unchanged.
+    #[arg(long)]
+    pub cell: Option<String>,
     #[arg(long)]
     pub force: bool,
     #[command(flatten)]
@@ -25,20 +31,28 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
-    let (est, note) = load_estimate(&a.estimate, &a.accept, None)?;
+    let cell = a
+        .cell
+        .as_deref()
+        .map(super::output::load_cell)
+        .transpose()?;
+    let (est, note) = load_estimate(&a.estimate, &a.accept, cell.as_ref().map(|c| &c.model))?;
     let note = note.as_deref();
     let model = Model::from_spec(&est.model).context("rebuilding the identified model")?;
-    let params = model.nominal();
-    let spec = match a.format.as_str() {
-        "zrp" => convert::to_zrp(&model, &params),
-        "dh" => convert::zrp_to_dh(&convert::to_zrp(&model, &params), Some(&est.model))?,
-        // Pure DH first: a Hayati link of the nominal cannot be regrouped into modified DH.
-        "mdh" => convert::dh_to_mdh(&convert::zrp_to_dh(
-            &convert::to_zrp(&model, &params),
-            None,
-        )?)?,
-        _ => est.model.clone(),
+    let form = match a.format.as_str() {
+        "zrp" => LinkForm::Zrp,
+        "dh" => LinkForm::Dh,
+        "mdh" => LinkForm::Mdh,
+        _ => LinkForm::AsGiven,
     };
+    let spec = export::export_form(&est.model, form)?;
+    let reference = match &cell {
+        Some(c) => export::export_form(&c.model.spec(), form)?,
+        None => spec.clone(),
+    };
+    for w in export::suspicious_values(&Model::from_spec(&reference)?, &spec)? {
+        eprintln!("warning: {w}");
+    }
     match a.format.as_str() {
         "json" => write_new(
             &a.out,
@@ -51,9 +65,23 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
             a.force,
         )?,
         _ => {
+            if cell.is_none() {
+                eprintln!(
+                    "note: without --cell the exported cell holds the model alone (no instrument \
+                     noise, working poses, obstacles, capsules); pass the estimate's cell with \
+                     --cell to carry them"
+                );
+            }
             write_new(
                 &a.out,
-                &with_note(export::to_cell_toml(&spec)?, note, NoteStyle::Hash),
+                &with_note(
+                    match &cell {
+                        Some(c) => armcal::cell::export::to_cell_toml(c, &model, &spec)?,
+                        None => export::to_cell_toml(&spec)?,
+                    },
+                    note,
+                    NoteStyle::Hash,
+                ),
                 a.force,
             )?;
             write_new(

@@ -1,0 +1,119 @@
+//! A cell file of a (calibrated) model that the commands accept unchanged: the model's links
+//! (in whatever convention the export chose) together with everything else of the cell it
+//! was identified in — the instrument's kind, noise model and incidence limit, targets,
+//! capsules (re-expressed in the exported frames), working poses, obstacles, joint limits,
+//! the data columns, the measurement type, what the cell fixed or gave a prior, and
+//! `free = "auto"`.
+
+use super::{Cell, NoiseModel, Obstacle};
+use crate::model::export::{to_cell_toml_with, CellSections};
+use crate::model::{Model, ModelSpec, Status, Unit};
+use crate::robots::transfer_capsules;
+use crate::Error;
+use std::fmt::Write;
+
+/// `spec` (a model of `cell`'s robot, e.g. an identified model converted to DH; `identified`
+/// is the model the capsules' frames refer to, the one `spec` was converted from) as a cell
+/// file carrying the rest of `cell`.
+pub fn to_cell_toml(cell: &Cell, identified: &Model, spec: &ModelSpec) -> Result<String, Error> {
+    let exported = Model::from_spec(spec)?;
+    let mut s = CellSections {
+        name: Some(cell.name.clone()),
+        ..Default::default()
+    };
+    for c in transfer_capsules(identified, &exported, &cell.capsules)? {
+        let _ = writeln!(
+            s.robot,
+            "[[robot.capsules]]\nframe = {:?}\na_mm = {:?}\nb_mm = {:?}\nradius_mm = {:?}\n",
+            c.frame, c.a, c.b, c.radius
+        );
+    }
+    if let Some(i) = &cell.instrument {
+        let _ = writeln!(s.instrument, "kind = {:?}", i.kind);
+        let noise = match &i.noise {
+            NoiseModel::Constant { sigma, sigma_angle } => format!(
+                "{{ model = \"constant\", sigma_mm = {:?}, sigma_angle_deg = {:?} }}",
+                sigma,
+                sigma_angle.to_degrees()
+            ),
+            NoiseModel::Range { a, b_per_m } => format!(
+                "{{ model = \"range\", a_mm = {a:?}, b_um_per_m = {:?} }}",
+                b_per_m * 1000.0
+            ),
+            NoiseModel::PerMeasurement { floor } => {
+                format!("{{ model = \"per-measurement\", floor_mm = {floor:?} }}")
+            }
+        };
+        let _ = writeln!(s.instrument, "noise = {noise}");
+        if let Some(a) = i.max_incidence {
+            let _ = writeln!(s.instrument, "max_incidence_deg = {:?}", a.to_degrees());
+        }
+    }
+    s.parameters = Some(parameters(cell, &exported));
+    for w in &cell.working {
+        let q: Vec<f64> =
+            w.q.iter()
+                .zip(&cell.model.joints)
+                .map(|(v, j)| v * j.kind.unit().display_factor())
+                .collect();
+        let _ = writeln!(
+            s.tail,
+            "\n[[working]]\nname = {:?}\njoints_deg = {q:?}\nweight = {:?}",
+            w.name, w.weight
+        );
+    }
+    for o in &cell.obstacles {
+        let _ = match o {
+            Obstacle::Capsule { name, a, b, radius } => writeln!(
+                s.tail,
+                "\n[[obstacles]]\nname = {name:?}\nkind = \"capsule\"\na_mm = {a:?}\nb_mm = {b:?}\nradius_mm = {radius:?}"
+            ),
+            Obstacle::HalfSpace {
+                name,
+                normal,
+                offset,
+            } => writeln!(
+                s.tail,
+                "\n[[obstacles]]\nname = {name:?}\nkind = \"half-space\"\nnormal = {normal:?}\noffset_mm = {offset:?}"
+            ),
+        };
+    }
+    if let Some(d) = &cell.data_columns {
+        let _ = writeln!(s.tail, "\n[data]\njoints = {:?}", d.joints);
+    }
+    to_cell_toml_with(spec, &s)
+}
+
+/// The `[parameters]` body: `free = "auto"` (or `"all"`, as the cell had it), the cell's
+/// measurement type, the parameters the cell fixed and the priors it gave, for every one the
+/// exported model has under the same name.
+fn parameters(cell: &Cell, exported: &Model) -> String {
+    let declared = cell.declared_model();
+    let mut fixed = Vec::new();
+    let mut priors = Vec::new();
+    for p in declared.registry.iter() {
+        if exported.registry.index_of(&p.name).is_none() {
+            continue;
+        }
+        match p.status {
+            Status::Fixed => fixed.push(format!("{:?}", p.name)),
+            Status::Prior { sigma } => priors.push(format!(
+                "{:?} = {{ sigma_{} = {:?} }}",
+                p.name,
+                if p.unit == Unit::Rad { "deg" } else { "mm" },
+                sigma * p.unit.display_factor()
+            )),
+            Status::Free => {}
+        }
+    }
+    let free = if cell.auto_free { "auto" } else { "all" };
+    let measurement = format!("{:?}", cell.measurement).to_lowercase();
+    let mut out = format!("free = \"{free}\"\nmeasurement = \"{measurement}\"\n");
+    if !fixed.is_empty() {
+        let _ = writeln!(out, "fixed = [{}]", fixed.join(", "));
+    }
+    if !priors.is_empty() {
+        let _ = writeln!(out, "priors = {{ {} }}", priors.join(", "));
+    }
+    out
+}
