@@ -198,11 +198,27 @@ fn dh_and_mdh_regroup_exactly() {
     }
 }
 
+/// The paper robot's Hayati link j2 (parallel axes 2–3) regroups into modified DH with β:
+/// `Tx(a) Rx(α) Ry(β)` leads link j3, which becomes `mdh_beta` (issue 10, item 8).
+#[test]
+fn a_hayati_link_regroups_into_modified_dh_with_beta() {
+    let mut paper = robot("paper");
+    let j2 = paper.links.iter().position(|l| l.name == "j2").unwrap();
+    paper.links[j2].geometry.values[3] = 0.05f64.to_radians();
+    let mdh = dh_to_mdh(&paper).unwrap();
+    let j3 = mdh.links.iter().find(|l| l.name == "j3").unwrap();
+    assert_eq!(j3.geometry.convention, Convention::MdhBeta);
+    assert!((j3.geometry.values[2] - 0.05f64.to_radians()).abs() < 1e-15);
+    assert_same_fk(&paper, &mdh, 23, "paper");
+}
+
 #[test]
 fn regrouping_refuses_links_it_cannot_absorb() {
-    // paper: j1 (DH, a = 350 mm, α = 90°) is followed by the Hayati link j2.
-    let e = dh_to_mdh(&robot("paper")).unwrap_err().to_string();
-    assert!(e.contains("`j1`") && e.contains("`j2` (hayati)"), "{e}");
+    // An MDH link ahead of a DH link's trailing Tx(a) Rx(α) cannot take it.
+    let mut mixed = random_chain(Convention::Dh, 3, 3);
+    mixed.links[2].geometry = armcal::model::LinkGeometry::mdh(0.1, 20.0, 0.2, 30.0);
+    let e = dh_to_mdh(&mixed).unwrap_err().to_string();
+    assert!(e.contains("(mdh)"), "{e}");
     // A DH chain that ends without a frame6 cannot place the last Tx(a) Rx(α).
     let mut dh = random_chain(Convention::Dh, 3, 1);
     dh.links.pop();

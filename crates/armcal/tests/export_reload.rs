@@ -85,19 +85,28 @@ fn every_cell_export_identifies_again_to_the_same_fit() {
     }
 }
 
-/// A plain modified-DH export across the paper robot's parallel axes 2–3 holds a `d` of
-/// more than a hundred metres: the export warns; the robot's own convention does not.
+/// The modified-DH export of the paper robot (Hayati j2, parallel axes 2–3) uses β in link
+/// j3 and holds no far common normal; the plain common-normal form of the same calibrated
+/// robot holds a `d` of more than a hundred metres, which is warned about.
 #[test]
-fn an_ill_conditioned_export_is_warned_about() {
+fn a_modified_dh_export_uses_beta_and_an_ill_conditioned_form_is_warned_about() {
+    use armcal::model::convert::{dh_to_mdh, to_zrp, zrp_to_dh};
     let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
     let cell = Cell::from_file(&examples.join("paper-cell.toml")).unwrap();
     let mut p = cell.model.nominal();
     let beta = cell.model.registry.require("j2.beta").unwrap();
     p[beta] = 0.05f64.to_radians();
     let calibrated = cell.model.spec_at(&p);
-    let reference = Model::from_spec(&export_form(&cell.model.spec(), LinkForm::Mdh).unwrap());
+    let reference =
+        Model::from_spec(&export_form(&cell.model.spec(), LinkForm::Mdh).unwrap()).unwrap();
     let mdh = export_form(&calibrated, LinkForm::Mdh).unwrap();
-    let warnings = suspicious_values(&reference.unwrap(), &mdh).unwrap();
+    let j3 = mdh.links.iter().find(|l| l.name == "j3").unwrap();
+    assert_eq!(j3.geometry.convention, armcal::model::Convention::MdhBeta);
+    let none = suspicious_values(&reference, &mdh).unwrap();
+    assert!(none.is_empty(), "{none:?}");
+    let model = Model::from_spec(&calibrated).unwrap();
+    let plain = dh_to_mdh(&zrp_to_dh(&to_zrp(&model, &p), None).unwrap()).unwrap();
+    let warnings = suspicious_values(&reference, &plain).unwrap();
     assert!(
         warnings
             .iter()

@@ -15,7 +15,7 @@
 use crate::model::chain::{LinkSpec, Model, ModelSpec};
 use crate::model::kinematics::{forward_kinematics, Data};
 use crate::model::link::{Convention, JointKind, LinkGeometry};
-use crate::model::pose::{rot_x, rot_z, Pose};
+use crate::model::pose::{rot_x, rot_y, rot_z, Pose};
 use crate::model::registry::Unit;
 use crate::Error;
 use nalgebra::Vector3;
@@ -49,43 +49,68 @@ fn frame6_geometry(p: &Pose<f64>) -> LinkGeometry {
 /// Standard DH → Craig's modified DH. Each DH link `Rz(θ+q) Tz(d) Tx(a) Rx(α)` becomes the
 /// MDH link `Rx(α′) Tx(a′) Rz(θ+q) Tz(d)` whose `α′, a′` are the previous DH link's `α, a`
 /// (zero for the first one); the `Tx(a) Rx(α)` of a DH link followed by a fixed `frame6`
-/// (typically the tool) is multiplied into that frame from the left.
+/// (typically the tool) is multiplied into that frame from the left. A revolute Hayati link
+/// `Rz(θ+q) Tx(a) Rx(α) Ry(β)` (nearly parallel axes, book §2.6) regroups the same way with
+/// `d = 0`: its `Tx(a) Rx(α) Ry(β) = Rx(α) Tx(a) Ry(β)` leads the next link, which becomes
+/// the modified-DH link with β, `Rx(α) Tx(a) Ry(β) Rz(θ+q) Tz(d)` — so the modified-DH form
+/// of a complete model is complete too, with no far common normal.
 ///
-/// Errors when a DH link with non-zero `a` or `α` is followed by anything but a DH link or
-/// a fixed `frame6` (e.g. a Hayati link `Rz Tx Rx Ry`, which cannot absorb `Rx(α) Tx(a)` in
-/// front of its `Rz`), or ends the chain.
+/// Errors when a DH or Hayati link with a non-zero trailing part is followed by anything but
+/// a DH link or a fixed `frame6`, or ends the chain.
 pub fn dh_to_mdh(spec: &ModelSpec) -> Result<ModelSpec, Error> {
     let mut links = Vec::with_capacity(spec.links.len());
-    // The `Tx(a) Rx(α)` left over by the last DH link (only when non-zero) and its name.
-    let mut pending: Option<(f64, f64, &str)> = None;
+    // The `Tx(a) Rx(α) Ry(β)` left over by the last DH or Hayati link (only when non-zero)
+    // and its name.
+    let mut pending: Option<(f64, f64, f64, &str)> = None;
     for l in &spec.links {
         let g = &l.geometry;
-        match g.convention {
-            Convention::Dh => {
-                let (a0, alpha0) = pending.map_or((0.0, 0.0), |p| (p.0, p.1));
-                let (theta, d, a, alpha) = (g.values[0], g.values[1], g.values[2], g.values[3]);
+        let kind = l.joint.as_ref().map(|j| j.kind);
+        let leftover = match (g.convention, kind) {
+            (Convention::Dh, _) => Some((g.values[0], g.values[1], g.values[2], g.values[3], 0.0)),
+            (Convention::Hayati, Some(JointKind::Revolute)) => {
+                Some((g.values[0], 0.0, g.values[1], g.values[2], g.values[3]))
+            }
+            _ => None,
+        };
+        match leftover {
+            Some((theta, d, a, alpha, beta)) => {
+                let (a0, alpha0, beta0) = pending.map_or((0.0, 0.0, 0.0), |p| (p.0, p.1, p.2));
+                let geometry = if beta0 == 0.0 {
+                    LinkGeometry::mdh(alpha0, a0, theta, d)
+                } else {
+                    LinkGeometry::mdh_beta(alpha0, a0, beta0, theta, d)
+                };
                 links.push(LinkSpec {
-                    geometry: LinkGeometry::mdh(alpha0, a0, theta, d),
+                    geometry,
                     ..l.clone()
                 });
-                pending = (a != 0.0 || alpha != 0.0).then_some((a, alpha, l.name.as_str()));
+                pending = (a != 0.0 || alpha != 0.0 || beta != 0.0).then_some((
+                    a,
+                    alpha,
+                    beta,
+                    l.name.as_str(),
+                ));
             }
-            Convention::Frame6 if pending.is_some() => {
-                let (a, alpha, _) = pending.take().expect("checked");
+            None if g.convention == Convention::Frame6 && pending.is_some() => {
+                let (a, alpha, beta, _) = pending.take().expect("checked");
+                let screw = x_screw(a, alpha).compose(&Pose {
+                    rot: rot_y(beta),
+                    trans: Vector3::zeros(),
+                });
                 links.push(LinkSpec {
-                    geometry: frame6_geometry(&x_screw(a, alpha).compose(&frame6_pose(g))),
+                    geometry: frame6_geometry(&screw.compose(&frame6_pose(g))),
                     ..l.clone()
                 });
             }
-            _ => {
-                if let Some((a, alpha, from)) = pending {
+            None => {
+                if let Some((a, alpha, _, from)) = pending {
                     return Err(leftover_error(from, a, alpha, Some(l)));
                 }
                 links.push(l.clone());
             }
         }
     }
-    if let Some((a, alpha, from)) = pending {
+    if let Some((a, alpha, _, from)) = pending {
         return Err(leftover_error(from, a, alpha, None));
     }
     Ok(ModelSpec {
@@ -546,7 +571,6 @@ fn book_type3_to(m: &Pose<f64>, tz_nom: f64) -> LinkGeometry {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::pose::rot_y;
 
     #[test]
     fn wrap_is_half_open() {

@@ -185,15 +185,18 @@ pub fn to_table_csv(spec: &ModelSpec) -> String {
 
 /// `spec` in the link form of an export, forward kinematics unchanged: `Zrp` the
 /// zero-reference model; `Dh` DH links by the common normals, Hayati links where `spec` has
-/// them (book §6.3.4); `Mdh` Craig's modified DH of the pure DH form (a Hayati link cannot be
-/// regrouped into modified DH); anything else `spec` as it is.
+/// them (book §6.3.4); `Mdh` Craig's modified DH of that DH form, with β where it has a
+/// Hayati link ([`convert::dh_to_mdh`]); anything else `spec` as it is.
 pub fn export_form(spec: &ModelSpec, form: LinkForm) -> Result<ModelSpec, Error> {
     let model = Model::from_spec(spec)?;
     let zrp = || convert::to_zrp(&model, &model.nominal());
     Ok(match form {
         LinkForm::Zrp => zrp(),
         LinkForm::Dh => convert::zrp_to_dh(&zrp(), Some(spec))?,
-        LinkForm::Mdh => convert::dh_to_mdh(&convert::zrp_to_dh(&zrp(), None)?)?,
+        // The DH form with Hayati links regroups with β; where it cannot (a book Type 3
+        // last link), the pure DH form.
+        LinkForm::Mdh => convert::dh_to_mdh(&convert::zrp_to_dh(&zrp(), Some(spec))?)
+            .or_else(|_| convert::dh_to_mdh(&convert::zrp_to_dh(&zrp(), None)?))?,
         LinkForm::Auto | LinkForm::AsGiven => spec.clone(),
     })
 }
