@@ -67,6 +67,20 @@ fn every_cell_export_identifies_again_to_the_same_fit() {
         let again = identify(&back, &data, &opts, &mut Silent).unwrap();
         assert!(again.solver.status.is_converged(), "{what}");
         assert_eq!(again.free.len(), est.free.len(), "{what}: {:?}", again.free);
+        if form == LinkForm::AsGiven {
+            // The same parameterisation: the same estimate, parameter by parameter.
+            for p in &again.parameters {
+                let q = est.parameters.iter().find(|q| q.name == p.name).unwrap();
+                let tol = 1e-9 * q.estimate.abs().max(1.0);
+                assert!(
+                    (p.estimate - q.estimate).abs() <= tol,
+                    "{}: {} vs {}",
+                    p.name,
+                    p.estimate,
+                    q.estimate
+                );
+            }
+        }
         let (c0, c1) = (est.uncertainty.chi2, again.uncertainty.chi2);
         assert!((c0 - c1).abs() <= 1e-9 * c0, "{what}: χ² {c1} vs {c0}");
         for (a, b) in again
