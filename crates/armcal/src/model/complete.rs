@@ -36,8 +36,8 @@ use serde::{Deserialize, Serialize};
 /// 30° makes the same choice on them; 10° keeps both forms far from their singularities.
 pub const NEAR_PARALLEL_DEG: f64 = 10.0;
 
-/// Below this `|sin α|` a DH link's axes are exactly parallel, so its `Tz(d)` commutes with
-/// `Tx(a) Rx(α)` and can move into the next link (see [`complete_minimal`]).
+/// Below this `|sin α|` a revolute Hayati link's axes are exactly parallel, so a `Tz(s)` in
+/// front of it commutes through `Rz Tx Rx(α)` into `Tz(s cos α)` after it (`dh_to_hayati`).
 const EXACTLY_PARALLEL: f64 = 1e-12;
 
 /// The link forms a cell can ask for (`[robot] convention`).
