@@ -129,4 +129,11 @@ fn a_modified_dh_export_uses_beta_and_an_ill_conditioned_form_is_warned_about() 
     );
     let own = suspicious_values(&cell.model, &calibrated).unwrap();
     assert!(own.is_empty(), "{own:?}");
+    // A model already in modified DH with β (a user's MDH table under `auto`) exports to
+    // modified DH with β again.
+    let again = export_form(&mdh, LinkForm::Mdh).unwrap();
+    let j3 = again.links.iter().find(|l| l.name == "j3").unwrap();
+    assert_eq!(j3.geometry.convention, armcal::model::Convention::MdhBeta);
+    let none = suspicious_values(&reference, &again).unwrap();
+    assert!(none.is_empty(), "{none:?}");
 }

@@ -440,7 +440,8 @@ pub(crate) fn link_pose(g: &LinkGeometry, kind: Option<JointKind>) -> Pose<f64> 
 /// `base` and `tool`; joint links keep theirs):
 /// * `base`: a fixed DH link from the world z axis to joint axis 1 (the book's `B→0`);
 /// * one link per joint `i < n` from axis `i` to axis `i+1`, driven by joint `i`: DH
-///   (eqs. 6.21–6.30), or Hayati (eqs. 6.31–6.40) where `nominal` has a Hayati link;
+///   (eqs. 6.21–6.30), or Hayati (eqs. 6.31–6.40) where `nominal` has a Hayati link there or
+///   a modified-DH link with β for joint `i+1`;
 /// * the last joint: `Rz(θ+q)` as a DH link with `d = a = α = 0` and `θ` the nominal's, or,
 ///   if `nominal`'s last joint link is a book Type 3 (eq. 6.4), a Type 3 link that takes
 ///   the tool too;
@@ -502,8 +503,13 @@ pub fn zrp_to_dh(spec: &ModelSpec, nominal: Option<&ModelSpec>) -> Result<ModelS
     for (i, (ls, axis)) in joint_links.iter().zip(&axes).enumerate() {
         let kind = axis.kind;
         let nominal_link = nominal_joints.get(i).map(|l| &l.geometry);
+        // A modified-DH link with β after this joint marks the same nearly parallel pair.
+        let next_has_beta = nominal_joints
+            .get(i + 1)
+            .is_some_and(|l| l.geometry.convention == Convention::MdhBeta);
         let form = match nominal_link.map(|g| g.convention) {
             Some(Convention::Hayati) if kind == JointKind::Revolute && i + 1 < n => Form::Hayati,
+            Some(_) if next_has_beta && kind == JointKind::Revolute => Form::Hayati,
             Some(Convention::BookType3) if kind == JointKind::Revolute && i + 1 == n => {
                 Form::BookType3
             }
