@@ -13,7 +13,7 @@ use armcal::model::{forward_kinematics, Data};
 use armcal::sim::{perturbed_truth, Perturbation};
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 
-const CELL: &str = include_str!("../../../examples/paper-cell.toml");
+use armcal::cell::builtin::PAPER_CELL as CELL;
 
 fn ik(c: &mut Criterion) {
     let cell = Cell::from_toml(CELL, "paper-cell.toml", std::path::Path::new(".")).expect("cell");

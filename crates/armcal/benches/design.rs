@@ -10,8 +10,8 @@ use armcal::cell::Cell;
 use armcal::design::plan::{plan, PlanSettings};
 use criterion::{criterion_group, criterion_main, Criterion};
 
-const CELL: &str = include_str!("../../../examples/paper-cell.toml");
-const CELL_OBSTACLES: &str = include_str!("../../../examples/paper-cell-obstacles.toml");
+use armcal::cell::builtin::PAPER_CELL as CELL;
+use armcal::cell::builtin::PAPER_CELL_OBSTACLES as CELL_OBSTACLES;
 
 fn design(c: &mut Criterion) {
     let mut group = c.benchmark_group("plan");

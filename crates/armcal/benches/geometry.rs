@@ -8,7 +8,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::Vector3;
 use std::hint::black_box;
 
-const CELL: &str = include_str!("../../../examples/paper-cell-obstacles.toml");
+use armcal::cell::builtin::PAPER_CELL_OBSTACLES as CELL;
 
 fn geometry(c: &mut Criterion) {
     // A general pair, a parallel pair and a point–segment pair, as capsule checks meet them.

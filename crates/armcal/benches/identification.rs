@@ -7,7 +7,7 @@ use armcal::model::identifiability::random_configurations;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use criterion::{criterion_group, criterion_main, Criterion};
 
-const CELL: &str = include_str!("../../../examples/paper-cell.toml");
+use armcal::cell::builtin::PAPER_CELL as CELL;
 
 fn identification(c: &mut Criterion) {
     let cell =

@@ -7,7 +7,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::DMatrix;
 use std::hint::black_box;
 
-const CELL: &str = include_str!("../../../examples/paper-cell.toml");
+use armcal::cell::builtin::PAPER_CELL as CELL;
 
 fn paper_cell() -> Cell {
     Cell::from_toml(CELL, "paper-cell.toml", std::path::Path::new(".")).expect("paper cell")

@@ -11,7 +11,7 @@ use nalgebra::{Matrix4, Vector3, Vector4};
 use serde_json::Value;
 use std::path::Path;
 
-const CELL: &str = include_str!("../../../examples/paper-cell-obstacles.toml");
+use armcal::cell::builtin::PAPER_CELL_OBSTACLES as CELL;
 
 fn cell() -> Cell {
     Cell::from_toml(CELL, "paper-cell-obstacles.toml", Path::new(".")).expect("paper cell")

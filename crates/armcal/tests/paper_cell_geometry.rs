@@ -12,7 +12,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::Path;
 
-const CELL: &str = include_str!("../../../examples/paper-cell-obstacles.toml");
+use armcal::cell::builtin::PAPER_CELL_OBSTACLES as CELL;
 
 fn cell() -> Cell {
     Cell::from_toml(CELL, "paper-cell-obstacles.toml", Path::new(".")).expect("paper cell")

@@ -3,6 +3,7 @@
 //! User files are in mm and degrees unless a field's suffix says otherwise (`_m`, `_rad`).
 //! Every error names the file, the line and the field.
 
+pub mod builtin;
 pub mod export;
 mod raw;
 

@@ -714,7 +714,7 @@ mod tests {
     use super::*;
     use std::path::Path;
 
-    const CELL: &str = include_str!("../../../../examples/paper-cell-obstacles.toml");
+    use crate::cell::builtin::PAPER_CELL_OBSTACLES as CELL;
 
     fn cell() -> Cell {
         Cell::from_toml(CELL, "paper-cell-obstacles.toml", Path::new(".")).expect("paper cell")

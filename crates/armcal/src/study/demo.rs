@@ -17,7 +17,7 @@ use crate::sim::{perturbed_truth, simulate, Perturbation};
 use crate::Error;
 use serde::{Deserialize, Serialize};
 
-const CELL: &str = include_str!("../../../../examples/paper-cell-obstacles.toml");
+use crate::cell::builtin::PAPER_CELL_OBSTACLES as CELL;
 
 /// One design's campaign.
 #[derive(Clone, Debug, Serialize, Deserialize)]

@@ -18,8 +18,7 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::time::Instant;
 
-const CELL: &str = include_str!("../../../../examples/paper-cell.toml");
-const CELL_OBSTACLES: &str = include_str!("../../../../examples/paper-cell-obstacles.toml");
+use crate::cell::builtin::{PAPER_CELL as CELL, PAPER_CELL_OBSTACLES as CELL_OBSTACLES};
 
 /// The paper cell with another robot of the library.
 pub fn cell_for(robot: &str, collisions: bool) -> Result<Cell, Error> {
