@@ -1,7 +1,7 @@
 //! Measurement blocks of every kind mixed in one problem: residual-row derivatives against
 //! finite differences, and exact recovery of the truth from noise-free mixed data.
 
-mod common;
+use crate::common;
 use armcal::identify::*;
 use armcal::measure::{Dataset, Measurement, MeasurementKind, NoiseModel};
 use armcal::model::identifiability::random_configurations;

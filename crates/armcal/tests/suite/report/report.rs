@@ -1,7 +1,7 @@
 //! The HTML report: ellipse geometry, figure builders, escaping, self-containedness, the
 //! figure count, document recognition and the constraint margins of the design file.
 
-mod common;
+use crate::common;
 use armcal::cell::Cell;
 use armcal::identify::{identify, Estimate, IdentifyOptions, Silent};
 use armcal::model::identifiability::random_configurations;

@@ -2,7 +2,7 @@
 //! to 1e-9 mm and their rotations to 1e-12 on random configurations, for the paper robot,
 //! the book's PUMA 560 (both models) and random chains. Round trips recover the parameters.
 
-mod common;
+use crate::common;
 use armcal::model::convert::{dh_to_mdh, mdh_to_dh, to_zrp, zrp_to_dh};
 use armcal::model::*;
 use armcal::robots;

@@ -1,8 +1,8 @@
 //! `simulate` → `identify` → `predict` through the binary, with the file-safety rules.
 
-use std::path::Path;
-mod common;
+use crate::common;
 use common::{armcal, identify_paper_cell, scratch, simulate_paper_cell};
+use std::path::Path;
 
 /// Running `args` again fails because its output exists, naming `--force`; with `--force`
 /// appended it succeeds.

@@ -1,7 +1,7 @@
 //! Identification against known truth in simulation: exact recovery, agreement of the
 //! solvers, honest covariance (Monte Carlo), both C_s formulas.
 
-mod common;
+use crate::common;
 use armcal::cell::Cell;
 use armcal::identify::*;
 use armcal::model::identifiability::random_configurations;

@@ -2,7 +2,7 @@
 //! from the tables in `tests/data/book/` (see its README). Lengths are compared in inches
 //! and angles in degrees, the book's units.
 
-mod common;
+use crate::common;
 use armcal::model::convert::zrp_to_dh;
 use armcal::model::*;
 use armcal::robots;
@@ -13,7 +13,7 @@ use rand::Rng;
 
 macro_rules! table {
     ($file:literal) => {
-        include_str!(concat!("data/book/", $file))
+        include_str!(concat!("../../data/book/", $file))
     };
 }
 

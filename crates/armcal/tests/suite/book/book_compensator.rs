@@ -1,7 +1,7 @@
 //! The book's optimal (LQR) compensator and CMAC (Mooring, Roth, Driels 1991, §5.3 and
 //! §5.4.2; book checks 9 and 10 of docs/book-notes.md).
 
-mod common;
+use crate::common;
 use armcal::compensate::cmac::{book_memory_words, Cmac, CmacSettings};
 use armcal::compensate::ik::{damped_step, task_jacobian_columns};
 use armcal::compensate::lqr::{
@@ -482,7 +482,7 @@ fn unit_grid_cmac(resolution: usize, levels: usize, outputs: usize) -> Cmac {
 #[test]
 fn cmac_output_of_table_5_8() {
     // Book Table 5.8: the output is the sum of the Q = 4 selected weights, 34.1.
-    let table = include_str!("data/book/table_5_8_cmac_weights.csv");
+    let table = include_str!("../../data/book/table_5_8_cmac_weights.csv");
     let mut weights = Vec::new();
     let mut printed_sum = None;
     for line in table.lines().skip(1) {

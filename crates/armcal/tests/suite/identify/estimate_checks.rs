@@ -3,7 +3,7 @@
 //! unverified estimate is refused, and a cell that differs from the estimate's is an error
 //! naming the difference.
 
-mod common;
+use crate::common;
 use armcal::cell::Cell;
 use armcal::identify::*;
 use armcal::measure::{Dataset, NoiseModel};

@@ -1,9 +1,9 @@
 //! `armcal compensate` with bad input (rows outside the joint limits, unreachable Cartesian
 //! targets, an estimate of another robot) and with the nonparametric correction.
 
-use std::path::Path;
-mod common;
+use crate::common;
 use common::{armcal, identify_paper_cell, scratch, simulate_paper_cell};
+use std::path::Path;
 
 /// The data rows of `text` whose `pose_id` is `id`.
 fn row<'a>(text: &'a str, id: &str) -> &'a str {

@@ -1,6 +1,6 @@
 //! The `armcal` binary end to end.
 
-mod common;
+use crate::common;
 use common::armcal;
 
 #[test]

@@ -2,7 +2,7 @@
 //! (same residuals, consistently transformed covariance), and a robust fit's variance
 //! factor and χ² test on the measurements it kept.
 
-mod common;
+use crate::common;
 
 use armcal::cell::Cell;
 use armcal::identify::*;

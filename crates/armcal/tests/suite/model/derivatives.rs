@@ -1,7 +1,7 @@
 //! Every analytic derivative against central finite differences, for every convention
 //! (revolute and prismatic), on random configurations. Relative error < 1e-6.
 
-mod common;
+use crate::common;
 use armcal::model::*;
 use common::*;
 use nalgebra::DMatrix;

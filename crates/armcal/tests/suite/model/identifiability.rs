@@ -1,6 +1,6 @@
 //! Completeness counts (book check 1) and the numerical identifiability analysis.
 
-mod common;
+use crate::common;
 use armcal::cell::Cell;
 use armcal::model::identifiability::{analyze, IdentifiabilityOptions, Measurement};
 use armcal::model::*;

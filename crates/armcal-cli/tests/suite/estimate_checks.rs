@@ -3,9 +3,9 @@
 //! unconverged one unless `--accept-unconverged`, and then every file it writes says so;
 //! a cell with other geometry than the estimate's is refused with the difference named.
 
-use std::path::{Path, PathBuf};
-mod common;
+use crate::common;
 use common::{armcal, identify_paper_cell, scratch, simulate_paper_cell};
+use std::path::{Path, PathBuf};
 
 fn s(p: &Path) -> String {
     p.to_str().unwrap().to_string()

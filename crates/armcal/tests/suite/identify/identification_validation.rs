@@ -1,7 +1,7 @@
 //! Validation the user controls: a held-out split recorded by the data file's pose ids, the
 //! user's own test file, the frames-only row of a frames-only cell, and bad fractions.
 
-mod common;
+use crate::common;
 use armcal::identify::*;
 use armcal::measure::Dataset;
 use armcal::model::identifiability::random_configurations;

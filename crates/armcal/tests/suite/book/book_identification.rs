@@ -34,7 +34,7 @@ use std::sync::OnceLock;
 
 macro_rules! table {
     ($file:literal) => {
-        include_str!(concat!("data/book/", $file))
+        include_str!(concat!("../../data/book/", $file))
     };
 }
 

@@ -1,0 +1,9 @@
+//! The `armcal` binary's tests in one test binary, a module per area.
+
+mod common;
+
+mod browser;
+mod cli;
+mod compensate_cli;
+mod estimate_checks;
+mod workflow;

@@ -1,0 +1,54 @@
+//! armcal's integration tests in one binary (it links the crate once), a module per area:
+//! `cargo test -p armcal --test suite AREA::` runs one area, e.g. `design::`.
+
+mod common;
+
+mod model {
+    mod cell_file;
+    mod conversions;
+    mod derivatives;
+    mod export_reload;
+    mod exports;
+    mod identifiability;
+    mod robots;
+}
+mod identify {
+    mod estimate_branch;
+    mod estimate_checks;
+    mod honest_free_set;
+    mod identification;
+    mod identification_input;
+    mod identification_validation;
+    mod mixed_measurements;
+    mod priors_and_noise;
+}
+mod design {
+    mod design_bound;
+    mod design_exchange;
+    mod design_gradients;
+    mod design_monte_carlo;
+    mod design_plan;
+    mod design_refine;
+    mod paper_cell_geometry;
+}
+mod compensate {
+    mod compensation;
+    mod nonparametric;
+}
+mod book {
+    mod book_checks;
+    mod book_compensator;
+    mod book_identification;
+    mod study_puma;
+}
+mod real_data {
+    mod motoman_calibration;
+    mod motoman_nominal;
+}
+mod report {
+    mod cell_view;
+    mod report;
+}
+mod repository {
+    mod builtin_cells;
+}
