@@ -1,7 +1,7 @@
 //! The paper's cells, built into the library (the demo, the paper study and the tests start
 //! from them). The files live inside the crate (`crates/armcal/cells/`) so the packaged crate
 //! is self-contained; `examples/` holds the same files for users to copy, and a test
-//! (`tests/builtin_cells.rs`) keeps the two byte-identical.
+//! (`tests/suite/repository/builtin_cells.rs`) keeps the two byte-identical.
 
 /// The paper's cell without obstacles (`examples/paper-cell.toml`): joint limits and the
 /// tracker's incidence limit (paper §5.1).

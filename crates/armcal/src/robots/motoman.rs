@@ -23,7 +23,7 @@
 //! parameters keep the toolbox's names and values and can be freed one by one; the `tool`
 //! frame origin is the reflector centre.
 //!
-//! Verified against the tracker data (`tests/motoman_nominal.rs`): after fitting only the
+//! Verified against the tracker data (`tests/suite/real_data/motoman_nominal.rs`): after fitting only the
 //! tracker-to-base transform the nominal chains reproduce the 6×6×6 grids to about 0.35 mm RMS
 //! for both arms, and reversing any one arm joint costs 9 mm RMS or more. The torso row and
 //! the reflector offset cannot be checked with these data: E and the other arm do not move,
