@@ -102,7 +102,7 @@ fn infeasible_report(
     t0: Instant,
 ) -> PlanReport {
     let draws = 20_000;
-    let qs = crate::model::identifiability::random_configurations(&d.model, draws, settings.seed);
+    let qs = crate::model::random_configurations(&d.model, draws, settings.seed);
     let mut ws = set.workspace();
     let mut values = vec![0.0; set.len()];
     let mut counts = vec![0usize; set.len()];
