@@ -1,5 +1,6 @@
 //! Robust estimation with gross errors, and bad input: clear errors, never a panic.
 
+use armcal::accuracy::ErrorStats;
 use armcal::cell::Cell;
 use armcal::identify::*;
 use armcal::measure::{csv, MeasurementKind};

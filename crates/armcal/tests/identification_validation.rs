@@ -2,6 +2,7 @@
 //! user's own test file, the frames-only row of a frames-only cell, and bad fractions.
 
 mod common;
+use armcal::accuracy::ErrorStats;
 use armcal::identify::*;
 use armcal::measure::Dataset;
 use armcal::model::random_configurations;

@@ -19,11 +19,10 @@ pub use lm::{levenberg_marquardt, LmSettings};
 pub use problem::Problem;
 pub use robust::{robust_fit, Loss, Outlier};
 pub use solver::{Observer, Silent, Solution, Status, Tolerances};
-pub use uncertainty::{
-    Chi2Outcome, ErrorStats, Observability, ParameterUncertainty, TcpCovariance,
-};
+pub use uncertainty::{Chi2Outcome, Observability, ParameterUncertainty, TcpCovariance};
 pub use verdicts::{Chi2Verdict, IdentifiabilityVerdict, Verdicts};
 
+use crate::accuracy::ErrorStats;
 use crate::cell::Cell;
 use crate::measure::{Dataset, MeasurementKind};
 use crate::model::identifiability::{Identifiability, IdentifiabilityOptions, Measurement};

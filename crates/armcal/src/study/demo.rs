@@ -4,12 +4,13 @@
 //! held-out poses. Every intermediate file and the HTML report are returned for writing; the
 //! same seed gives the same files (solver times are left out of them).
 
+use crate::accuracy::ErrorStats;
 use crate::compensate::program::filter_joint_program;
 use crate::compensate::IkSettings;
 use crate::design::baselines::random_feasible;
 use crate::design::plan::{constraint_set, plan, CellConstraints, PlanSettings};
 use crate::design::DesignModel;
-use crate::identify::{identify, ErrorStats, Estimate, IdentifyOptions, Silent};
+use crate::identify::{identify, Estimate, IdentifyOptions, Silent};
 use crate::measure::csv;
 use crate::model::{forward_kinematics, observed_position, Data, Observed};
 use crate::report::{self, DesignRecord, Document, Input, ReportContent};
