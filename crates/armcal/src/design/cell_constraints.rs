@@ -27,7 +27,7 @@
 //!
 //! **Capsule distances.** With `(s, t)` the closest-point parameters and `n` the unit vector
 //! from the second segment's closest point `Q` to the first's `P`, the derivative of the
-//! segment distance is `n · (Ṗ − Q̇)` (see [`segment_distance`](super::segment_distance)); for
+//! segment distance is `n · (Ṗ − Q̇)` (see [`segment_distance`](crate::geometry::segment_distance())); for
 //! two robot capsules only the joints between their frames contribute (a common joint moves
 //! both rigidly and `n · (ω × (P − Q)) = 0`).
 //!
@@ -64,7 +64,7 @@
 //! has no instrument frame; incidence also needs `instrument.max_incidence` in the cell.
 
 use crate::cell::{half_space_unit_normal, Cell, Obstacle};
-use crate::geometry::segment_distance::{point_segment_distance, segment_distance};
+use crate::geometry::{point_segment_distance, segment_distance};
 use crate::model::{forward_kinematics, Data, Model, Twist};
 use crate::Error;
 use nalgebra::Vector3;
@@ -113,16 +113,67 @@ impl Default for ConstraintOptions {
     }
 }
 
-/// A robot capsule compiled against the model.
+/// A robot capsule of a cell compiled against its model.
 #[derive(Clone, Debug)]
-struct RobotCapsule {
-    link: usize,
+pub struct RobotCapsule {
+    /// The chain frame (link index) it moves with.
+    pub link: usize,
     /// Joints `0..joints` move it.
-    joints: usize,
-    a: Vector3<f64>,
-    b: Vector3<f64>,
-    radius: f64,
-    label: String,
+    pub joints: usize,
+    /// Endpoints in the frame of `link` (mm).
+    pub a: Vector3<f64>,
+    pub b: Vector3<f64>,
+    /// Radius (mm).
+    pub radius: f64,
+    /// `frame#k`: the k-th capsule on that frame, as the constraint names call it.
+    pub label: String,
+}
+
+impl RobotCapsule {
+    /// World endpoints `T_f(q) a`, `T_f(q) b` at the configuration placed in `data` by
+    /// [`forward_kinematics`].
+    #[inline]
+    pub fn place(&self, data: &Data<f64>) -> [Vector3<f64>; 2] {
+        let f = &data.frames[self.link];
+        [f.transform_point(&self.a), f.transform_point(&self.b)]
+    }
+}
+
+/// The robot capsules of `cell`, in the cell's order, compiled against its model; an error
+/// names a capsule on a frame the model does not have.
+pub fn robot_capsules(cell: &Cell) -> Result<Vec<RobotCapsule>, Error> {
+    let model = &cell.model;
+    // joints_through[L]: number of joints in links 0..=L (joints are numbered in chain
+    // order), i.e. the joints that move frame L are 0..joints_through[L].
+    let mut joints_through = Vec::with_capacity(model.links.len());
+    let mut count = 0;
+    for l in &model.links {
+        if l.joint.is_some() {
+            count += 1;
+        }
+        joints_through.push(count);
+    }
+    let mut per_frame = std::collections::HashMap::<&str, usize>::new();
+    let mut capsules = Vec::with_capacity(cell.capsules.len());
+    for c in &cell.capsules {
+        let link = model.link_index(&c.frame).ok_or_else(|| {
+            Error::Model(format!(
+                "capsule on frame `{}`: the model has no such chain frame",
+                c.frame
+            ))
+        })?;
+        let k = per_frame.entry(c.frame.as_str()).or_insert(0);
+        capsules.push(RobotCapsule {
+            link,
+            joints: joints_through[link],
+            a: Vector3::from(c.a),
+            b: Vector3::from(c.b),
+            radius: c.radius,
+            label: format!("{}#{}", c.frame, k),
+        });
+        *k += 1;
+    }
+    Ok(capsules)
 }
 
 #[derive(Clone, Debug)]
@@ -214,43 +265,17 @@ impl ConstraintSet {
             )));
         }
         let model = cell.model.clone();
-        // joints_through[L]: number of joints in links 0..=L (joints are numbered in chain
-        // order), i.e. the joints that move frame L are 0..joints_through[L].
-        let mut joints_through = Vec::with_capacity(model.links.len());
-        let mut count = 0;
-        for l in &model.links {
-            if l.joint.is_some() {
-                count += 1;
-            }
-            joints_through.push(count);
-        }
         let dof = model.dof();
-
-        let mut per_frame = std::collections::HashMap::<&str, usize>::new();
-        let mut capsules = Vec::new();
-        for c in &cell.capsules {
-            let link = model.link_index(&c.frame).ok_or_else(|| {
-                Error::Model(format!(
-                    "capsule on frame `{}`: the model has no such chain frame",
-                    c.frame
-                ))
-            })?;
-            if !(c.radius.is_finite() && c.radius >= 0.0) {
-                return Err(Error::Model(format!(
-                    "capsule on frame `{}` has radius {}",
-                    c.frame, c.radius
-                )));
-            }
-            let k = per_frame.entry(c.frame.as_str()).or_insert(0);
-            capsules.push(RobotCapsule {
-                link,
-                joints: joints_through[link],
-                a: Vector3::from(c.a),
-                b: Vector3::from(c.b),
-                radius: c.radius,
-                label: format!("{}#{}", c.frame, k),
-            });
-            *k += 1;
+        let capsules = robot_capsules(cell)?;
+        if let Some(c) = cell
+            .capsules
+            .iter()
+            .find(|c| !(c.radius.is_finite() && c.radius >= 0.0))
+        {
+            return Err(Error::Model(format!(
+                "capsule on frame `{}` has radius {}",
+                c.frame, c.radius
+            )));
         }
         let mut obstacles = Vec::new();
         let mut obstacle_names = Vec::new();
@@ -479,9 +504,7 @@ impl ConstraintSet {
     fn place(&self, ws: &mut ConstraintWorkspace, params: &[f64], q: &[f64]) {
         forward_kinematics(&self.model, &mut ws.data, params, q);
         for (c, ends) in self.capsules.iter().zip(ws.ends.iter_mut()) {
-            let f = &ws.data.frames[c.link];
-            ends[0] = f.transform_point(&c.a);
-            ends[1] = f.transform_point(&c.b);
+            *ends = c.place(&ws.data);
         }
     }
 
@@ -700,9 +723,8 @@ fn reflector_carriers(
                     Reflector::Target(t) => data.targets[t].trans,
                     Reflector::Tool => data.tool().trans,
                 };
-                let f = &data.frames[c.link];
-                let (d, _) =
-                    point_segment_distance(&p, &f.transform_point(&c.a), &f.transform_point(&c.b));
+                let [a, b] = c.place(&data);
+                let (d, _) = point_segment_distance(&p, &a, &b);
                 d <= c.radius + beam_radius
             })
         })
