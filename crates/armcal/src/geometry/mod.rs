@@ -2,11 +2,14 @@
 //!
 //! One small module per query, in the style of parry:
 //! - [`segment_distance`]: closest points between two segments and the gradient of their
-//!   distance w.r.t. the endpoints (Ericson §5.1.9; the paper's eq. 21 and 23).
+//!   distance w.r.t. the endpoints (Ericson §5.1.9; the paper's eq. 21 and 23);
+//! - [`fit`]: plane, circle and line through points, with the covariance of the fitted
+//!   axis (book §4.6).
 //!
 //! The constraint set of a cell built from these (incidence, capsule–capsule, half-space,
 //! line of sight) is design work: [`crate::design::cell_constraints`].
 
+pub mod fit;
 pub mod segment_distance;
 
 pub use segment_distance::{point_segment_distance, segment_distance, SegmentDistance};

@@ -1,7 +1,9 @@
 //! Parameter identification with honest uncertainty (book ch. 4, paper eqs. 5–6, 13–19):
 //! Levenberg–Marquardt, Gauss–Newton, recursive (Kalman) estimation, robust IRLS, priors
-//! (MAP), parameter and TCP covariances, observability indices, held-out validation.
+//! (MAP), parameter and TCP covariances, observability indices, held-out validation; joint
+//! axes by circle point analysis.
 
+pub mod circle_point;
 pub mod fingerprint;
 pub mod gauss_newton;
 pub mod kalman;

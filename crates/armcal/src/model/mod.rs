@@ -1,7 +1,6 @@
 //! Kinematic models: conventions, chain, parameter registry, forward kinematics, exact
 //! Jacobians, identifiability, configuration sampling, conversions and URDF.
 
-pub mod axes;
 pub mod branch;
 pub mod chain;
 pub mod complete;
