@@ -535,11 +535,7 @@ pub fn identify(
     opts: &IdentifyOptions,
     observer: &mut dyn Observer,
 ) -> Result<Estimate, Error> {
-    let noise = cell
-        .instrument
-        .as_ref()
-        .map(|i| i.noise.clone())
-        .unwrap_or_default();
+    let noise = cell.noise();
     let split = Split::of(data, opts)?;
     let train = &split.train;
     let fit = fit_free_set(cell, train, &noise, opts, observer)?;

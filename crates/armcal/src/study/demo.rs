@@ -62,11 +62,7 @@ pub fn run_demo(seed: u64, progress: &dyn Fn(&str)) -> Result<Demo, Error> {
     let cell =
         crate::cell::Cell::from_toml(CELL, "paper-cell-obstacles.toml", std::path::Path::new("."))?;
     let model = &cell.model;
-    let noise = cell
-        .instrument
-        .as_ref()
-        .map(|i| i.noise.clone())
-        .unwrap_or_default();
+    let noise = cell.noise();
     let truth = perturbed_truth(model, &Perturbation::default(), seed);
     let mut files = vec![("cell.toml".to_string(), CELL.to_string())];
     let poses = 60;
