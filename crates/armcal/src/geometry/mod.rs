@@ -1,7 +1,7 @@
 //! Pure geometry for measurement-pose design (paper §2.2, §3.2): shapes in, numbers out.
 //!
 //! One small module per query, in the style of parry:
-//! - [`segment_distance`]: closest points between two segments and the gradient of their
+//! - [`segment_distance`](mod@segment_distance): closest points between two segments and the gradient of their
 //!   distance w.r.t. the endpoints (Ericson §5.1.9; the paper's eq. 21 and 23);
 //! - [`fit`]: plane, circle and line through points, with the covariance of the fitted
 //!   axis (book §4.6).

@@ -1,7 +1,7 @@
 //! The per-configuration constraint set of a cell for measurement-pose design (paper
 //! eq. 24b), every constraint written as `g(q) ≥ 0`, with its value and its exact gradient
 //! w.r.t. the joints (through the world joint twists of
-//! [`forward_kinematics`](crate::model::forward_kinematics); no finite differences).
+//! [`forward_kinematics`]; no finite differences).
 //!
 //! A joint twist `(ω_j, v_j)` moves a world point `x` on a link it drives with velocity
 //! `ẋ = ω_j × x + v_j`; joint `j` drives the chain frames from its own link onwards and the
@@ -64,7 +64,7 @@
 //! Constraints that need the tracker (incidence, line of sight) are left out when the model
 //! has no instrument frame; incidence also needs `instrument.max_incidence` in the cell.
 //!
-//! This file assembles the set from a cell ([`ConstraintSet::new`]); [`evaluate`] computes
+//! This file assembles the set from a cell ([`ConstraintSet::new`]); `evaluate.rs` computes
 //! values and gradients at a configuration.
 
 use crate::cell::{half_space_unit_normal, Cell, Obstacle};

@@ -5,10 +5,12 @@
 //! single leaf). Every joint on it becomes one link of the model, named after the URDF joint
 //! (`.` and `*`, which armcal reserves for parameter patterns, become `_`):
 //!
-//! - revolute, continuous, prismatic: a [`Convention::Urdf`] link, origin
-//!   `T(x, y, z) Rz(yaw) Ry(pitch) Rx(roll)` then a rotation about (translation along) the unit
-//!   `axis` by `q + offset`, offset 0; its joint carries the URDF joint's name and limits;
-//! - fixed: a [`Convention::Frame6`] link with the same origin (`Frame6` is the URDF origin).
+//! - revolute, continuous, prismatic: a [`Convention::Urdf`](crate::model::Convention::Urdf)
+//!   link, origin `T(x, y, z) Rz(yaw) Ry(pitch) Rx(roll)` then a rotation about (translation
+//!   along) the unit `axis` by `q + offset`, offset 0; its joint carries the URDF joint's
+//!   name and limits;
+//! - fixed: a [`Convention::Frame6`](crate::model::Convention::Frame6) link with the same
+//!   origin (`Frame6` is the URDF origin).
 //!
 //! URDF lengths are metres, armcal's millimetres. Limits: revolute `[lower, upper]` rad as
 //! given (an omitted limit, URDF ≥ 1.2, means ±[`CONTINUOUS_RANGE`]); continuous joints get
