@@ -8,7 +8,7 @@
 
 use armcal::cell::Cell;
 use armcal::compensate::{CalibratedIk, IkSettings, IkTarget};
-use armcal::model::identifiability::random_configurations;
+use armcal::model::random_configurations;
 use armcal::model::{forward_kinematics, Data};
 use armcal::sim::{perturbed_truth, Perturbation};
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};

@@ -3,7 +3,8 @@
 //! with obstacles (FK + 67 values + 67 × 6 Jacobian).
 
 use armcal::cell::Cell;
-use armcal::geometry::{segment_distance, ConstraintOptions, ConstraintSet};
+use armcal::design::{ConstraintOptions, ConstraintSet};
+use armcal::geometry::segment_distance;
 use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::Vector3;
 use std::hint::black_box;

@@ -3,7 +3,7 @@
 
 use armcal::cell::Cell;
 use armcal::identify::{levenberg_marquardt, LmSettings, Problem, Silent};
-use armcal::model::identifiability::random_configurations;
+use armcal::model::random_configurations;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use criterion::{criterion_group, criterion_main, Criterion};
 

@@ -5,11 +5,11 @@
 //! (1991) ("book") and Jost, Kudruss, Körkel & Walter (2017), optimum experimental design of
 //! laser-tracker measurement poses ("paper").
 
+pub mod accuracy;
 pub mod cell;
 pub mod compensate;
 pub mod design;
 pub mod error;
-pub mod evaluate;
 pub mod geometry;
 pub mod identify;
 pub mod measure;

@@ -2,7 +2,7 @@
 //! data file.
 
 use super::output::{load_cell, load_data, load_estimate, AcceptUnconverged};
-use armcal::evaluate::report::accuracy_report;
+use armcal::accuracy::report::accuracy_report;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]

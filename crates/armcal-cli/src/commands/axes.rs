@@ -4,8 +4,8 @@
 
 use super::output::{load_cell, load_data, write_new};
 use anyhow::bail;
+use armcal::identify::circle_point::{identify_axes, JointSweep};
 use armcal::measure::MeasurementKind;
-use armcal::model::axes::{identify_axes, JointSweep};
 use armcal::model::{forward_kinematics, Data, JointKind};
 use armcal::nalgebra::Vector3;
 use std::path::PathBuf;

@@ -54,17 +54,7 @@ fn joints_header(model: &Model) -> String {
     model
         .joints
         .iter()
-        .map(|j| {
-            format!(
-                "{}_{}",
-                j.name,
-                if j.kind == JointKind::Revolute {
-                    "deg"
-                } else {
-                    "mm"
-                }
-            )
-        })
+        .map(csv::joint_column)
         .collect::<Vec<_>>()
         .join(",")
 }

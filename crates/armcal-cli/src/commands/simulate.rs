@@ -51,11 +51,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         ..Perturbation::default()
     };
     let truth = perturbed_truth(model, &pert, a.seed);
-    let noise = cell
-        .instrument
-        .as_ref()
-        .map(|i| i.noise.clone())
-        .unwrap_or_default();
+    let noise = cell.noise();
     let mut data = simulate(
         model,
         &truth,

@@ -108,6 +108,15 @@ pub struct Cell {
 }
 
 impl Cell {
+    /// The instrument's noise model; [`NoiseModel::default`] for a cell without an
+    /// instrument.
+    pub fn noise(&self) -> NoiseModel {
+        self.instrument
+            .as_ref()
+            .map(|i| i.noise.clone())
+            .unwrap_or_default()
+    }
+
     /// Reads a cell file.
     pub fn from_file(path: &Path) -> Result<Cell, Error> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::File {

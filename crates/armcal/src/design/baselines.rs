@@ -55,7 +55,7 @@ pub fn strategy(model: &Model, s: Strategy, n: usize, seed: u64) -> Vec<Vec<f64>
             }
             out
         }
-        Strategy::S4 => crate::model::identifiability::random_configurations(model, n, seed),
+        Strategy::S4 => crate::model::random_configurations(model, n, seed),
     }
 }
 

@@ -51,11 +51,7 @@ impl DesignModel {
         };
         let working: Vec<Vec<f64>> = cell.working.iter().map(|w| w.q.clone()).collect();
         let kpi_rows = crate::identify::uncertainty::tcp_jacobian(&model, &params, &free, &working);
-        let noise = cell
-            .instrument
-            .as_ref()
-            .map(|i| i.noise.clone())
-            .unwrap_or_default();
+        let noise = cell.noise();
         let sigma = match noise {
             NoiseModel::Constant { sigma, .. } => sigma,
             NoiseModel::Range { a, b_per_m } => {

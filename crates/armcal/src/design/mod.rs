@@ -5,6 +5,7 @@
 pub mod assess;
 pub mod baselines;
 pub mod bound;
+pub mod cell_constraints;
 pub mod criteria;
 pub mod exchange;
 pub mod information;
@@ -14,6 +15,9 @@ pub mod plan;
 pub mod refine;
 pub mod small_cholesky;
 
+pub use cell_constraints::{
+    ConstraintKind, ConstraintOptions, ConstraintSet, ConstraintWorkspace, Margin,
+};
 pub use criteria::{Criterion, CriterionValue};
 pub use information::{DesignModel, InformationWorkspace};
 pub use objective::{DesignObjective, ObjectiveWorkspace};

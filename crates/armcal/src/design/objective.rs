@@ -177,7 +177,7 @@ pub fn triangular_factor(a: DMatrix<f64>) -> DMatrix<f64> {
 mod tests {
     use super::*;
     use crate::cell::Cell;
-    use crate::model::identifiability::random_configurations;
+    use crate::model::random_configurations;
     use std::path::Path;
 
     /// The cached evaluation (value, then gradient at the same point; then other points and

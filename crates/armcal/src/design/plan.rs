@@ -5,13 +5,13 @@
 use crate::cell::Cell;
 use crate::design::baselines::random_feasible;
 use crate::design::bound::{has_bound, optimality_bound, OptimalityBound};
+use crate::design::cell_constraints::{ConstraintOptions, ConstraintSet, ConstraintWorkspace};
 use crate::design::exchange::{exchange, ExchangeSettings};
 use crate::design::information::DesignModel;
 use crate::design::objective::DesignObjective;
 use crate::design::order::order_for_travel;
 use crate::design::refine::{refine, ConfigurationConstraints, RefineSettings};
 use crate::design::Criterion;
-use crate::geometry::{ConstraintOptions, ConstraintSet, ConstraintWorkspace};
 use crate::Error;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -102,7 +102,7 @@ fn infeasible_report(
     t0: Instant,
 ) -> PlanReport {
     let draws = 20_000;
-    let qs = crate::model::identifiability::random_configurations(&d.model, draws, settings.seed);
+    let qs = crate::model::random_configurations(&d.model, draws, settings.seed);
     let mut ws = set.workspace();
     let mut values = vec![0.0; set.len()];
     let mut counts = vec![0usize; set.len()];
@@ -226,7 +226,7 @@ impl CellConstraints<'_> {
             return 0.0;
         }
         match self.set.kind(i) {
-            crate::geometry::ConstraintKind::Incidence => INCIDENCE_MARGIN,
+            crate::design::ConstraintKind::Incidence => INCIDENCE_MARGIN,
             _ => DISTANCE_MARGIN,
         }
     }

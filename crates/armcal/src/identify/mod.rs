@@ -1,7 +1,9 @@
 //! Parameter identification with honest uncertainty (book ch. 4, paper eqs. 5–6, 13–19):
 //! Levenberg–Marquardt, Gauss–Newton, recursive (Kalman) estimation, robust IRLS, priors
-//! (MAP), parameter and TCP covariances, observability indices, held-out validation.
+//! (MAP), parameter and TCP covariances, observability indices, held-out validation; joint
+//! axes by circle point analysis.
 
+pub mod circle_point;
 pub mod fingerprint;
 pub mod gauss_newton;
 pub mod kalman;
@@ -19,11 +21,10 @@ pub use lm::{levenberg_marquardt, LmSettings};
 pub use problem::Problem;
 pub use robust::{robust_fit, Loss, Outlier};
 pub use solver::{Observer, Silent, Solution, Status, Tolerances};
-pub use uncertainty::{
-    Chi2Outcome, ErrorStats, Observability, ParameterUncertainty, TcpCovariance,
-};
+pub use uncertainty::{Chi2Outcome, Observability, ParameterUncertainty, TcpCovariance};
 pub use verdicts::{Chi2Verdict, IdentifiabilityVerdict, Verdicts};
 
+use crate::accuracy::ErrorStats;
 use crate::cell::Cell;
 use crate::measure::{Dataset, MeasurementKind};
 use crate::model::identifiability::{Identifiability, IdentifiabilityOptions, Measurement};
@@ -534,11 +535,7 @@ pub fn identify(
     opts: &IdentifyOptions,
     observer: &mut dyn Observer,
 ) -> Result<Estimate, Error> {
-    let noise = cell
-        .instrument
-        .as_ref()
-        .map(|i| i.noise.clone())
-        .unwrap_or_default();
+    let noise = cell.noise();
     let split = Split::of(data, opts)?;
     let train = &split.train;
     let fit = fit_free_set(cell, train, &noise, opts, observer)?;

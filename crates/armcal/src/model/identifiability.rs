@@ -20,10 +20,9 @@ use crate::model::jacobian::{identification_jacobian, Observed, Rows};
 use crate::model::kinematics::{forward_kinematics, Data};
 use crate::model::link::JointKind;
 use crate::model::registry::{Segment, Status};
+use crate::model::sampling::random_configurations;
 use crate::Error;
 use nalgebra::{DMatrix, DVector};
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 /// What the instrument measures, for the identifiability analysis.
@@ -195,26 +194,6 @@ fn observations(model: &Model, m: Measurement) -> Vec<(Observed, Rows)> {
             }
         }
     }
-}
-
-/// Uniform random configurations within the joint limits (seeded).
-pub fn random_configurations(model: &Model, n: usize, seed: u64) -> Vec<Vec<f64>> {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    (0..n)
-        .map(|_| {
-            model
-                .joints
-                .iter()
-                .map(|j| {
-                    if j.upper > j.lower {
-                        rng.random_range(j.lower..j.upper)
-                    } else {
-                        j.lower
-                    }
-                })
-                .collect()
-        })
-        .collect()
 }
 
 /// Stacked identification Jacobian for a measurement type over configurations `qs`, one

@@ -260,15 +260,6 @@ impl Convention {
             Convention::Frame6 | Convention::Point => None,
         }
     }
-
-    /// Number of parameters a joint of this kind contributes to a complete, minimal
-    /// model: 4 for revolute and 2 for prismatic joints (book §2.3, N = 4R + 2P + 6).
-    pub fn complete_count(kind: JointKind) -> usize {
-        match kind {
-            JointKind::Revolute => 4,
-            JointKind::Prismatic => 2,
-        }
-    }
 }
 
 impl fmt::Display for Convention {

@@ -1,7 +1,6 @@
 //! Kinematic models: conventions, chain, parameter registry, forward kinematics, exact
-//! Jacobians, identifiability, conversions and URDF.
+//! Jacobians, identifiability, configuration sampling, conversions and URDF.
 
-pub mod axes;
 pub mod branch;
 pub mod chain;
 pub mod complete;
@@ -14,6 +13,7 @@ pub mod link;
 pub mod pose;
 pub mod rank_deficit;
 pub mod registry;
+pub mod sampling;
 pub mod urdf;
 
 pub use chain::{Link, LinkSpec, Model, ModelSpec};
@@ -25,3 +25,4 @@ pub use kinematics::{forward_kinematics, tool_pose, Data};
 pub use link::{Convention, Joint, JointKind, LinkGeometry, Motion};
 pub use pose::{Pose, Twist};
 pub use registry::{Parameter, Registry, Segment, Status, Unit};
+pub use sampling::random_configurations;

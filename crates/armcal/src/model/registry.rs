@@ -204,6 +204,9 @@ impl Registry {
         self.params[i].status = status;
     }
 
+    /// Sets the nominal value of parameter `i` (internal units). Not called by the library;
+    /// kept for the tests' cell with an unplaced tracker (`tests/common`), which moves a
+    /// nominal without rebuilding the model and its statuses.
     pub fn set_nominal(&mut self, i: usize, value: f64) {
         self.params[i].nominal = value;
     }
@@ -218,16 +221,6 @@ impl Registry {
         (0..self.len())
             .filter(|&i| self.params[i].status.is_free())
             .collect()
-    }
-
-    /// Rebuilds the name index (after deserialisation).
-    pub fn reindex(&mut self) {
-        self.index = self
-            .params
-            .iter()
-            .enumerate()
-            .map(|(i, p)| (p.name.clone(), i))
-            .collect();
     }
 }
 

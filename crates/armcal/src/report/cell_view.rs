@@ -9,7 +9,7 @@
 //! For every pose `q` of every design, forward kinematics at the nominal parameters gives the
 //! world pose `T_f(q)` of each chain frame `f`; a robot capsule `(f, a, b, r)` is drawn from
 //! `T_f(q)·a` to `T_f(q)·b` with radius `r` (the same placement as
-//! [`ConstraintSet::evaluate`](crate::geometry::ConstraintSet::evaluate)). The beam runs from
+//! [`ConstraintSet::evaluate`](crate::design::ConstraintSet::evaluate)). The beam runs from
 //! the instrument frame's origin (the tracker) to each target (reflector) position. A pose is
 //! marked violating, and its beam drawn red, when it lies outside the joint limits or any
 //! constraint of the planner's set (paper eq. 24b; [`constraint_set`]) is negative there; the
@@ -22,8 +22,9 @@
 
 use super::html::escape;
 use crate::cell::{half_space_unit_normal, Cell, Obstacle};
+use crate::design::cell_constraints::robot_capsules;
 use crate::design::plan::constraint_set;
-use crate::geometry::ConstraintKind;
+use crate::design::ConstraintKind;
 use crate::model::{forward_kinematics, Data};
 use crate::Error;
 use nalgebra::Vector3;
@@ -215,25 +216,16 @@ fn scene(cell: &Cell, designs: &[(&str, &[Vec<f64>])]) -> Result<Scene, Error> {
     }
 
     // Robot capsules compiled against the model, labelled as the constraint set labels them.
-    let mut links = Vec::with_capacity(cell.capsules.len());
-    let mut robot = Vec::with_capacity(cell.capsules.len());
-    let mut per_frame = std::collections::HashMap::<&str, usize>::new();
-    for c in &cell.capsules {
-        let link = model.link_index(&c.frame).ok_or_else(|| {
-            Error::Model(format!(
-                "capsule on frame `{}`: the model has no such chain frame",
-                c.frame
-            ))
-        })?;
-        let k = per_frame.entry(c.frame.as_str()).or_insert(0);
-        robot.push(RobotCapsule {
+    let links = robot_capsules(cell)?;
+    let robot: Vec<RobotCapsule> = links
+        .iter()
+        .zip(&cell.capsules)
+        .map(|(l, c)| RobotCapsule {
             frame: c.frame.clone(),
-            label: format!("{}#{}", c.frame, k),
+            label: l.label.clone(),
             r: mm(c.radius),
-        });
-        *k += 1;
-        links.push((link, Vector3::from(c.a), Vector3::from(c.b)));
-    }
+        })
+        .collect();
 
     let set = constraint_set(cell, true)?;
     let mut ws = set.workspace();
@@ -261,9 +253,8 @@ fn scene(cell: &Cell, designs: &[(&str, &[Vec<f64>])]) -> Result<Scene, Error> {
         for q in poses.iter() {
             forward_kinematics(model, &mut data, &params, q);
             let mut caps = Vec::with_capacity(links.len());
-            for ((link, a, b), c) in links.iter().zip(&cell.capsules) {
-                let f = &data.frames[*link];
-                let (wa, wb) = (f.transform_point(a), f.transform_point(b));
+            for (c, l) in cell.capsules.iter().zip(&links) {
+                let [wa, wb] = l.place(&data);
                 bounds.add(&wa, c.radius);
                 bounds.add(&wb, c.radius);
                 caps.push([wa.x, wa.y, wa.z, wb.x, wb.y, wb.z].map(mm));
@@ -423,7 +414,7 @@ fn scene(cell: &Cell, designs: &[(&str, &[Vec<f64>])]) -> Result<Scene, Error> {
 
 /// Records the robot capsules and obstacles a constraint name refers to. Names are
 /// `capsule j2#0 / j5#0`, `j3#0 / car-body`, `j2#0.a / wall`, `beam / car-roof`, `incidence`
-/// ([`ConstraintSet::names`](crate::geometry::ConstraintSet::names)): robot capsules appear
+/// ([`ConstraintSet::names`](crate::design::ConstraintSet::names)): robot capsules appear
 /// as `frame#k` (with `.a`/`.b` for an endpoint), an obstacle as the part after ` / `.
 fn mark_named(
     name: &str,

@@ -6,7 +6,7 @@
 use crate::cell::Cell;
 use crate::design::assess::{assess, DesignAssessment};
 use crate::design::plan::{constraint_set, PlanReport};
-use crate::geometry::ConstraintKind;
+use crate::design::ConstraintKind;
 use crate::model::Model;
 use crate::Error;
 use serde::{Deserialize, Serialize};

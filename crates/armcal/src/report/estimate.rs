@@ -4,7 +4,8 @@
 
 use super::figures::{bar_figure, histogram_figure, series_figure, Reference};
 use super::html::{escape, facts, fixed, number, table, Section};
-use crate::identify::{ErrorStats, Estimate, Method, Observability};
+use crate::accuracy::ErrorStats;
+use crate::identify::{Estimate, Method, Observability};
 use crate::Error;
 
 fn stats_row(name: &str, s: &ErrorStats) -> Vec<String> {

@@ -4,12 +4,13 @@
 //! held-out poses. Every intermediate file and the HTML report are returned for writing; the
 //! same seed gives the same files (solver times are left out of them).
 
+use crate::accuracy::ErrorStats;
 use crate::compensate::program::filter_joint_program;
 use crate::compensate::IkSettings;
 use crate::design::baselines::random_feasible;
 use crate::design::plan::{constraint_set, plan, CellConstraints, PlanSettings};
 use crate::design::DesignModel;
-use crate::identify::{identify, ErrorStats, Estimate, IdentifyOptions, Silent};
+use crate::identify::{identify, Estimate, IdentifyOptions, Silent};
 use crate::measure::csv;
 use crate::model::{forward_kinematics, observed_position, Data, Observed};
 use crate::report::{self, DesignRecord, Document, Input, ReportContent};
@@ -61,11 +62,7 @@ pub fn run_demo(seed: u64, progress: &dyn Fn(&str)) -> Result<Demo, Error> {
     let cell =
         crate::cell::Cell::from_toml(CELL, "paper-cell-obstacles.toml", std::path::Path::new("."))?;
     let model = &cell.model;
-    let noise = cell
-        .instrument
-        .as_ref()
-        .map(|i| i.noise.clone())
-        .unwrap_or_default();
+    let noise = cell.noise();
     let truth = perturbed_truth(model, &Perturbation::default(), seed);
     let mut files = vec![("cell.toml".to_string(), CELL.to_string())];
     let poses = 60;

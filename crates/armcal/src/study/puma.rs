@@ -129,6 +129,14 @@ pub fn book_model(name: &str, csv: &str) -> Result<Model, Error> {
 
 /// Inverse kinematics of the tool frame by damped least squares from `seed`; joints are
 /// wrapped into their limits. `None` if it does not converge or leaves the limits.
+///
+/// Not [`calibrated_ik`](crate::compensate::ik::calibrated_ik): this is a sampler, whose
+/// solution from a random seed decides which branch (and, wrapped into (−π, π], which
+/// representative) a book pose gets, so the study's poses — and every number of its
+/// tables — are a seeded function of these exact iterates. The calibrated IK keeps to the
+/// branch of its seed and clamps to the limits: from the same 400 random seeds at the grid
+/// it agreed bitwise on none, gave another solution on 133 and converged where this one
+/// did not (or the reverse) on 102, so using it would change the study's results.
 pub fn ik(m: &Model, params: &[f64], target: &Pose<f64>, seed: &[f64]) -> Option<Vec<f64>> {
     let mut q = seed.to_vec();
     let mut d = Data::new(m);

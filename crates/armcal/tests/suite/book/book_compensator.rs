@@ -9,7 +9,7 @@ use armcal::compensate::lqr::{
     OperationCount,
 };
 use armcal::compensate::nonparametric::PolynomialCorrection;
-use armcal::model::identifiability::random_configurations;
+use armcal::model::random_configurations;
 use armcal::model::{forward_kinematics, joint_jacobian, tool_pose, Data, Model, Observed, Pose};
 use armcal::robots;
 use armcal::sim::{perturbed_truth, Perturbation};

@@ -10,7 +10,7 @@ use armcal::compensate::program::filter_joint_program_corrected;
 use armcal::compensate::{IkSettings, IkStatus};
 use armcal::identify::{identify, IdentifyOptions, Silent};
 use armcal::measure::{Dataset, MeasurementKind, NoiseModel};
-use armcal::model::identifiability::random_configurations;
+use armcal::model::random_configurations;
 use armcal::model::{forward_kinematics, Data};
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use nalgebra::Vector3;

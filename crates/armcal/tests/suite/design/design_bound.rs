@@ -6,7 +6,7 @@ use armcal::design::bound::optimality_bound;
 use armcal::design::exchange::{exchange, ExchangeSettings};
 use armcal::design::refine::{refine, RefineSettings};
 use armcal::design::{Criterion, DesignModel, DesignObjective};
-use armcal::model::identifiability::random_configurations;
+use armcal::model::random_configurations;
 use nalgebra::DMatrix;
 use std::path::Path;
 

@@ -4,7 +4,7 @@
 use armcal::cell::Cell;
 use armcal::design::exchange::{exchange, ExchangeSettings};
 use armcal::design::{Criterion, DesignModel, DesignObjective};
-use armcal::model::identifiability::random_configurations;
+use armcal::model::random_configurations;
 use nalgebra::DMatrix;
 use std::path::Path;
 

@@ -3,7 +3,7 @@
 
 use armcal::cell::Cell;
 use armcal::design::{Criterion, DesignModel, DesignObjective};
-use armcal::model::identifiability::random_configurations;
+use armcal::model::random_configurations;
 use std::path::Path;
 
 #[test]

@@ -6,7 +6,7 @@
 //! the reading of the setup and the ≈ 6 % incidence-feasible share of uniform draws.
 
 use armcal::cell::Cell;
-use armcal::geometry::{ConstraintKind, ConstraintOptions, ConstraintSet};
+use armcal::design::{ConstraintKind, ConstraintOptions, ConstraintSet};
 use armcal::model::{forward_kinematics, Data};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -7,7 +7,7 @@ use crate::common;
 use armcal::cell::Cell;
 use armcal::identify::*;
 use armcal::measure::{Dataset, MeasurementKind};
-use armcal::model::identifiability::random_configurations;
+use armcal::model::random_configurations;
 use armcal::model::Model;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use nalgebra::Vector3;

@@ -7,7 +7,7 @@ use crate::common;
 use armcal::cell::Cell;
 use armcal::identify::*;
 use armcal::measure::{Dataset, NoiseModel};
-use armcal::model::identifiability::random_configurations;
+use armcal::model::random_configurations;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use common::example_cell;
 use std::path::Path;

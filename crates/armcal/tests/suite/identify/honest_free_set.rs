@@ -3,7 +3,7 @@
 
 use armcal::cell::Cell;
 use armcal::identify::{identify, IdentifyOptions, Silent};
-use armcal::model::identifiability::random_configurations;
+use armcal::model::random_configurations;
 use armcal::model::Convention;
 use armcal::robots;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};

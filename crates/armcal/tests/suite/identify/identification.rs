@@ -4,7 +4,7 @@
 use crate::common;
 use armcal::cell::Cell;
 use armcal::identify::*;
-use armcal::model::identifiability::random_configurations;
+use armcal::model::random_configurations;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;

@@ -1,9 +1,10 @@
 //! Robust estimation with gross errors, and bad input: clear errors, never a panic.
 
+use armcal::accuracy::ErrorStats;
 use armcal::cell::Cell;
 use armcal::identify::*;
 use armcal::measure::{csv, MeasurementKind};
-use armcal::model::identifiability::random_configurations;
+use armcal::model::random_configurations;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use nalgebra::Vector3;
 use std::path::Path;

@@ -2,9 +2,10 @@
 //! user's own test file, the frames-only row of a frames-only cell, and bad fractions.
 
 use crate::common;
+use armcal::accuracy::ErrorStats;
 use armcal::identify::*;
 use armcal::measure::Dataset;
-use armcal::model::identifiability::random_configurations;
+use armcal::model::random_configurations;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 
 /// Noisy data of the paper cell at `n` random poses whose ids are not their numbers

@@ -4,7 +4,7 @@
 use crate::common;
 use armcal::identify::*;
 use armcal::measure::{Dataset, Measurement, MeasurementKind, NoiseModel};
-use armcal::model::identifiability::random_configurations;
+use armcal::model::random_configurations;
 use armcal::model::*;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use nalgebra::{DMatrix, DVector, Vector3};

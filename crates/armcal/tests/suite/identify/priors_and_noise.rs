@@ -3,7 +3,7 @@
 use armcal::cell::Cell;
 use armcal::identify::*;
 use armcal::measure::{csv, NoiseModel};
-use armcal::model::identifiability::random_configurations;
+use armcal::model::random_configurations;
 use armcal::model::Status as ParamStatus;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use std::path::Path;

@@ -8,7 +8,7 @@ use armcal::cell::{export::to_cell_toml, Cell};
 use armcal::identify::{identify, IdentifyOptions, Silent};
 use armcal::model::complete::LinkForm;
 use armcal::model::export::{export_form, suspicious_values};
-use armcal::model::identifiability::random_configurations;
+use armcal::model::random_configurations;
 use armcal::model::{forward_kinematics, Data, Model};
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use std::path::Path;

@@ -3,7 +3,7 @@
 //! zero-reference; JSON; URDF through urdf-rs.
 
 use armcal::cell::Cell;
-use armcal::model::identifiability::random_configurations;
+use armcal::model::random_configurations;
 use armcal::model::{
     convert, export, forward_kinematics, observed_pose, urdf, Data, Model, ModelSpec, Observed,
 };

@@ -1,8 +1,8 @@
 //! Real data: calibration of the Motoman dual-arm robot from the Leica laser-tracker grids
 //! (data/motoman-leica), with a seeded held-out third, and its position repeatability.
 
+use armcal::accuracy::iso9283::position_repeatability;
 use armcal::cell::Cell;
-use armcal::evaluate::iso9283::position_repeatability;
 use armcal::identify::{identify, IdentifyOptions, Silent};
 use armcal::measure::{csv, MeasurementKind};
 use std::path::{Path, PathBuf};

@@ -5,7 +5,7 @@
 
 use armcal::cell::Cell;
 use armcal::design::plan::constraint_set;
-use armcal::model::identifiability::random_configurations;
+use armcal::model::random_configurations;
 use armcal::report::cell_view::cell_view_section;
 use nalgebra::{Matrix4, Vector3, Vector4};
 use serde_json::Value;

@@ -4,7 +4,7 @@
 use crate::common;
 use armcal::cell::Cell;
 use armcal::identify::{identify, Estimate, IdentifyOptions, Silent};
-use armcal::model::identifiability::random_configurations;
+use armcal::model::random_configurations;
 use armcal::model::{forward_kinematics, Data};
 use armcal::report::design_record::kind_margins;
 use armcal::report::ellipse::{confidence_scale, ellipse_axes, ellipse_points, Plane};

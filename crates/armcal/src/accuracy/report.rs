@@ -1,9 +1,9 @@
 //! Accuracy of a model against measurements, and ISO 9283 figures per commanded pose.
 
-use crate::evaluate::iso9283::{
+use crate::accuracy::iso9283::{
     position_accuracy, position_repeatability, Accuracy, Repeatability,
 };
-use crate::identify::ErrorStats;
+use crate::accuracy::ErrorStats;
 use crate::measure::{Dataset, MeasurementKind};
 use crate::model::{forward_kinematics, observed_position, Data, Model};
 use serde::{Deserialize, Serialize};

@@ -3,5 +3,6 @@
 
 pub mod iso9283;
 pub mod report;
+pub mod stats;
 
-pub use crate::identify::ErrorStats;
+pub use stats::ErrorStats;

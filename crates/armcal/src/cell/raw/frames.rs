@@ -1,0 +1,53 @@
+//! `[base]`, `[tool]` and `[[targets]]`: the frames the cell adds to the robot's chain.
+
+use super::fields::*;
+use super::*;
+
+/// The `[base]` and `[tool]` frames, if given.
+pub(super) fn base_and_tool(
+    ctx: &Ctx,
+    base: &Option<Spanned<toml::Table>>,
+    tool: &Option<Spanned<toml::Table>>,
+) -> Result<(Option<LinkGeometry>, Option<LinkGeometry>), Error> {
+    let base = match base {
+        Some(t) => Some(frame(t.get_ref(), &[]).map_err(|e| ctx.err(t.span(), "base", e))?),
+        None => None,
+    };
+    let tool = match tool {
+        Some(t) => Some(frame(t.get_ref(), &[]).map_err(|e| ctx.err(t.span(), "tool", e))?),
+        None => None,
+    };
+    Ok((base, tool))
+}
+
+/// `[[targets]]`: a point (`xyz_mm`) or, with `rpy`, a frame; named `smr1`, `smr2`, … by
+/// default.
+pub(super) fn targets(ctx: &Ctx, tables: &[Spanned<toml::Table>]) -> Result<Vec<LinkSpec>, Error> {
+    let mut targets = Vec::new();
+    for (i, t) in tables.iter().enumerate() {
+        let tt = t.get_ref();
+        let field = format!("targets[{i}]");
+        let name = string_field(tt, "name")
+            .map_err(|e| ctx.err(t.span(), &field, e))?
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("smr{}", i + 1));
+        let is_frame = tt.keys().any(|k| k.starts_with("rpy"));
+        let geometry = if is_frame {
+            frame(tt, &["name"]).map_err(|e| ctx.err(t.span(), &field, e))?
+        } else {
+            let mut used = vec!["name".to_string()];
+            let xyz = unit_triple(tt, "xyz", Unit::Mm, &mut used)
+                .and_then(|v| v.ok_or_else(|| "missing `xyz_mm`".to_string()))
+                .map_err(|e| ctx.err(t.span(), &field, e))?;
+            check_unused(tt, &used, &[], &[unit_spellings("xyz", Unit::Mm)])
+                .map_err(|e| ctx.err(t.span(), &field, e))?;
+            LinkGeometry::point(xyz)
+        };
+        targets.push(LinkSpec {
+            name,
+            geometry,
+            joint: None,
+        });
+    }
+    Ok(targets)
+}

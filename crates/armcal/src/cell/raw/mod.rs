@@ -1,0 +1,215 @@
+//! The TOML layer of the cell file: raw structures with spans, unit suffixes, and errors
+//! that give file, line and field. [`parse`] reads the file section by section, one module
+//! per section: [`robot`] (`[robot]`, `[[tool_capsules]]`), [`instrument`], [`frames`]
+//! (`[base]`, `[tool]`, `[[targets]]`), [`parameters`], [`working`], [`obstacles`], and
+//! `[data]` here; [`fields`] holds the field readers they share.
+
+use super::*;
+use crate::model::complete::LinkForm;
+use crate::model::identifiability::Measurement;
+use crate::model::{Convention, Joint, JointKind, LinkGeometry, LinkSpec, Unit};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use toml::Spanned;
+
+mod fields;
+mod frames;
+mod instrument;
+mod obstacles;
+mod parameters;
+mod robot;
+mod working;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawCell {
+    name: Option<String>,
+    robot: Spanned<RawRobot>,
+    instrument: Option<Spanned<RawInstrument>>,
+    base: Option<Spanned<toml::Table>>,
+    tool: Option<Spanned<toml::Table>>,
+    #[serde(default)]
+    targets: Vec<Spanned<toml::Table>>,
+    parameters: Option<Spanned<RawParameters>>,
+    #[serde(default)]
+    working: Vec<Spanned<toml::Table>>,
+    #[serde(default)]
+    obstacles: Vec<Spanned<toml::Table>>,
+    #[serde(default)]
+    tool_capsules: Vec<Spanned<toml::Table>>,
+    data: Option<RawData>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawRobot {
+    builtin: Option<String>,
+    urdf: Option<String>,
+    tip: Option<String>,
+    name: Option<String>,
+    #[serde(default)]
+    links: Vec<Spanned<toml::Table>>,
+    /// Per-joint limit overrides, `q1 = [-82, 82]` (deg; mm for prismatic joints).
+    limits: Option<BTreeMap<String, [f64; 2]>>,
+    #[serde(default)]
+    capsules: Vec<Spanned<toml::Table>>,
+    /// `auto` (default), `as-given`, `dh`, `mdh` or `zrp` ([`LinkForm`]).
+    convention: Option<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawInstrument {
+    name: Option<String>,
+    kind: Option<String>,
+    xyz_mm: Option<[f64; 3]>,
+    xyz_m: Option<[f64; 3]>,
+    rpy_deg: Option<[f64; 3]>,
+    rpy_rad: Option<[f64; 3]>,
+    noise: Option<toml::Table>,
+    max_incidence_deg: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawParameters {
+    /// `"auto"`: reduce to the minimal identifiable set; or a list of patterns.
+    free: Option<toml::Value>,
+    #[serde(default)]
+    fixed: Vec<String>,
+    #[serde(default)]
+    priors: BTreeMap<String, toml::Table>,
+    measurement: Option<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawData {
+    joints: Vec<String>,
+}
+
+/// Error helper: file, line of a span, field path.
+struct Ctx<'a> {
+    file: &'a str,
+    text: &'a str,
+}
+
+impl Ctx<'_> {
+    fn line(&self, span: std::ops::Range<usize>) -> usize {
+        self.text[..span.start.min(self.text.len())]
+            .chars()
+            .filter(|&c| c == '\n')
+            .count()
+            + 1
+    }
+
+    fn err(&self, span: std::ops::Range<usize>, field: &str, msg: impl std::fmt::Display) -> Error {
+        Error::File {
+            file: self.file.to_string(),
+            message: format!("line {}: `{field}`: {msg}", self.line(span)),
+        }
+    }
+}
+
+/// Parses a cell file section by section (in the order errors are reported).
+pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
+    let ctx = Ctx { file, text };
+    let raw: RawCell = toml::from_str(text).map_err(|e| Error::File {
+        file: file.to_string(),
+        message: e.to_string(),
+    })?;
+    let rspan = raw.robot.span();
+    let rr = raw.robot.into_inner();
+
+    let mut robot = robot::robot(&ctx, &rr, rspan.clone(), dir)?;
+    let (instrument, instrument_geometry, instrument_name) =
+        instrument::instrument(&ctx, raw.instrument)?;
+    let (base, tool) = frames::base_and_tool(&ctx, &raw.base, &raw.tool)?;
+    let targets = frames::targets(&ctx, &raw.targets)?;
+    let spec = assemble_spec(
+        &robot,
+        instrument_geometry,
+        &instrument_name,
+        base,
+        tool,
+        targets,
+    );
+    let model_error = |e: Error| Error::File {
+        file: file.to_string(),
+        message: e.to_string(),
+    };
+    let mut tool_capsules = robot::tool_capsules(&ctx, &raw.tool_capsules)?;
+    let form = robot::link_form(&ctx, &rr, rspan.clone())?;
+    let given = Model::from_spec(&spec).map_err(model_error)?;
+    let shaped = shape_robot(&mut robot, &given, spec, form, &mut tool_capsules)
+        .map_err(|e| ctx.err(rspan.clone(), "robot.convention", e))?;
+    let mut model = Model::from_spec(&shaped.spec).map_err(model_error)?;
+
+    let (measurement, auto_free) =
+        parameters::parameters(&ctx, raw.parameters.as_ref(), &mut model)?;
+    let (working, warnings) = working::working(&ctx, &raw.working, &model)?;
+    let obstacles = obstacles::obstacles(&ctx, &raw.obstacles)?;
+    let mut capsules = robot.capsules.clone();
+    capsules.extend(tool_capsules);
+    for (i, c) in capsules.iter().enumerate() {
+        if model.link_index(&c.frame).is_none() {
+            return Err(Error::File {
+                file: file.to_string(),
+                message: format!(
+                    "capsule {i} names frame `{}`, which the robot does not have",
+                    c.frame
+                ),
+            });
+        }
+    }
+    let data_columns = data_columns(file, raw.data, &model)?;
+    let mut cell = Cell {
+        name: raw.name.unwrap_or_else(|| robot.name.clone()),
+        origin: file.to_string(),
+        robot,
+        model,
+        instrument,
+        working,
+        obstacles,
+        capsules,
+        measurement,
+        auto_free,
+        declared_free: Vec::new(),
+        data_columns,
+        warnings,
+        form,
+        form_changes: shaped.changes,
+        form_incomplete: shaped.incomplete,
+    };
+    cell.declared_free = cell.model.registry.free();
+    if cell.auto_free {
+        let report = cell.identifiability(&cell.identifiability_options())?;
+        report.apply(&mut cell.model)?;
+    }
+    Ok(cell)
+}
+
+/// `[data]`: the data-file column of every joint, one per joint.
+fn data_columns(
+    file: &str,
+    data: Option<RawData>,
+    model: &Model,
+) -> Result<Option<DataColumns>, Error> {
+    let data_columns = match data {
+        Some(d) => {
+            if d.joints.len() != model.dof() {
+                return Err(Error::File {
+                    file: file.to_string(),
+                    message: format!(
+                        "`data.joints` lists {} columns, the robot has {} joints",
+                        d.joints.len(),
+                        model.dof()
+                    ),
+                });
+            }
+            Some(DataColumns { joints: d.joints })
+        }
+        None => None,
+    };
+    Ok(data_columns)
+}

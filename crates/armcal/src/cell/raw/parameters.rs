@@ -1,0 +1,95 @@
+//! `[parameters]`: the free set (`auto`, `all` or patterns), `fixed`, `priors` and the
+//! measurement type.
+
+use super::fields::*;
+use super::*;
+
+/// Applies `[parameters]` to `model`; returns the measurement type (pose if every target is
+/// a frame, else position, unless given) and whether the free set is `auto`.
+pub(super) fn parameters(
+    ctx: &Ctx,
+    section: Option<&Spanned<RawParameters>>,
+    model: &mut Model,
+) -> Result<(Measurement, bool), Error> {
+    let all_frames = (0..model.targets.len()).all(|k| model.target_is_frame(k));
+    let mut measurement = if all_frames {
+        // No targets (the tool frame is measured) or only frame targets.
+        Measurement::Pose
+    } else {
+        Measurement::Position
+    };
+    let mut auto_free = true;
+    if let Some(p) = section {
+        let span = p.span();
+        let p = p.get_ref();
+        let free: Vec<String> = match &p.free {
+            None => Vec::new(),
+            Some(toml::Value::String(s)) if s == "auto" => Vec::new(),
+            Some(toml::Value::String(s)) if s == "all" => {
+                auto_free = false;
+                Vec::new()
+            }
+            Some(toml::Value::Array(a)) => {
+                auto_free = false;
+                a.iter()
+                    .map(|v| v.as_str().map(str::to_string))
+                    .collect::<Option<Vec<_>>>()
+                    .ok_or_else(|| {
+                        ctx.err(
+                            span.clone(),
+                            "parameters.free",
+                            "must be \"auto\", \"all\" or a list of parameter patterns",
+                        )
+                    })?
+            }
+            Some(_) => {
+                return Err(ctx.err(
+                    span,
+                    "parameters.free",
+                    "must be \"auto\", \"all\" or a list of parameter patterns",
+                ))
+            }
+        };
+        let mut priors = Vec::new();
+        for (name, t) in &p.priors {
+            let i = model
+                .registry
+                .matching(name)
+                .map_err(|e| ctx.err(span.clone(), &format!("parameters.priors.{name}"), e))?;
+            let unit = model.registry.get(i[0]).unit;
+            let mut used = Vec::new();
+            let s = unit_value(t, "sigma", unit, &mut used)
+                .and_then(|v| v.ok_or_else(|| "missing `sigma_deg` / `sigma_mm`".into()))
+                .and_then(|v| {
+                    check_unused(t, &used, &[], &[unit_spellings("sigma", unit)]).map(|_| v)
+                })
+                .map_err(|e| ctx.err(span.clone(), &format!("parameters.priors.{name}"), e))?;
+            if s <= 0.0 {
+                return Err(ctx.err(
+                    span,
+                    &format!("parameters.priors.{name}"),
+                    "sigma must be positive",
+                ));
+            }
+            priors.push((name.clone(), s));
+        }
+        if !free.is_empty() {
+            // An explicit free list: everything else is fixed.
+            model
+                .set_status("*", Status::Fixed)
+                .expect("every model has parameters");
+        }
+        apply_statuses(model, &p.fixed, &free, &priors)
+            .map_err(|e| ctx.err(span.clone(), "parameters", e))?;
+        if let Some(m) = &p.measurement {
+            measurement = Measurement::from_name(m).ok_or_else(|| {
+                ctx.err(
+                    span.clone(),
+                    "parameters.measurement",
+                    format!("`{m}`: use pose, position or distance"),
+                )
+            })?;
+        }
+    }
+    Ok((measurement, auto_free))
+}

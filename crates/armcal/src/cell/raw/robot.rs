@@ -1,0 +1,251 @@
+//! `[robot]` (a built-in robot, a URDF file or inline `[[robot.links]]`, joint `limits`,
+//! `[[robot.capsules]]`, `convention`) and `[[tool_capsules]]`.
+
+use super::fields::*;
+use super::*;
+use std::ops::Range;
+
+/// The robot of `[robot]`: exactly one of `builtin`, `urdf` (relative to `dir`) or
+/// `[[robot.links]]`, with its `limits` overrides and `[[robot.capsules]]`.
+pub(super) fn robot(
+    ctx: &Ctx,
+    rr: &RawRobot,
+    rspan: Range<usize>,
+    dir: &Path,
+) -> Result<Robot, Error> {
+    let file = ctx.file;
+    let sources = rr.builtin.is_some() as usize
+        + rr.urdf.is_some() as usize
+        + (!rr.links.is_empty()) as usize;
+    if sources != 1 {
+        return Err(ctx.err(
+            rspan,
+            "robot",
+            "give exactly one of `builtin`, `urdf` or `[[robot.links]]`",
+        ));
+    }
+    let mut robot = if let Some(b) = &rr.builtin {
+        robots::robot(b).map_err(|e| ctx.err(rspan.clone(), "robot.builtin", e))?
+    } else if let Some(u) = &rr.urdf {
+        let path = dir.join(u);
+        let spec = crate::model::urdf::read_urdf(&path, rr.tip.as_deref())
+            .map_err(|e| ctx.err(rspan.clone(), "robot.urdf", e))?;
+        Robot {
+            name: rr.name.clone().unwrap_or_else(|| spec.name.clone()),
+            summary: format!("imported from {u}"),
+            source: format!("URDF file {}", path.display()),
+            spec,
+            capsules: Vec::new(),
+        }
+    } else {
+        let mut links = Vec::new();
+        let mut joint_index = 0;
+        for (i, l) in rr.links.iter().enumerate() {
+            let has_joint = matches!(
+                l.get_ref().get("joint").and_then(|v| v.as_str()),
+                Some("revolute") | Some("prismatic")
+            );
+            if has_joint {
+                joint_index += 1;
+            }
+            let spec = inline_link(l.get_ref(), joint_index)
+                .map_err(|e| ctx.err(l.span(), &format!("robot.links[{i}]"), e))?;
+            links.push(spec);
+        }
+        // Every chain starts with a base frame and ends with a tool frame.
+        if links.first().map(|l| l.name.as_str()) != Some("base") {
+            links.insert(0, crate::robots::frame_link("base", [0.0; 3], [0.0; 3]));
+        }
+        if links.last().map(|l| l.name.as_str()) != Some("tool") {
+            links.push(crate::robots::frame_link("tool", [0.0; 3], [0.0; 3]));
+        }
+        let name = rr.name.clone().unwrap_or_else(|| "inline".into());
+        Robot {
+            name: name.clone(),
+            summary: "inline robot from the cell file".into(),
+            source: format!("cell file {file}"),
+            spec: ModelSpec {
+                name,
+                instrument: None,
+                links,
+                targets: vec![],
+            },
+            capsules: Vec::new(),
+        }
+    };
+    if let Some(limits) = &rr.limits {
+        for (jname, [lo, hi]) in limits {
+            let link = robot
+                .spec
+                .links
+                .iter_mut()
+                .find(|l| l.joint.as_ref().map(|j| j.name == *jname).unwrap_or(false))
+                .ok_or_else(|| {
+                    ctx.err(
+                        rspan.clone(),
+                        &format!("robot.limits.{jname}"),
+                        "no joint of that name",
+                    )
+                })?;
+            let j = link.joint.as_mut().expect("found by joint");
+            let f = match j.kind {
+                JointKind::Revolute => std::f64::consts::PI / 180.0,
+                JointKind::Prismatic => 1.0,
+            };
+            j.lower = lo * f;
+            j.upper = hi * f;
+        }
+    }
+    for (i, c) in rr.capsules.iter().enumerate() {
+        let cap = capsule(c.get_ref(), true)
+            .map_err(|e| ctx.err(c.span(), &format!("robot.capsules[{i}]"), e))?;
+        robot.capsules.push(cap);
+    }
+    Ok(robot)
+}
+
+/// `robot.convention`: the form the chain is put in ([`LinkForm`]; default `auto`).
+pub(super) fn link_form(ctx: &Ctx, rr: &RawRobot, rspan: Range<usize>) -> Result<LinkForm, Error> {
+    let form = match &rr.convention {
+        None => LinkForm::Auto,
+        Some(c) => LinkForm::from_name(c).ok_or_else(|| {
+            ctx.err(
+                rspan.clone(),
+                "robot.convention",
+                format!(
+                    "`{c}`; use {}",
+                    LinkForm::ALL.map(LinkForm::name).join(", ")
+                ),
+            )
+        })?,
+    };
+    Ok(form)
+}
+
+/// `[[tool_capsules]]`: capsules on the tool frame unless they name another.
+pub(super) fn tool_capsules(
+    ctx: &Ctx,
+    tables: &[Spanned<toml::Table>],
+) -> Result<Vec<Capsule>, Error> {
+    let mut tool_capsules = Vec::new();
+    for (i, c) in tables.iter().enumerate() {
+        tool_capsules.push(
+            capsule(c.get_ref(), false)
+                .map_err(|e| ctx.err(c.span(), &format!("tool_capsules[{i}]"), e))?,
+        );
+    }
+    Ok(tool_capsules)
+}
+
+/// An inline link: `name`, `convention`, the convention's fields with unit suffixes,
+/// optional `joint = "revolute" | "prismatic"`, `limits = [lo, hi]` (deg or mm),
+/// `axis = [x, y, z]` for URDF-convention links.
+fn inline_link(t: &toml::Table, index: usize) -> Result<LinkSpec, String> {
+    let name = string_field(t, "name")?
+        .map(str::to_string)
+        .unwrap_or_else(|| format!("j{index}"));
+    let conv_name = string_field(t, "convention")?.ok_or("missing `convention`")?;
+    let mut convention = Convention::from_name(conv_name).ok_or_else(|| {
+        format!(
+            "unknown convention `{conv_name}`; known: {}",
+            Convention::ALL.map(|c| c.name()).join(", ")
+        )
+    })?;
+    // A modified-DH link with β (book §2.6) is written `convention = "mdh"` + `beta_deg`.
+    if convention == Convention::Mdh && (t.contains_key("beta_deg") || t.contains_key("beta_rad")) {
+        convention = Convention::MdhBeta;
+    }
+    let kind = match string_field(t, "joint")? {
+        None | Some("fixed") => None,
+        Some("revolute") => Some(JointKind::Revolute),
+        Some("prismatic") => Some(JointKind::Prismatic),
+        Some(other) => {
+            return Err(format!(
+                "`joint` is `{other}`; use revolute, prismatic or fixed"
+            ))
+        }
+    };
+    let mut used = Vec::new();
+    let mut values = Vec::new();
+    for (field, unit) in convention.fields(kind) {
+        let v = unit_value(t, field, *unit, &mut used)?;
+        let default_zero = *field == "offset";
+        values.push(match v {
+            Some(v) => v,
+            None if default_zero => 0.0,
+            None => {
+                let hint = match unit {
+                    Unit::Mm => "_mm",
+                    Unit::Rad => "_deg",
+                    Unit::Unitless => "",
+                };
+                return Err(format!(
+                    "missing `{field}{hint}` for convention {convention}"
+                ));
+            }
+        });
+    }
+    let mut geometry = LinkGeometry::new(convention, values);
+    if let Some(a) = t.get("axis") {
+        let arr: Vec<f64> = a
+            .as_array()
+            .map(|v| v.iter().filter_map(number).collect())
+            .unwrap_or_default();
+        if arr.len() != 3 || arr.iter().all(|x| *x == 0.0) {
+            return Err("`axis` must be a non-zero array of 3 numbers".into());
+        }
+        geometry.axis = Some([arr[0], arr[1], arr[2]]);
+    }
+    let joint = match kind {
+        None => None,
+        Some(k) => {
+            let lim = t
+                .get("limits")
+                .and_then(|v| v.as_array())
+                .filter(|a| a.len() == 2)
+                .ok_or(
+                    "a jointed link needs `limits = [lower, upper]` (deg, or mm for prismatic)",
+                )?;
+            let f = match k {
+                JointKind::Revolute => std::f64::consts::PI / 180.0,
+                JointKind::Prismatic => 1.0,
+            };
+            let num = |v: &toml::Value| number(v).ok_or("`limits` must hold finite numbers");
+            let jname = string_field(t, "joint_name")?
+                .map(str::to_string)
+                .unwrap_or_else(|| format!("q{index}"));
+            Some(Joint {
+                name: jname,
+                kind: k,
+                lower: num(&lim[0])? * f,
+                upper: num(&lim[1])? * f,
+            })
+        }
+    };
+    let mut valid: Vec<String> = convention
+        .fields(kind)
+        .iter()
+        .map(|(f, u)| unit_spellings(f, *u))
+        .collect();
+    if convention == Convention::Mdh {
+        valid.push(unit_spellings("beta", Unit::Rad));
+    }
+    check_unused(
+        t,
+        &used,
+        &[
+            "name",
+            "convention",
+            "joint",
+            "limits",
+            "axis",
+            "joint_name",
+        ],
+        &valid,
+    )?;
+    Ok(LinkSpec {
+        name,
+        geometry,
+        joint,
+    })
+}

@@ -1,0 +1,247 @@
+//! Values `g(q)` and exact joint gradients of a [`ConstraintSet`] at a configuration (see
+//! the [module documentation](super) for the formulas).
+
+use super::*;
+
+impl ConstraintSet {
+    /// Evaluates every constraint at parameters `params` (internal units, the model's full
+    /// parameter vector) and joints `q`: `values[i] = g_i(q)` (≥ 0 is feasible) and, if given,
+    /// `jacobian[i · dof + j] = ∂g_i/∂q_j` (row major, `len × dof`). Allocates nothing.
+    ///
+    /// # Panics
+    /// If `params`, `q`, `values` or `jacobian` have the wrong length.
+    pub fn evaluate(
+        &self,
+        ws: &mut ConstraintWorkspace,
+        params: &[f64],
+        q: &[f64],
+        values: &mut [f64],
+        mut jacobian: Option<&mut [f64]>,
+    ) {
+        self.check_lengths(params, q, values, jacobian.as_deref());
+        self.place(ws, params, q);
+        let dof = self.dof();
+        for (row, value) in values.iter_mut().enumerate() {
+            let grad = jacobian
+                .as_deref_mut()
+                .map(|jac| &mut jac[row * dof..(row + 1) * dof]);
+            *value = self.evaluate_row(ws, row, grad);
+        }
+    }
+
+    /// Like [`ConstraintSet::evaluate`], but only the constraints listed in `rows`: their
+    /// values (and Jacobian rows) are written at their own index of the full-length `values`
+    /// (and `jacobian`); the other entries are left as they are. One forward kinematics plus
+    /// the listed constraints: the cost of a projection that knows which constraints can be
+    /// near their boundary.
+    ///
+    /// # Panics
+    /// If a length is wrong or a row is out of range.
+    pub fn evaluate_rows(
+        &self,
+        ws: &mut ConstraintWorkspace,
+        params: &[f64],
+        q: &[f64],
+        rows: &[usize],
+        values: &mut [f64],
+        mut jacobian: Option<&mut [f64]>,
+    ) {
+        self.check_lengths(params, q, values, jacobian.as_deref());
+        self.place(ws, params, q);
+        let dof = self.dof();
+        for &row in rows {
+            let grad = jacobian
+                .as_deref_mut()
+                .map(|jac| &mut jac[row * dof..(row + 1) * dof]);
+            values[row] = self.evaluate_row(ws, row, grad);
+        }
+    }
+
+    fn check_lengths(&self, params: &[f64], q: &[f64], values: &[f64], jac: Option<&[f64]>) {
+        assert_eq!(params.len(), self.model.param_count(), "parameter count");
+        assert_eq!(q.len(), self.dof(), "joint count");
+        assert_eq!(values.len(), self.len(), "values length");
+        if let Some(jac) = jac {
+            assert_eq!(
+                jac.len(),
+                self.len() * self.dof(),
+                "jacobian length (len × dof)"
+            );
+        }
+    }
+
+    /// Forward kinematics and the world endpoints of every robot capsule at `q`.
+    fn place(&self, ws: &mut ConstraintWorkspace, params: &[f64], q: &[f64]) {
+        forward_kinematics(&self.model, &mut ws.data, params, q);
+        for (c, ends) in self.capsules.iter().zip(ws.ends.iter_mut()) {
+            *ends = c.place(&ws.data);
+        }
+    }
+
+    /// Value (and gradient) of constraint `row` at the configuration [`Self::place`]d in `ws`.
+    #[inline]
+    fn evaluate_row(&self, ws: &ConstraintWorkspace, row: usize, grad: Option<&mut [f64]>) -> f64 {
+        let data = &ws.data;
+        let ends = &ws.ends;
+        let refl = match self.reflector {
+            Reflector::Target(k) => &data.targets[k],
+            Reflector::Tool => data.tool(),
+        };
+        let p = refl.trans;
+        let tracker = data.instrument.trans;
+        let twists = &data.joint_twists;
+        match self.items[row] {
+            Item::Incidence => {
+                let z = refl.rot.column(2).into_owned();
+                let beam = tracker - p;
+                let len = beam.norm();
+                let g = beam / len;
+                let cos_b = z.dot(&g);
+                if let Some(grad) = grad {
+                    let perp = z - g * cos_b;
+                    for (gj, tw) in grad.iter_mut().zip(twists) {
+                        let dp = tw.point_velocity(&p);
+                        *gj = tw.w.cross(&z).dot(&g) - perp.dot(&dp) / len;
+                    }
+                }
+                cos_b - self.cos_max
+            }
+            Item::Pair { i, j } => {
+                let (ci, cj) = (&self.capsules[i], &self.capsules[j]);
+                let sd = segment_distance(&ends[i][0], &ends[i][1], &ends[j][0], &ends[j][1]);
+                if let Some(grad) = grad {
+                    two_point_gradient(
+                        grad, twists, &sd.normal, &sd.p, ci.joints, &sd.q, cj.joints,
+                    );
+                }
+                sd.distance - ci.radius - cj.radius
+            }
+            Item::Obstacle { i, o } => {
+                let (ci, ob) = (&self.capsules[i], &self.obstacles[o]);
+                let sd = segment_distance(&ends[i][0], &ends[i][1], &ob.a, &ob.b);
+                if let Some(grad) = grad {
+                    two_point_gradient(grad, twists, &sd.normal, &sd.p, ci.joints, &sd.q, 0);
+                }
+                sd.distance - ci.radius - ob.radius
+            }
+            Item::HalfSpace { i, end, h } => {
+                let (ci, hs) = (&self.capsules[i], &self.half_spaces[h]);
+                let x = ends[i][end];
+                if let Some(grad) = grad {
+                    two_point_gradient(grad, twists, &hs.normal, &x, ci.joints, &x, 0);
+                }
+                hs.normal.dot(&x) - ci.radius - hs.offset
+            }
+            Item::BeamRobot { i } => {
+                let ci = &self.capsules[i];
+                let sd = segment_distance(&p, &tracker, &ends[i][0], &ends[i][1]);
+                if let Some(grad) = grad {
+                    beam_gradient(grad, twists, &sd.normal, sd.s, &p, &sd.q, ci.joints);
+                }
+                sd.distance - self.beam_radius - ci.radius
+            }
+            Item::BeamObstacle { o } => {
+                let ob = &self.obstacles[o];
+                let sd = segment_distance(&p, &tracker, &ob.a, &ob.b);
+                if let Some(grad) = grad {
+                    beam_gradient(grad, twists, &sd.normal, sd.s, &p, &sd.q, 0);
+                }
+                sd.distance - self.beam_radius - ob.radius
+            }
+        }
+    }
+
+    /// Whether `q` lies within the joint limits (inclusive).
+    pub fn within_limits(&self, q: &[f64]) -> bool {
+        q.iter()
+            .zip(self.lower.iter().zip(&self.upper))
+            .all(|(v, (lo, hi))| *v >= *lo && *v <= *hi)
+    }
+
+    /// The smallest of `values` (one per constraint) with its index, name and kind; `None`
+    /// for an empty set.
+    pub fn min_margin<'a>(&'a self, values: &[f64]) -> Option<Margin<'a>> {
+        let (index, value) = values
+            .iter()
+            .copied()
+            .enumerate()
+            .min_by(|a, b| a.1.total_cmp(&b.1))?;
+        Some(Margin {
+            index,
+            value,
+            name: &self.names[index],
+            kind: self.items[index].kind(),
+        })
+    }
+
+    /// Evaluates the constraints at `q` (into `ws.values`) and returns the smallest.
+    pub fn min_margin_at<'a>(
+        &'a self,
+        ws: &mut ConstraintWorkspace,
+        params: &[f64],
+        q: &[f64],
+    ) -> Option<Margin<'a>> {
+        let mut values = std::mem::take(&mut ws.values);
+        self.evaluate(ws, params, q, &mut values, None);
+        ws.values = values;
+        self.min_margin(&ws.values)
+    }
+
+    /// `q` within the joint limits and every constraint ≥ 0 (paper eq. 24b). Stops at the
+    /// first violated constraint (random draws are mostly rejected by one of the first few),
+    /// so `ws.values` is not filled; use [`ConstraintSet::min_margin_at`] for the values.
+    pub fn feasible(&self, ws: &mut ConstraintWorkspace, params: &[f64], q: &[f64]) -> bool {
+        if !self.within_limits(q) {
+            return false;
+        }
+        assert_eq!(params.len(), self.model.param_count(), "parameter count");
+        assert_eq!(q.len(), self.dof(), "joint count");
+        self.place(ws, params, q);
+        (0..self.len()).all(|row| self.evaluate_row(ws, row, None) >= 0.0)
+    }
+}
+
+/// `∂/∂q_j` of a distance whose closest points `P` (moved by joints `0..jp`) and `Q` (moved by
+/// joints `0..jq`) separate along the unit vector `n`: `n · (Ṗ_j − Q̇_j)`.
+#[inline]
+fn two_point_gradient(
+    grad: &mut [f64],
+    twists: &[Twist<f64>],
+    n: &Vector3<f64>,
+    p: &Vector3<f64>,
+    jp: usize,
+    q: &Vector3<f64>,
+    jq: usize,
+) {
+    for (j, (gj, tw)) in grad.iter_mut().zip(twists).enumerate() {
+        let mut v = 0.0;
+        if j < jp {
+            v += n.dot(&tw.point_velocity(p));
+        }
+        if j < jq {
+            v -= n.dot(&tw.point_velocity(q));
+        }
+        *gj = v;
+    }
+}
+
+/// Gradient of the beam–capsule distance: the beam's closest point `(1 − s) p + s t` moves
+/// with `(1 − s) ṗ` (the tracker origin `t` is fixed), the capsule's `Q` with joints `0..jq`.
+#[inline]
+fn beam_gradient(
+    grad: &mut [f64],
+    twists: &[Twist<f64>],
+    n: &Vector3<f64>,
+    s: f64,
+    p: &Vector3<f64>,
+    q: &Vector3<f64>,
+    jq: usize,
+) {
+    for (j, (gj, tw)) in grad.iter_mut().zip(twists).enumerate() {
+        let mut v = (1.0 - s) * n.dot(&tw.point_velocity(p));
+        if j < jq {
+            v -= n.dot(&tw.point_velocity(q));
+        }
+        *gj = v;
+    }
+}

@@ -1,0 +1,261 @@
+//! URDF → armcal: the serial chain from the root link to a tip link (see the [module
+//! documentation](super) for the mapping of joints, origins and limits).
+
+use crate::model::chain::{LinkSpec, ModelSpec};
+use crate::model::link::{Convention, Joint, JointKind, LinkGeometry};
+use crate::Error;
+use nalgebra::Vector3;
+use std::collections::{HashMap, HashSet};
+use std::path::Path;
+
+use super::{unique, CONTINUOUS_RANGE, M_PER_MM};
+
+/// Reads a URDF file and imports the chain from its root to `tip` (default: the single leaf
+/// link). Errors name the file.
+pub fn read_urdf(path: impl AsRef<Path>, tip: Option<&str>) -> Result<ModelSpec, Error> {
+    let path = path.as_ref();
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| Error::File {
+        file: file.clone(),
+        message: format!("cannot read the URDF file: {e}"),
+    })?;
+    from_urdf_str(&text, tip).map_err(|e| Error::File {
+        file,
+        message: match e {
+            Error::Input(m) => m,
+            other => other.to_string(),
+        },
+    })
+}
+
+/// Parses URDF text and imports the chain from its root to `tip` (default: the single leaf).
+pub fn from_urdf_str(xml: &str, tip: Option<&str>) -> Result<ModelSpec, Error> {
+    let robot = urdf_rs::read_from_string(xml)
+        .map_err(|e| Error::Input(format!("not a valid URDF document: {e}")))?;
+    from_urdf_robot(&robot, tip)
+}
+
+/// Imports the serial chain of a parsed URDF robot from its root link to `tip` (default: the
+/// single leaf link).
+pub fn from_urdf_robot(robot: &urdf_rs::Robot, tip: Option<&str>) -> Result<ModelSpec, Error> {
+    let err = |m: String| Error::Input(format!("URDF robot `{}`: {m}", robot.name));
+    if robot.links.is_empty() {
+        return Err(err("has no links".into()));
+    }
+    let mut links = HashSet::new();
+    for l in &robot.links {
+        if !links.insert(l.name.as_str()) {
+            return Err(err(format!("link `{}` is defined twice", l.name)));
+        }
+    }
+    // parent joint of every child link, and the joints leaving every link
+    let mut parent_joint: HashMap<&str, &urdf_rs::Joint> = HashMap::new();
+    let mut has_children: HashSet<&str> = HashSet::new();
+    for j in &robot.joints {
+        for end in [&j.parent.link, &j.child.link] {
+            if !links.contains(end.as_str()) {
+                return Err(err(format!(
+                    "joint `{}` refers to unknown link `{end}`",
+                    j.name
+                )));
+            }
+        }
+        if let Some(other) = parent_joint.insert(&j.child.link, j) {
+            return Err(err(format!(
+                "link `{}` is the child of two joints, `{}` and `{}` (a URDF is a tree)",
+                j.child.link, other.name, j.name
+            )));
+        }
+        has_children.insert(&j.parent.link);
+    }
+    let roots: Vec<&str> = robot
+        .links
+        .iter()
+        .map(|l| l.name.as_str())
+        .filter(|l| !parent_joint.contains_key(l))
+        .collect();
+    let root = match roots.as_slice() {
+        [r] => *r,
+        [] => return Err(err("has no root link: its joints form a cycle".into())),
+        _ => {
+            return Err(err(format!(
+                "has several root links ({}): the links are not connected into one tree",
+                roots.join(", ")
+            )))
+        }
+    };
+    let tip = match tip {
+        Some(t) => {
+            if !links.contains(t) {
+                let mut known: Vec<&str> = links.iter().copied().collect();
+                known.sort_unstable();
+                return Err(err(format!(
+                    "unknown tip link `{t}`; links: {}",
+                    known.join(", ")
+                )));
+            }
+            t
+        }
+        None => {
+            let leaves: Vec<&str> = robot
+                .links
+                .iter()
+                .map(|l| l.name.as_str())
+                .filter(|l| !has_children.contains(l))
+                .collect();
+            match leaves.as_slice() {
+                [l] => *l,
+                _ => {
+                    return Err(err(format!(
+                        "the tree branches into several leaf links ({}); choose the tip link \
+                         the chain ends in",
+                        leaves.join(", ")
+                    )))
+                }
+            }
+        }
+    };
+    // Walk up from the tip to the root.
+    let mut path = Vec::new();
+    let mut link = tip;
+    let mut seen = HashSet::new();
+    while let Some(j) = parent_joint.get(link) {
+        if !seen.insert(link) {
+            return Err(err(format!("the joints above link `{tip}` form a cycle")));
+        }
+        path.push(*j);
+        link = &j.parent.link;
+    }
+    debug_assert_eq!(link, root);
+    path.reverse();
+
+    let mut names: HashSet<String> = ["base".to_string(), "tool".to_string()].into();
+    let mut out = vec![identity_frame("base")];
+    for j in path {
+        let name = unique(&sanitise(&j.name), &mut names);
+        out.push(import_joint(j, name).map_err(|m| err(format!("joint `{}`: {m}", j.name)))?);
+    }
+    if out.iter().all(|l| l.joint.is_none()) {
+        return Err(err(format!(
+            "no movable joint between the root link `{root}` and the tip link `{tip}`"
+        )));
+    }
+    out.push(identity_frame("tool"));
+    Ok(ModelSpec {
+        name: robot.name.clone(),
+        instrument: None,
+        links: out,
+        targets: Vec::new(),
+    })
+}
+
+/// One URDF joint as a link spec (lengths in mm).
+fn import_joint(j: &urdf_rs::Joint, name: String) -> Result<LinkSpec, String> {
+    use urdf_rs::JointType as T;
+    let xyz = j.origin.xyz.0.map(|v| v / M_PER_MM);
+    let rpy = j.origin.rpy.0;
+    if !xyz.iter().chain(&rpy).all(|v| v.is_finite()) {
+        return Err(format!("origin xyz {xyz:?} mm / rpy {rpy:?} is not finite"));
+    }
+    let kind = match j.joint_type {
+        T::Fixed => {
+            return Ok(LinkSpec {
+                name,
+                geometry: LinkGeometry::frame6(xyz, rpy),
+                joint: None,
+            })
+        }
+        T::Revolute | T::Continuous => JointKind::Revolute,
+        T::Prismatic => JointKind::Prismatic,
+        ref other => {
+            return Err(format!(
+                "joint type `{}` is not supported (revolute, continuous, prismatic, fixed)",
+                format!("{other:?}").to_lowercase()
+            ))
+        }
+    };
+    if let Some(m) = &j.mimic {
+        return Err(format!(
+            "mimics `{}`: mimic joints are not supported (every chain joint is independent)",
+            m.joint
+        ));
+    }
+    let axis = Vector3::from(j.axis.xyz.0);
+    if !axis.iter().all(|v| v.is_finite()) || axis.norm() < 1e-12 {
+        return Err(format!(
+            "axis {:?} must be a finite, non-zero vector",
+            j.axis.xyz.0
+        ));
+    }
+    let axis = axis.normalize();
+    let (lower, upper) = match j.joint_type {
+        T::Continuous => (-CONTINUOUS_RANGE, CONTINUOUS_RANGE),
+        T::Revolute => {
+            let (l, u) = (j.limit.lower, j.limit.upper);
+            (
+                if l.is_finite() { l } else { -CONTINUOUS_RANGE },
+                if u.is_finite() { u } else { CONTINUOUS_RANGE },
+            )
+        }
+        _ => {
+            let (l, u) = (j.limit.lower, j.limit.upper);
+            if !(l.is_finite() && u.is_finite()) {
+                return Err(format!(
+                    "a prismatic joint needs finite limits, got [{l}, {u}] m"
+                ));
+            }
+            (l / M_PER_MM, u / M_PER_MM)
+        }
+    };
+    if lower.is_nan() || upper.is_nan() || lower >= upper {
+        return Err(format!(
+            "empty joint range [{}, {}] {} (is <limit> missing? use a fixed joint for a \
+             locked axis)",
+            j.limit.lower,
+            j.limit.upper,
+            if kind == JointKind::Prismatic {
+                "m"
+            } else {
+                "rad"
+            }
+        ));
+    }
+    let mut values = xyz.to_vec();
+    values.extend(rpy);
+    values.push(0.0);
+    Ok(LinkSpec {
+        name: name.clone(),
+        geometry: LinkGeometry {
+            convention: Convention::Urdf,
+            values,
+            axis: Some([axis.x, axis.y, axis.z]),
+        },
+        joint: Some(Joint {
+            name,
+            kind,
+            lower,
+            upper,
+        }),
+    })
+}
+
+fn identity_frame(name: &str) -> LinkSpec {
+    LinkSpec {
+        name: name.into(),
+        geometry: LinkGeometry::frame6([0.0; 3], [0.0; 3]),
+        joint: None,
+    }
+}
+
+/// A URDF name as an armcal frame name: `.` and `*` become `_`; empty becomes `joint`.
+fn sanitise(name: &str) -> String {
+    let s: String = name
+        .chars()
+        .map(|c| if c == '.' || c == '*' { '_' } else { c })
+        .collect();
+    if s.is_empty() {
+        "joint".into()
+    } else {
+        s
+    }
+}
