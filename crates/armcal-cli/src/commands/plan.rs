@@ -7,7 +7,7 @@ use armcal::design::assess::assess;
 use armcal::design::plan::{constraint_set, plan, CellConstraints, PlanSettings};
 use armcal::design::Criterion;
 use armcal::measure::csv;
-use armcal::report::DesignRecord;
+use armcal::design::DesignRecord;
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]

@@ -11,9 +11,11 @@ pub mod information;
 pub mod objective;
 pub mod order;
 pub mod plan;
+pub mod record;
 pub mod refine;
 pub mod small_cholesky;
 
 pub use criteria::{Criterion, CriterionValue};
 pub use information::{DesignModel, InformationWorkspace};
 pub use objective::{DesignObjective, ObjectiveWorkspace};
+pub use record::DesignRecord;

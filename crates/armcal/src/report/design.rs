@@ -2,7 +2,7 @@
 //! optimality bound and efficiency), its predicted precision (C_p, C_s), the poses as joint
 //! plots against the joint limits, and the smallest margin of every kind of constraint.
 
-use super::design_record::DesignRecord;
+use crate::design::DesignRecord;
 use super::estimate::observability_table;
 use super::figures::{bar_figure, joint_figure, JointTrace};
 use super::html::{escape, facts, fixed, number, table, Section};
