@@ -2,7 +2,7 @@
 
 use super::output::{load_cell, load_estimate, with_note, write_new, AcceptUnconverged, NoteStyle};
 use armcal::measure::csv;
-use armcal::sim::simulate;
+use armcal::sim::predict;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -40,12 +40,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         model,
         cell.data_columns.as_ref().map(|d| d.joints.as_slice()),
     )?;
-    let qs: Vec<Vec<f64>> = poses.iter().map(|(_, q)| q.clone()).collect();
-    let mut data = simulate(model, &params, &qs, None, 0)?;
-    for (k, (id, _)) in poses.iter().enumerate() {
-        data.config_ids[k] = id.clone();
-    }
-    data.source = "prediction".into();
+    let data = predict(model, &params, &poses)?;
     write_new(
         &a.out,
         &with_note(
@@ -58,7 +53,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     println!(
         "predicted {} measurements at {} configurations with the {} model → {}",
         data.measurements.len(),
-        qs.len(),
+        poses.len(),
         if a.estimate.is_some() {
             "identified"
         } else {

@@ -1,8 +1,10 @@
 //! What a design gives, before anything is measured: predicted C_p (paper §1.1), C_s at
 //! the working configurations, observability indices and every criterion's value — for a
-//! planned design or one a user made by hand.
+//! planned design or one a user made by hand; with its constraint margins, the record of
+//! `armcal evaluate` ([`evaluate_design`]).
 
 use crate::cell::Cell;
+use crate::design::plan::{constraint_set, CellConstraints, DesignMargin};
 use crate::design::{Criterion, DesignModel, DesignObjective, InformationWorkspace};
 use crate::identify::uncertainty::{self, Observability, TcpCovariance};
 use crate::Error;
@@ -61,5 +63,48 @@ pub fn assess(cell: &Cell, design: &[Vec<f64>]) -> Result<DesignAssessment, Erro
         tcp,
         observability: uncertainty::observability(&j),
         criteria,
+    })
+}
+
+/// What `armcal evaluate --json` prints: a design's assessment and how it meets the cell's
+/// constraints at the nominal parameters.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct DesignEvaluation {
+    pub cell: String,
+    pub poses: usize,
+    pub assessment: DesignAssessment,
+    /// The poses (1-based) outside the joint limits or violating a constraint.
+    pub infeasible_poses: Vec<usize>,
+    /// The smallest constraint margin over the design (none without constraints).
+    pub min_margin: Option<DesignMargin>,
+}
+
+impl DesignEvaluation {
+    /// The record as JSON (keys in alphabetical order, see [`crate::json`]).
+    pub fn to_json(&self) -> Result<String, Error> {
+        crate::json::sorted_pretty(self)
+    }
+}
+
+/// The assessment of `design` (internal units) for `cell`, its infeasible poses and its
+/// smallest margin, with or without the collision and line-of-sight constraints.
+pub fn evaluate_design(
+    cell: &Cell,
+    design: &[Vec<f64>],
+    collisions: bool,
+) -> Result<DesignEvaluation, Error> {
+    let assessment = assess(cell, design)?;
+    let set = constraint_set(cell, collisions)?;
+    let params = cell.model.nominal();
+    let cons = CellConstraints::new(&set, &params);
+    Ok(DesignEvaluation {
+        cell: cell.name.clone(),
+        poses: design.len(),
+        assessment,
+        infeasible_poses: (0..design.len())
+            .filter(|&i| !cons.feasible(&design[i]))
+            .map(|i| i + 1)
+            .collect(),
+        min_margin: cons.design_margin(design),
     })
 }

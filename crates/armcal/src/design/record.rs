@@ -5,7 +5,7 @@
 
 use crate::cell::Cell;
 use crate::design::assess::{assess, DesignAssessment};
-use crate::design::plan::{constraint_set, PlanReport};
+use crate::design::plan::{constraint_set, plan, PlanReport, PlanSettings};
 use crate::geometry::ConstraintKind;
 use crate::model::Model;
 use crate::Error;
@@ -200,6 +200,27 @@ impl DesignRecord {
             margins: kind_margins(cell, design, collisions)?,
             plan,
         })
+    }
+
+    /// Plans a design for `cell` ([`plan`], augmenting the `measured` poses) and makes its
+    /// record; `method` says how it was asked for.
+    pub fn planned(
+        cell: &Cell,
+        cell_source: Option<&str>,
+        method: &str,
+        settings: &PlanSettings,
+        measured: &[Vec<f64>],
+    ) -> Result<DesignRecord, Error> {
+        let report = plan(cell, settings, measured)?;
+        let design = report.design.clone();
+        DesignRecord::new(
+            cell,
+            cell_source,
+            method,
+            &design,
+            Some(report),
+            settings.collisions,
+        )
     }
 
     /// The poses in internal units (rad, mm) for `model`, whose joints must match the
