@@ -3,11 +3,11 @@
 
 mod common;
 use armcal::cell::Cell;
+use armcal::design::record::kind_margins;
+use armcal::design::DesignRecord;
 use armcal::identify::{identify, Estimate, IdentifyOptions, Silent};
 use armcal::model::identifiability::random_configurations;
 use armcal::model::{forward_kinematics, Data};
-use armcal::design::record::kind_margins;
-use armcal::design::DesignRecord;
 use armcal::report::ellipse::{confidence_scale, ellipse_axes, ellipse_points, Plane};
 use armcal::report::figures::{
     bar_figure, cdf_figure, colour, ellipse_figure, histogram_figure, joint_figure, series_figure,

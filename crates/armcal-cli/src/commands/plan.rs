@@ -6,8 +6,8 @@ use anyhow::bail;
 use armcal::design::assess::evaluate_design;
 use armcal::design::plan::PlanSettings;
 use armcal::design::Criterion;
-use armcal::measure::csv;
 use armcal::design::DesignRecord;
+use armcal::measure::csv;
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -176,10 +176,7 @@ pub fn run_evaluate(a: &EvaluateArgs) -> anyhow::Result<()> {
     for (c, v) in &ev.assessment.criteria {
         println!("  {:<4} {v:.6}", c.name());
     }
-    println!(
-        "  φ_A(C_p) = tr(C_p)/n_p = {:.6}",
-        ev.assessment.phi_a_cp
-    );
+    println!("  φ_A(C_p) = tr(C_p)/n_p = {:.6}", ev.assessment.phi_a_cp);
     for t in &ev.assessment.tcp {
         println!("  (1/3) tr C_s at `{}` = {:.5} mm²", t.name, t.kpi);
     }

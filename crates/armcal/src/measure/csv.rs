@@ -14,7 +14,7 @@
 //! unknown unit suffix is an error.
 
 use crate::measure::{Dataset, Measurement, MeasurementKind};
-use crate::model::{JointKind, Model, Observed, Pose};
+use crate::model::{Joint, JointKind, Model, Observed, Pose};
 use crate::Error;
 use nalgebra::Vector3;
 use std::collections::HashMap;
@@ -485,17 +485,7 @@ pub fn write_string(data: &Dataset, model: &Model) -> Result<String, Error> {
     });
     let mut w = csv::Writer::from_writer(Vec::new());
     let mut header = vec!["pose_id".to_string()];
-    for j in &model.joints {
-        header.push(format!(
-            "{}_{}",
-            j.name,
-            if j.kind == JointKind::Revolute {
-                "deg"
-            } else {
-                "mm"
-            }
-        ));
-    }
+    header.extend(model.joints.iter().map(joint_column));
     header.extend(["target", "x_mm", "y_mm", "z_mm"].map(String::from));
     if any_pose {
         header.extend(["roll_deg", "pitch_deg", "yaw_deg"].map(String::from));
@@ -565,21 +555,28 @@ pub fn write_string(data: &Dataset, model: &Model) -> Result<String, Error> {
     String::from_utf8(bytes).map_err(|e| Error::Input(e.to_string()))
 }
 
+/// The column armcal writes for a joint: its name with `_deg` (revolute) or `_mm`
+/// (prismatic).
+pub fn joint_column(j: &Joint) -> String {
+    format!(
+        "{}_{}",
+        j.name,
+        if j.kind == JointKind::Revolute {
+            "deg"
+        } else {
+            "mm"
+        }
+    )
+}
+
 /// Writes joint configurations (a pose list, design or joint program): `pose_id` 1, 2, …
 /// and one column per joint, `_deg` for revolute and `_mm` for prismatic joints — the format
 /// [`read_configurations`] reads.
 pub fn write_configurations(model: &Model, qs: &[Vec<f64>]) -> String {
     let mut s = String::from("pose_id");
     for j in &model.joints {
-        s.push_str(&format!(
-            ",{}_{}",
-            j.name,
-            if j.kind == JointKind::Revolute {
-                "deg"
-            } else {
-                "mm"
-            }
-        ));
+        s.push(',');
+        s.push_str(&joint_column(j));
     }
     s.push('\n');
     for (i, q) in qs.iter().enumerate() {

@@ -2,6 +2,7 @@
 //! Jacobians, identifiability, conversions and URDF.
 
 pub mod axes;
+pub mod axes_record;
 pub mod branch;
 pub mod chain;
 pub mod complete;

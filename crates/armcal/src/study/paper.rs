@@ -350,11 +350,7 @@ pub struct PaperStudy {
 
 /// The study over `robots` ([`run`]), timed, as its record; `progress` is called after
 /// each robot.
-pub fn run_study(
-    robots: &[String],
-    s: &StudySettings,
-    progress: &(dyn Fn() + Sync),
-) -> PaperStudy {
+pub fn run_study(robots: &[String], s: &StudySettings, progress: &(dyn Fn() + Sync)) -> PaperStudy {
     let t0 = Instant::now();
     let (failed, rows): (Vec<StudyRow>, Vec<StudyRow>) = run(robots, s, progress)
         .into_iter()
