@@ -4,6 +4,7 @@
 //! Every error names the file, the line and the field.
 
 pub mod export;
+pub mod model_analysis;
 mod raw;
 
 pub use crate::measure::NoiseModel;
