@@ -67,7 +67,11 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
             )?;
             write_new(
                 &a.out.with_extension("csv"),
-                &with_note(exported.table_csv.unwrap_or_default(), note, NoteStyle::Hash),
+                &with_note(
+                    exported.table_csv.unwrap_or_default(),
+                    note,
+                    NoteStyle::Hash,
+                ),
                 a.force,
             )?;
         }

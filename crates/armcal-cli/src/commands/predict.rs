@@ -1,6 +1,6 @@
 //! `armcal predict`: what the (nominal or identified) model says the instrument measures.
 
-use super::output::{load_cell, load_estimate, with_note, write_new, AcceptUnconverged, NoteStyle};
+use super::output::{load_cell, load_params, with_note, write_new, AcceptUnconverged, NoteStyle};
 use armcal::measure::csv;
 use armcal::sim::predict;
 use std::path::PathBuf;
@@ -28,13 +28,7 @@ pub struct Args {
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
-    let (params, note) = match &a.estimate {
-        Some(p) => {
-            let (est, note) = load_estimate(p, &a.accept, Some(model))?;
-            (est.params_for(model)?, note)
-        }
-        None => (model.nominal(), None),
-    };
+    let (params, note) = load_params(a.estimate.as_deref(), &a.accept, model)?;
     let poses = csv::read_configurations(
         &a.joints,
         model,

@@ -12,6 +12,7 @@ pub mod documents;
 pub mod ellipse;
 pub mod estimate;
 pub mod figures;
+pub mod files;
 pub mod font;
 pub mod html;
 pub mod study;
