@@ -127,6 +127,7 @@ pub enum ExportFormat {
     Cell(LinkForm),
     /// The model spec as JSON.
     Json,
+    /// URDF (the model's links as joints and fixed frames).
     Urdf,
 }
 
@@ -150,8 +151,11 @@ impl ExportFormat {
 /// ([`model_export::suspicious_values`]).
 #[derive(Clone, Debug)]
 pub struct Exported {
+    /// The exported file.
     pub content: String,
+    /// The parameter table beside a cell export.
     pub table_csv: Option<String>,
+    /// Values to check before loading the export, each as a sentence.
     pub warnings: Vec<String>,
 }
 

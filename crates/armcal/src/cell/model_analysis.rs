@@ -30,6 +30,7 @@ pub struct ModelAnalysis {
     /// On the parameters the cell declared free, before the automatic reduction, so that
     /// every excluded parameter gets its reason.
     pub identifiability: Identifiability,
+    /// Why fewer parameters are identifiable than the generic count, if so.
     pub rank_deficit: Option<RankDeficit>,
 }
 
@@ -99,15 +100,20 @@ pub fn analyze_model(
 /// A parameter in display units (mm, deg).
 #[derive(Clone, Debug, Serialize)]
 pub struct ParameterRecord {
+    /// The parameter's name in the registry (`j2.theta`).
     pub name: String,
+    /// Its display unit (`mm`, `deg`, or empty).
     pub unit: String,
+    /// Its nominal value in that unit.
     pub nominal: f64,
+    /// Free, fixed or with a prior.
     pub status: Status,
 }
 
 /// What `armcal model --json` prints.
 #[derive(Clone, Debug, Serialize)]
 pub struct ModelRecord {
+    /// The cell's name.
     pub cell: String,
     /// The robot's source (datasheet, paper).
     pub source: String,
@@ -115,11 +121,17 @@ pub struct ModelRecord {
     pub convention: Option<String>,
     /// The link form the cell asked for.
     pub form: String,
+    /// Links the cell's form changed (Hayati / β across nearly parallel axes).
     pub form_changes: Vec<FormChange>,
+    /// Nearly parallel axes left without a tilt parameter, with the fix.
     pub form_incomplete: Vec<String>,
+    /// The joints with their limits (internal units).
     pub joints: Vec<Joint>,
+    /// Every parameter of the model analysed.
     pub parameters: Vec<ParameterRecord>,
+    /// The identifiability analysis.
     pub identifiability: Identifiability,
+    /// Why fewer parameters are identifiable than the generic count, if so.
     pub rank_deficit: Option<RankDeficit>,
 }
 

@@ -29,6 +29,7 @@ const CORRECTION_PASSES: usize = 2;
 /// One filtered program row.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct FilteredRow {
+    /// The row's `pose_id`.
     pub id: String,
     /// The program's joint values (nominal model).
     pub q_nominal: Vec<f64>,
@@ -118,6 +119,7 @@ pub fn filter_joint_program_corrected(
 pub struct CorrectedTarget {
     /// The pose to send to the controller (its nominal model's pose at the solution).
     pub pose: Pose<f64>,
+    /// The solve with the calibrated model.
     pub result: IkResult,
     /// The nonparametric correction applied to the target position (world, mm).
     pub correction: Vector3<f64>,
@@ -174,9 +176,11 @@ pub struct CompensatedProgram {
 /// header has a `roll…` column) and its rows' ids and joint values.
 #[derive(Clone, Debug)]
 pub struct ProgramFile {
+    /// The file's text.
     pub text: String,
     /// The file's name, for messages.
     pub file: String,
+    /// Whether the rows are Cartesian tool targets (else joint configurations).
     pub cartesian: bool,
     /// `(pose_id, q)` per row: the program, or the Cartesian targets' starting guesses.
     pub rows: Vec<(String, Vec<f64>)>,

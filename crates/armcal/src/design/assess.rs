@@ -18,15 +18,19 @@ pub struct DesignAssessment {
     pub parameters: Vec<String>,
     /// Predicted σ of each free parameter (mm, rad).
     pub sigma: Vec<f64>,
+    /// The predicted covariance of the free parameters, C_p (paper §1.1).
     pub c_p: DMatrix<f64>,
     /// tr(C_p)/n_p (the paper's φ_A(C_p), mm and rad unscaled).
     pub phi_a_cp: f64,
+    /// C_s at each working configuration.
     pub tcp: Vec<TcpCovariance>,
+    /// The observability indices O1…O5 of the design's Jacobian.
     pub observability: Observability,
     /// Every criterion's value (see [`Criterion`]).
     pub criteria: Vec<(Criterion, f64)>,
 }
 
+/// The predicted precision of `design` (internal units) for `cell`, before anything is measured.
 pub fn assess(cell: &Cell, design: &[Vec<f64>]) -> Result<DesignAssessment, Error> {
     let d = DesignModel::from_cell(cell)?;
     let mut ws = InformationWorkspace::new(&d);
@@ -70,8 +74,11 @@ pub fn assess(cell: &Cell, design: &[Vec<f64>]) -> Result<DesignAssessment, Erro
 /// constraints at the nominal parameters.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct DesignEvaluation {
+    /// The cell's name.
     pub cell: String,
+    /// Number of poses.
     pub poses: usize,
+    /// The predicted precision ([`assess`]).
     pub assessment: DesignAssessment,
     /// The poses (1-based) outside the joint limits or violating a constraint.
     pub infeasible_poses: Vec<usize>,

@@ -13,24 +13,35 @@ use serde::{Deserialize, Serialize};
 /// One identified axis with its σ, beside the nominal axis.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct AxisRecord {
+    /// The joint's name.
     pub joint: String,
     /// Unit direction (instrument frame).
     pub direction: [f64; 3],
     /// A point on the axis (instrument frame, mm).
     pub point_mm: [f64; 3],
+    /// Circle radius (revolute) or 0 (prismatic).
     pub radius_mm: f64,
+    /// RMS residual of the circle or line fit.
     pub rms_mm: f64,
+    /// Number of points of the sweep.
     pub points: usize,
     /// Range of the swept joint's values, in `span_unit` (`°` or `mm`).
     pub span: f64,
+    /// The unit of `span`.
     pub span_unit: String,
+    /// Point noise per coordinate estimated from the fit's residuals (none for an exact fit).
     pub sigma_noise_mm: Option<f64>,
+    /// Degrees of freedom of that estimate.
     pub dof: Option<usize>,
+    /// σ of the direction (deg).
     pub sigma_direction_deg: Option<f64>,
+    /// σ of the point across the axis (mm).
     pub sigma_point_mm: Option<f64>,
     /// The basis `(x, u × x)` of the covariances below.
     pub covariance_basis: [[f64; 3]; 2],
+    /// Covariance of the direction's small rotation in `covariance_basis` (rad²).
     pub direction_covariance_rad2: Option<[[f64; 2]; 2]>,
+    /// Covariance of the point across the axis in `covariance_basis` (mm²).
     pub point_covariance_mm2: Option<[[f64; 2]; 2]>,
     /// Why the axis is not to be trusted, if it is not.
     pub warning: Option<String>,
@@ -44,7 +55,9 @@ pub struct AxisRecord {
 /// The axes of all joints, in joint order, and the warnings of those not to be trusted.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AxesRecord {
+    /// One record per joint, in joint order.
     pub axes: Vec<AxisRecord>,
+    /// The warnings of the axes not to be trusted.
     pub warnings: Vec<String>,
 }
 

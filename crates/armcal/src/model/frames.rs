@@ -9,8 +9,11 @@ use serde::{Deserialize, Serialize};
 /// A pose in user units: position (mm), roll-pitch-yaw (deg) and the homogeneous matrix.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PoseRecord {
+    /// Position (mm).
     pub xyz_mm: [f64; 3],
+    /// Roll, pitch, yaw (deg).
     pub rpy_deg: [f64; 3],
+    /// The homogeneous transform, rows (mm).
     pub matrix: [[f64; 4]; 4],
 }
 
@@ -29,32 +32,42 @@ impl PoseRecord {
 /// A joint value in its display unit (deg or mm).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct JointValue {
+    /// The joint's name.
     pub name: String,
+    /// Its value in `unit`.
     pub value: f64,
+    /// `deg` or `mm`.
     pub unit: String,
 }
 
 /// A link's or target's pose in the world frame.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct WorldFrame {
+    /// The link's or target's name.
     pub frame: String,
+    /// Its pose in the world frame.
     pub pose: PoseRecord,
 }
 
 /// A target's pose in the instrument frame.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MeasuredTarget {
+    /// The target's name.
     pub target: String,
+    /// Its pose in the instrument frame.
     pub pose: PoseRecord,
 }
 
 /// What `armcal fk` shows (and prints with `--json`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FramesRecord {
+    /// The cell's name.
     pub cell: String,
+    /// The configuration, display units.
     pub joints: Vec<JointValue>,
     /// The links, then the targets.
     pub frames_world: Vec<WorldFrame>,
+    /// The targets as the instrument measures them.
     pub in_instrument_frame: Vec<MeasuredTarget>,
 }
 

@@ -11,7 +11,9 @@ use std::path::{Path, PathBuf};
 
 /// The report's page and the notes it carries (also for the user's terminal).
 pub struct FilesReport {
+    /// The report page ([`Page::render`] gives the HTML).
     pub page: Page,
+    /// Notes for the reader, e.g. why the 3D view is missing.
     pub notes: Vec<String>,
 }
 

@@ -141,18 +141,24 @@ pub fn simulate(
 /// One parameter of a simulated robot, display units (mm, deg).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TrueParameter {
+    /// The parameter's name.
     pub name: String,
+    /// Its display unit.
     pub unit: String,
+    /// Its nominal value.
     pub nominal: f64,
+    /// Its true value.
     pub truth: f64,
 }
 
 /// The true parameters of a simulation (`armcal simulate --truth-out`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TruthRecord {
+    /// The cell's name.
     pub cell: String,
     /// The seed of the perturbation and of the noise.
     pub seed: u64,
+    /// Every parameter of the model, nominal and true.
     pub parameters: Vec<TrueParameter>,
 }
 
@@ -185,7 +191,9 @@ impl TruthRecord {
 /// A simulated campaign: the data measured and the robot that was measured.
 #[derive(Clone, Debug)]
 pub struct Simulation {
+    /// The data measured.
     pub data: Dataset,
+    /// The true parameters.
     pub truth: TruthRecord,
 }
 

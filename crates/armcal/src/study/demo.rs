@@ -22,6 +22,7 @@ const CELL: &str = include_str!("../../../../examples/paper-cell-obstacles.toml"
 /// One design's campaign.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Campaign {
+    /// `heuristic` or `kpi`.
     pub design: String,
     /// Predicted σ of the TCP at the working pose, √((1/3) tr C_s) (mm).
     pub tcp_sigma_predicted: f64,
@@ -36,33 +37,44 @@ pub struct Campaign {
 /// The demo's numbers.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct DemoSummary {
+    /// The seed of the truth, the designs and the noise.
     pub seed: u64,
+    /// Poses per design.
     pub poses: usize,
+    /// Held-out position error of the nominal model against the true robot (mm).
     pub nominal_held_out: ErrorStats,
     /// The nominal model's error per held-out pose (mm).
     pub nominal_held_out_errors: Vec<f64>,
+    /// The heuristic design's campaign.
     pub heuristic: Campaign,
+    /// The KPI design's campaign.
     pub kpi: Campaign,
     /// Largest miss of the working program on the true robot: nominal joints and filtered
     /// joints (mm).
     pub program_miss_nominal: f64,
+    /// (see `program_miss_nominal`)
     pub program_miss_compensated: f64,
+    /// Efficiency of the KPI design against the optimality bound, if computed.
     pub kpi_bound_efficiency: Option<f64>,
 }
 
 /// The demo: its summary, the files it produced (name, content) and the records a report
 /// of it shows.
 pub struct Demo {
+    /// The demo's numbers.
     pub summary: DemoSummary,
+    /// Every file of the demo but the report (name, content).
     pub files: Vec<(String, String)>,
     /// The cell calibrated (`cell.toml` among the files).
     pub cell: crate::cell::Cell,
     /// The records of the KPI and the heuristic design (`design-kpi.json`,
     /// `design-heuristic.json`).
     pub kpi_design: DesignRecord,
+    /// (see `kpi_design`)
     pub heuristic_design: DesignRecord,
     /// The estimates from the two campaigns (`estimate-kpi.json`, `estimate-heuristic.json`).
     pub kpi_estimate: Estimate,
+    /// (see `kpi_estimate`)
     pub heuristic_estimate: Estimate,
 }
 

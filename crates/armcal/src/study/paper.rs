@@ -37,15 +37,23 @@ pub fn cell_for(robot: &str, collisions: bool) -> Result<Cell, Error> {
 /// One robot, one collision setting: the KPI of each design (mm²).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct StudyRow {
+    /// The robot's name in the library.
     pub robot: String,
+    /// Whether collision avoidance applied.
     pub collisions: bool,
+    /// KPI of the heuristic design (mm²).
     pub heuristic: f64,
+    /// KPI of the C_p-optimal design (mm²).
     pub cp_optimal: f64,
+    /// KPI of the C_s-optimal (KPI) design (mm²).
     pub cs_optimal: f64,
     /// Improvement of the KPI design over the heuristic and over the C_p design (fractions).
     pub gain_vs_heuristic: f64,
+    /// (see `gain_vs_heuristic`)
     pub gain_vs_cp: f64,
+    /// Whether both optimal designs are feasible.
     pub feasible: bool,
+    /// Wall-clock time for this robot (s).
     pub seconds: f64,
     /// Why this robot has no result (e.g. no feasible configuration in the cell).
     pub error: Option<String>,
@@ -54,8 +62,11 @@ pub struct StudyRow {
 /// Settings of the study.
 #[derive(Clone, Debug)]
 pub struct StudySettings {
+    /// Collision avoidance (the cell with obstacles).
     pub collisions: bool,
+    /// Poses per design.
     pub poses: usize,
+    /// Seed of the candidate pool and of the heuristic design.
     pub seed: u64,
     /// The planner's settings (poses, criterion and collisions are set per run).
     pub plan: PlanSettings,
@@ -123,6 +134,7 @@ pub fn table6_robots() -> Vec<String> {
     ["kr15", "kr300", "kr500"].map(String::from).to_vec()
 }
 
+/// The 90 notional manipulators of Tables 7–8: `paper-<λ>-<μ>`, λ ∈ {650, …, 1100} mm, μ ∈ {600, …, 1000} mm.
 pub fn notional_robots() -> Vec<String> {
     let mut v = Vec::new();
     for l in (650..=1100).step_by(50) {
@@ -227,6 +239,7 @@ pub fn run(robots: &[String], s: &StudySettings, progress: &(dyn Fn() + Sync)) -
 pub struct StudyRecord {
     /// "paper".
     pub study: String,
+    /// Whether collision avoidance applied.
     pub collisions: bool,
     /// Wall-clock time of the whole study (s); 0 in files written before it was recorded.
     #[serde(default)]
@@ -238,8 +251,11 @@ pub struct StudyRecord {
 /// Mean, smallest and largest value of one column over some rows.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Spread {
+    /// Mean.
     pub mean: f64,
+    /// Smallest value.
     pub min: f64,
+    /// Largest value.
     pub max: f64,
 }
 
@@ -258,11 +274,17 @@ impl Spread {
 /// Tables 7–8: the notional manipulators' KPI per design and the KPI design's gains.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NotionalSummary {
+    /// Number of notional robots.
     pub robots: usize,
+    /// KPI of the heuristic designs (mm²).
     pub heuristic: Spread,
+    /// KPI of the C_p-optimal designs (mm²).
     pub cp_optimal: Spread,
+    /// KPI of the KPI designs (mm²).
     pub cs_optimal: Spread,
+    /// Gain of the KPI design over the heuristic (fraction).
     pub gain_vs_heuristic: Spread,
+    /// Gain of the KPI design over the C_p design (fraction).
     pub gain_vs_cp: Spread,
 }
 
@@ -344,7 +366,9 @@ impl StudyRecord {
 /// without one (with their error).
 #[derive(Clone, Debug)]
 pub struct PaperStudy {
+    /// The robots with a result.
     pub record: StudyRecord,
+    /// The robots without one, with their error.
     pub failed: Vec<StudyRow>,
 }
 

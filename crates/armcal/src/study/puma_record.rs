@@ -14,6 +14,7 @@ pub struct PumaRecord {
     pub study: String,
     /// Wall-clock time of the study (s).
     pub seconds: f64,
+    /// The study's result.
     pub result: PumaStudy,
 }
 

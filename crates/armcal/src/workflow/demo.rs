@@ -6,7 +6,9 @@ use crate::Error;
 
 /// The demo's summary and every file it writes (name, content), the report included.
 pub struct DemoFiles {
+    /// The demo's numbers.
     pub summary: DemoSummary,
+    /// Every file (name, content), `report.html` last.
     pub files: Vec<(String, String)>,
 }
 
