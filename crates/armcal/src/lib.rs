@@ -13,6 +13,8 @@ pub mod evaluate;
 pub mod geometry;
 pub mod identify;
 pub mod json;
+#[cfg(test)]
+mod layering;
 pub mod measure;
 pub mod model;
 pub mod report;
