@@ -12,12 +12,14 @@ pub mod design;
 pub mod error;
 pub mod geometry;
 pub mod identify;
+pub mod json;
 pub mod measure;
 pub mod model;
 pub mod report;
 pub mod robots;
 pub mod sim;
 pub mod study;
+pub mod workflow;
 
 pub use error::{Error, Result};
 /// The linear-algebra crate of the public API.

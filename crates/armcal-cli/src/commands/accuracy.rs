@@ -1,7 +1,7 @@
 //! `armcal accuracy`: ISO 9283 accuracy and repeatability, and the model's errors, from a
 //! data file.
 
-use super::output::{load_cell, load_data, load_estimate, AcceptUnconverged};
+use super::output::{load_cell, load_data, load_params, AcceptUnconverged};
 use armcal::accuracy::report::accuracy_report;
 use std::path::PathBuf;
 
@@ -26,13 +26,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
     let data = load_data(&cell, &a.data)?;
-    let (params, note) = match &a.estimate {
-        Some(p) => {
-            let (est, note) = load_estimate(p, &a.accept, Some(model))?;
-            (est.params_for(model)?, note)
-        }
-        None => (model.nominal(), None),
-    };
+    let (params, note) = load_params(a.estimate.as_deref(), &a.accept, model)?;
     let rep = accuracy_report(model, &params, &data);
     if a.json {
         println!("{}", serde_json::to_string_pretty(&rep)?);

@@ -5,13 +5,9 @@
 use super::output::{
     load_cell, load_data, load_estimate, with_note, write_new, AcceptUnconverged, NoteStyle,
 };
-use anyhow::bail;
 use armcal::compensate::nonparametric::{CorrectionInputs, ResidualCorrection};
-use armcal::compensate::program::{corrected_cartesian_targets, filter_joint_program_corrected};
-use armcal::compensate::{IkResult, IkSettings, IkStatus};
-use armcal::measure::{csv, MeasurementKind};
-use armcal::model::{JointKind, Model, Pose};
-use armcal::nalgebra::Vector3;
+use armcal::compensate::program::{compensate_program, ProgramFile};
+use armcal::compensate::IkSettings;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -50,64 +46,16 @@ pub struct Args {
     pub accept: AcceptUnconverged,
 }
 
-fn joints_header(model: &Model) -> String {
-    model
-        .joints
-        .iter()
-        .map(csv::joint_column)
-        .collect::<Vec<_>>()
-        .join(",")
-}
-
-fn joint_values(model: &Model, q: &[f64]) -> String {
-    q.iter()
-        .zip(&model.joints)
-        .map(|(v, j)| {
-            format!(
-                "{:.9}",
-                if j.kind == JointKind::Revolute {
-                    v.to_degrees()
-                } else {
-                    *v
-                }
-            )
-        })
-        .collect::<Vec<_>>()
-        .join(",")
-}
-
-/// Status (with the joint and limit, or the residual, for a row that did not converge) and
-/// residual columns.
-fn status_columns(model: &Model, r: &IkResult) -> String {
-    format!(
-        "{},{:.9},{:.9}",
-        r.describe(model),
-        r.position_error,
-        r.orientation_error.to_degrees()
-    )
-}
-
-/// `correction_x_mm,…,` columns (empty without a correction).
-fn correction_columns(c: &Vector3<f64>, with: bool) -> String {
-    if with {
-        format!("{:.6},{:.6},{:.6},", c.x, c.y, c.z)
-    } else {
-        String::new()
-    }
-}
-
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
     let (est, note) = load_estimate(&a.estimate, &a.accept, Some(model))?;
     let calibrated = est.params_for(model)?;
-    let nominal = model.nominal();
-    let settings = IkSettings::default();
-    let text = std::fs::read_to_string(&a.targets)?;
-    let header = text.lines().find(|l| !l.starts_with('#')).unwrap_or("");
-    let cartesian = header.split(',').any(|h| h.trim().starts_with("roll"));
-    let program =
-        csv::read_configurations_str(&text, &a.targets.display().to_string(), model, None)?;
+    let program = ProgramFile::read(
+        std::fs::read_to_string(&a.targets)?,
+        &a.targets.display().to_string(),
+        model,
+    )?;
     let correction = match &a.nonparametric {
         Some(path) => {
             let data = load_data(&cell, path)?;
@@ -132,102 +80,24 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         }
         None => None,
     };
-    let with = correction.is_some();
-    let correction_header = if with {
-        "correction_x_mm,correction_y_mm,correction_z_mm,"
-    } else {
-        ""
-    };
-    let mut out = String::new();
-    let mut failed = 0;
-    if cartesian {
-        // Read the tool poses with a robot-only model: rows become world-frame poses.
-        let mut robot_only = model.spec();
-        robot_only.instrument = None;
-        robot_only.targets.clear();
-        let robot = Model::from_spec(&robot_only)?;
-        let (data, _) = csv::read_str(&text, &a.targets.display().to_string(), &robot, None)?;
-        let poses: Vec<Pose<f64>> = data
-            .measurements
-            .iter()
-            .map(|m| match &m.kind {
-                MeasurementKind::Pose { value, .. } => Ok(*value),
-                _ => bail!(
-                    "line {}: Cartesian targets need x, y, z, roll, pitch, yaw",
-                    m.line
-                ),
-            })
-            .collect::<anyhow::Result<_>>()?;
-        let seeds: Vec<Vec<f64>> = data
-            .measurements
-            .iter()
-            .map(|m| data.configurations[m.config].clone())
-            .collect();
-        let rows = corrected_cartesian_targets(
-            model,
-            &nominal,
-            &calibrated,
-            &poses,
-            &seeds,
-            &settings,
-            correction.as_ref(),
-        );
-        out.push_str(&format!(
-            "pose_id,{},x_mm,y_mm,z_mm,roll_deg,pitch_deg,yaw_deg,{correction_header}status,position_error_mm,orientation_error_deg\n",
-            joints_header(model)
-        ));
-        for (i, row) in rows.iter().enumerate() {
-            let (xyz, rpy) = row.pose.to_xyz_rpy();
-            failed += usize::from(row.result.status != IkStatus::Converged);
-            out.push_str(&format!(
-                "{},{},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{}{}\n",
-                data.config_ids[data.measurements[i].config],
-                joint_values(model, &row.result.q),
-                xyz[0],
-                xyz[1],
-                xyz[2],
-                rpy[0].to_degrees(),
-                rpy[1].to_degrees(),
-                rpy[2].to_degrees(),
-                correction_columns(&row.correction, with),
-                status_columns(model, &row.result)
-            ));
-        }
-    } else {
-        let rows = filter_joint_program_corrected(
-            model,
-            &nominal,
-            &calibrated,
-            &program,
-            &settings,
-            correction.as_ref(),
-        );
-        out.push_str(&format!(
-            "pose_id,{},{correction_header}status,position_error_mm,orientation_error_deg\n",
-            joints_header(model)
-        ));
-        for row in &rows {
-            failed += usize::from(row.result.status != IkStatus::Converged);
-            out.push_str(&format!(
-                "{},{},{}{}\n",
-                row.id,
-                joint_values(model, &row.result.q),
-                correction_columns(&row.correction, with),
-                status_columns(model, &row.result)
-            ));
-        }
-    }
+    let comp = compensate_program(
+        model,
+        &calibrated,
+        &program,
+        &IkSettings::default(),
+        correction.as_ref(),
+    )?;
     write_new(
         &a.out,
-        &with_note(out, note.as_deref(), NoteStyle::Hash),
+        &with_note(comp.csv, note.as_deref(), NoteStyle::Hash),
         a.force,
     )?;
     println!(
         "{} {} filtered through the calibrated model → {} ({} not converged; see the status column)",
-        program.len(),
-        if cartesian { "Cartesian targets" } else { "joint configurations" },
+        comp.rows,
+        if comp.cartesian { "Cartesian targets" } else { "joint configurations" },
         a.out.display(),
-        failed
+        comp.not_converged
     );
     Ok(())
 }

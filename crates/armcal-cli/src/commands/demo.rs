@@ -1,7 +1,7 @@
 //! `armcal demo`: the whole workflow on the built-in paper cell.
 
 use anyhow::{bail, Context};
-use armcal::study::demo::run_demo;
+use armcal::workflow::demo::demo;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -39,7 +39,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         ProgressStyle::with_template("{spinner} {msg} ({elapsed})").expect("valid template"),
     );
     spinner.enable_steady_tick(Duration::from_millis(120));
-    let demo = run_demo(a.seed, &|stage| spinner.set_message(stage.to_string()))?;
+    let demo = demo(a.seed, &|stage| spinner.set_message(stage.to_string()))?;
     spinner.finish_and_clear();
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     std::fs::write(a.out.join(MARKER), "written by armcal demo\n")?;

@@ -2,9 +2,7 @@
 //! links), a parameter table, JSON or URDF.
 
 use super::output::{load_estimate, with_note, write_new, AcceptUnconverged, NoteStyle};
-use anyhow::Context;
-use armcal::model::complete::LinkForm;
-use armcal::model::{export, urdf, Model};
+use armcal::cell::export::{export_model, ExportFormat};
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -38,33 +36,23 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         .transpose()?;
     let (est, note) = load_estimate(&a.estimate, &a.accept, cell.as_ref().map(|c| &c.model))?;
     let note = note.as_deref();
-    let model = Model::from_spec(&est.model).context("rebuilding the identified model")?;
-    let form = match a.format.as_str() {
-        "zrp" => LinkForm::Zrp,
-        "dh" => LinkForm::Dh,
-        "mdh" => LinkForm::Mdh,
-        _ => LinkForm::AsGiven,
-    };
-    let spec = export::export_form(&est.model, form)?;
-    let reference = match &cell {
-        Some(c) => export::export_form(&c.model.spec(), form)?,
-        None => spec.clone(),
-    };
-    for w in export::suspicious_values(&Model::from_spec(&reference)?, &spec)? {
+    let format = ExportFormat::from_name(&a.format).expect("clap checked");
+    let exported = export_model(&est.model, cell.as_ref(), format)?;
+    for w in &exported.warnings {
         eprintln!("warning: {w}");
     }
-    match a.format.as_str() {
-        "json" => write_new(
+    match format {
+        ExportFormat::Json => write_new(
             &a.out,
-            &with_note(serde_json::to_string_pretty(&spec)?, note, NoteStyle::Json),
+            &with_note(exported.content, note, NoteStyle::Json),
             a.force,
         )?,
-        "urdf" => write_new(
+        ExportFormat::Urdf => write_new(
             &a.out,
-            &with_note(urdf::to_urdf(&spec)?, note, NoteStyle::Xml),
+            &with_note(exported.content, note, NoteStyle::Xml),
             a.force,
         )?,
-        _ => {
+        ExportFormat::Cell(_) => {
             if cell.is_none() {
                 eprintln!(
                     "note: without --cell the exported cell holds the model alone (no instrument \
@@ -74,19 +62,16 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
             }
             write_new(
                 &a.out,
-                &with_note(
-                    match &cell {
-                        Some(c) => armcal::cell::export::to_cell_toml(c, &model, &spec)?,
-                        None => export::to_cell_toml(&spec)?,
-                    },
-                    note,
-                    NoteStyle::Hash,
-                ),
+                &with_note(exported.content, note, NoteStyle::Hash),
                 a.force,
             )?;
             write_new(
                 &a.out.with_extension("csv"),
-                &with_note(export::to_table_csv(&spec), note, NoteStyle::Hash),
+                &with_note(
+                    exported.table_csv.unwrap_or_default(),
+                    note,
+                    NoteStyle::Hash,
+                ),
                 a.force,
             )?;
         }

@@ -1,7 +1,8 @@
 //! `armcal fk <robot-or-cell> --joints ...`
 
 use anyhow::{bail, Context};
-use armcal::model::{forward_kinematics, observed_pose, Data, JointKind, Observed, Pose};
+use armcal::model::frames::{frames, PoseRecord};
+use armcal::model::JointKind;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -16,15 +17,6 @@ pub struct Args {
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
-}
-
-fn pose_json(p: &Pose<f64>) -> serde_json::Value {
-    let (xyz, rpy) = p.to_xyz_rpy();
-    serde_json::json!({
-        "xyz_mm": xyz,
-        "rpy_deg": rpy.map(f64::to_degrees),
-        "matrix": p.to_matrix(),
-    })
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
@@ -63,39 +55,9 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
             _ => *v,
         })
         .collect();
-    model.check_joints(&q)?;
-    let params = model.nominal();
-    let mut data = Data::new(model);
-    forward_kinematics(model, &mut data, &params, &q);
-    let frames: Vec<(String, Pose<f64>)> = model
-        .links
-        .iter()
-        .zip(&data.frames)
-        .map(|(l, p)| (l.spec.name.clone(), *p))
-        .chain(
-            model
-                .targets
-                .iter()
-                .zip(&data.targets)
-                .map(|(l, p)| (l.spec.name.clone(), *p)),
-        )
-        .collect();
-    let measured: Vec<(String, Pose<f64>)> = (0..model.targets.len())
-        .map(|k| {
-            (
-                model.targets[k].spec.name.clone(),
-                observed_pose(&data, Observed::Target(k)),
-            )
-        })
-        .collect();
+    let rec = frames(&cell.name, model, &q)?;
     if a.json {
-        let out = serde_json::json!({
-            "cell": cell.name,
-            "joints": model.joints.iter().zip(&q).map(|(j, v)| serde_json::json!({"name": j.name, "value": v * j.kind.unit().display_factor(), "unit": j.kind.unit().display_name()})).collect::<Vec<_>>(),
-            "frames_world": frames.iter().map(|(n, p)| serde_json::json!({"frame": n, "pose": pose_json(p)})).collect::<Vec<_>>(),
-            "in_instrument_frame": measured.iter().map(|(n, p)| serde_json::json!({"target": n, "pose": pose_json(p)})).collect::<Vec<_>>(),
-        });
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        println!("{}", rec.to_json()?);
         return Ok(());
     }
     println!(
@@ -106,28 +68,23 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         "{:<10} {:>11} {:>11} {:>11} {:>9} {:>9} {:>9}",
         "frame", "x", "y", "z", "roll", "pitch", "yaw"
     );
-    let row = |n: &str, p: &Pose<f64>| {
-        let (t, r) = p.to_xyz_rpy();
+    let row = |n: &str, p: &PoseRecord| {
+        let (t, r) = (p.xyz_mm, p.rpy_deg);
         println!(
             "{n:<10} {:>11.4} {:>11.4} {:>11.4} {:>9.4} {:>9.4} {:>9.4}",
-            t[0],
-            t[1],
-            t[2],
-            r[0].to_degrees(),
-            r[1].to_degrees(),
-            r[2].to_degrees()
+            t[0], t[1], t[2], r[0], r[1], r[2]
         );
     };
-    for (n, p) in &frames {
-        row(n, p);
+    for f in &rec.frames_world {
+        row(&f.frame, &f.pose);
     }
     if let Some(inst) = &model.instrument {
         println!(
             "\nas the instrument `{}` measures them (instrument frame):",
             inst.spec.name
         );
-        for (n, p) in &measured {
-            row(n, p);
+        for t in &rec.in_instrument_frame {
+            row(&t.target, &t.pose);
         }
     }
     Ok(())

@@ -1,22 +1,13 @@
 //! `armcal model <robot-or-cell>`: parameters, completeness and identifiability.
 //!
-//! With `--convention dh|mdh|zrp` the model is first converted by `armcal::model::convert`
-//! (forward kinematics unchanged): `zrp` by `to_zrp` (identity base, one zero-reference
-//! link per joint, the tool pose at q = 0 as tool frame); `dh` by `zrp_to_dh` without a
-//! nominal (standard DH links by the common normals, book §6.3.4, and the tool frame that
-//! remains); `mdh` by `dh_to_mdh` of that. The table and the identifiability analysis are
-//! then those of the converted model. Its statuses, kept simple: the instrument and the
-//! targets, which the conversion copies unchanged, keep the cell's declared statuses; every
-//! chain parameter (base, links, tool) is a candidate, since the conversion redistributes
-//! the geometry among the chain's links and a fixed base or tool of the cell has no
-//! counterpart there. With `free = "auto"` in the cell the unidentifiable ones are shown
-//! fixed, as for the original model.
+//! With `--convention dh|mdh|zrp` the model is first converted (forward kinematics
+//! unchanged; `armcal::cell::model_analysis` says how and with which statuses); the table
+//! and the identifiability analysis are then those of the converted model.
 
-use armcal::cell::Cell;
-use armcal::model::complete::{in_form, LinkForm};
-use armcal::model::identifiability::{self, IdentifiabilityOptions, Measurement};
-use armcal::model::rank_deficit::rank_deficit;
-use armcal::model::{Model, Segment, Status};
+use armcal::cell::model_analysis::{analyze_model, ModelRecord};
+use armcal::model::complete::LinkForm;
+use armcal::model::identifiability::{IdentifiabilityOptions, Measurement};
+use armcal::model::Status;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -40,34 +31,6 @@ pub struct Args {
     pub convention: Option<String>,
 }
 
-/// The cell's model converted to `convention`, with the statuses described in the module
-/// documentation.
-fn converted(cell: &Cell, convention: &str) -> anyhow::Result<Model> {
-    let original = &cell.model;
-    let form = LinkForm::from_name(convention)
-        .ok_or_else(|| anyhow::anyhow!("unknown convention `{convention}`; use dh, mdh or zrp"))?;
-    let mut model = Model::from_spec(&in_form(&original.spec(), form)?.spec)?;
-    for i in 0..model.param_count() {
-        let p = model.registry.get(i);
-        let status = match p.segment {
-            Segment::Chain => Status::Free,
-            Segment::Instrument | Segment::Target(_) => {
-                let k = original.registry.require(&p.name)?;
-                if cell.declared_free.contains(&k) {
-                    match original.registry.get(k).status {
-                        Status::Prior { sigma } => Status::Prior { sigma },
-                        _ => Status::Free,
-                    }
-                } else {
-                    Status::Fixed
-                }
-            }
-        };
-        model.registry.set_status(i, status);
-    }
-    Ok(model)
-}
-
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let cell = super::output::load_cell(&a.target)?;
     let measurement = a
@@ -81,58 +44,20 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         seed: a.seed,
         ..cell.identifiability_options()
     };
-    // The analysis runs on the parameters the cell declared free, before the automatic
-    // reduction, so that every excluded parameter gets its reason.
-    let (model, report, deficit) = match a.convention.as_deref() {
-        Some(c) => {
-            let mut m = converted(&cell, c)?;
-            let report = identifiability::analyze(&m, &m.nominal(), &opts)?;
-            let deficit = rank_deficit(
-                &m,
-                &m.nominal(),
-                report.identifiable.len(),
-                measurement,
-                None,
-            )?;
-            if cell.auto_free {
-                report.apply(&mut m)?;
-            }
-            (std::borrow::Cow::Owned(m), report, deficit)
-        }
-        None => {
-            let report = cell.identifiability(&opts)?;
-            let deficit = cell.rank_deficit(&report, &cell.model.nominal(), None)?;
-            (std::borrow::Cow::Borrowed(&cell.model), report, deficit)
-        }
-    };
+    let convention = a
+        .convention
+        .as_deref()
+        .map(|c| LinkForm::from_name(c).expect("clap checked"));
+    let analysis = analyze_model(&cell, &opts, convention)?;
     if a.json {
-        let params: Vec<_> = model
-            .registry
-            .iter()
-            .map(|p| {
-                serde_json::json!({
-                    "name": p.name,
-                    "unit": p.unit.display_name(),
-                    "nominal": p.nominal * p.unit.display_factor(),
-                    "status": p.status,
-                })
-            })
-            .collect();
-        let out = serde_json::json!({
-            "cell": cell.name,
-            "source": cell.robot.source,
-            "convention": a.convention,
-            "form": cell.form.name(),
-            "form_changes": cell.form_changes,
-            "form_incomplete": cell.form_incomplete,
-            "joints": model.joints,
-            "parameters": params,
-            "identifiability": report,
-            "rank_deficit": deficit,
-        });
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        println!("{}", ModelRecord::new(&cell, &analysis).to_json()?);
         return Ok(());
     }
+    let (model, report, deficit) = (
+        &analysis.model,
+        &analysis.identifiability,
+        &analysis.rank_deficit,
+    );
     println!("{} ({})", cell.name, cell.origin);
     println!("source: {}", cell.robot.source);
     for c in &cell.form_changes {

@@ -72,6 +72,22 @@ pub fn load_estimate(
     Ok((est, usable.overridden))
 }
 
+/// The parameters of the estimate at `path` for `model` ([`load_estimate`]), or the nominal
+/// ones without an estimate; with the line every output made with them must carry.
+pub fn load_params(
+    path: Option<&Path>,
+    accept: &AcceptUnconverged,
+    model: &armcal::model::Model,
+) -> anyhow::Result<(Vec<f64>, Option<String>)> {
+    match path {
+        Some(p) => {
+            let (est, note) = load_estimate(p, accept, Some(model))?;
+            Ok((est.params_for(model)?, note))
+        }
+        None => Ok((model.nominal(), None)),
+    }
+}
+
 /// How an output format carries a note.
 #[derive(Clone, Copy)]
 pub enum NoteStyle {

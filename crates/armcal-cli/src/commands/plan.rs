@@ -3,11 +3,11 @@
 
 use super::output::{load_cell, write_new};
 use anyhow::bail;
-use armcal::design::assess::assess;
-use armcal::design::plan::{constraint_set, plan, CellConstraints, PlanSettings};
+use armcal::design::assess::evaluate_design;
+use armcal::design::plan::PlanSettings;
 use armcal::design::Criterion;
+use armcal::design::DesignRecord;
 use armcal::measure::csv;
-use armcal::report::DesignRecord;
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -83,22 +83,21 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         seed: a.seed,
         ..PlanSettings::default()
     };
-    let rep = plan(&cell, &settings, &measured)?;
-    write_new(
-        &a.out,
-        &csv::write_configurations(&cell.model, &rep.design),
-        a.force,
-    )?;
-    let record = DesignRecord::new(
+    let record = DesignRecord::planned(
         &cell,
         Some(&a.cell),
         &format!(
             "armcal plan, criterion {}, {} start(s), seed {}",
             a.criterion, a.starts, a.seed
         ),
-        &rep.design,
-        Some(rep.clone()),
-        settings.collisions,
+        &settings,
+        &measured,
+    )?;
+    let rep = record.plan.as_ref().expect("a planned design");
+    write_new(
+        &a.out,
+        &csv::write_configurations(&cell.model, &rep.design),
+        a.force,
     )?;
     write_new(
         &report_path,
@@ -168,46 +167,25 @@ pub fn run_evaluate(a: &EvaluateArgs) -> anyhow::Result<()> {
         .into_iter()
         .map(|(_, q)| q)
         .collect();
-    let assess = serde_json::to_value(assess(&cell, &design)?)?;
-    let set = constraint_set(&cell, a.collisions == "on")?;
-    let params = cell.model.nominal();
-    let cons = CellConstraints::new(&set, &params);
-    let infeasible: Vec<usize> = (0..design.len())
-        .filter(|&i| !cons.feasible(&design[i]))
-        .collect();
-    let margin = cons.design_margin(&design);
+    let ev = evaluate_design(&cell, &design, a.collisions == "on")?;
     if a.json {
-        let out = serde_json::json!({"cell": cell.name, "poses": design.len(), "assessment": assess, "infeasible_poses": infeasible.iter().map(|i| i + 1).collect::<Vec<_>>(), "min_margin": margin});
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        println!("{}", ev.to_json()?);
         return Ok(());
     }
-    println!("{} poses on `{}`", design.len(), cell.name);
-    if let Some(c) = assess["criteria"].as_array() {
-        for kv in c {
-            println!(
-                "  {:<4} {:.6}",
-                kv[0].as_str().unwrap_or(""),
-                kv[1].as_f64().unwrap_or(f64::NAN)
-            );
-        }
+    println!("{} poses on `{}`", ev.poses, ev.cell);
+    for (c, v) in &ev.assessment.criteria {
+        println!("  {:<4} {v:.6}", c.name());
     }
-    println!(
-        "  φ_A(C_p) = tr(C_p)/n_p = {:.6}",
-        assess["phi_a_cp"].as_f64().unwrap_or(f64::NAN)
-    );
-    if let Some(ts) = assess["tcp"].as_array() {
-        for t in ts {
-            println!(
-                "  (1/3) tr C_s at `{}` = {:.5} mm²",
-                t["name"].as_str().unwrap_or(""),
-                t["kpi"].as_f64().unwrap_or(f64::NAN)
-            );
-        }
+    println!("  φ_A(C_p) = tr(C_p)/n_p = {:.6}", ev.assessment.phi_a_cp);
+    for t in &ev.assessment.tcp {
+        println!("  (1/3) tr C_s at `{}` = {:.5} mm²", t.name, t.kpi);
     }
-    match (&margin, infeasible.is_empty()) {
-        (_, true) => println!(
+    let infeasible = &ev.infeasible_poses;
+    match (&ev.min_margin, infeasible.is_empty()) {
+        (margin, true) => println!(
             "every pose feasible; smallest margin {}",
             margin
+                .as_ref()
                 .map(|m| format!(
                     "{:.4} on `{}` at pose {}",
                     m.value,
@@ -221,7 +199,7 @@ pub fn run_evaluate(a: &EvaluateArgs) -> anyhow::Result<()> {
             infeasible.len(),
             infeasible
                 .iter()
-                .map(|i| (i + 1).to_string())
+                .map(|i| i.to_string())
                 .collect::<Vec<_>>()
                 .join(", "),
             m.value,

@@ -1,8 +1,8 @@
 //! `armcal predict`: what the (nominal or identified) model says the instrument measures.
 
-use super::output::{load_cell, load_estimate, with_note, write_new, AcceptUnconverged, NoteStyle};
+use super::output::{load_cell, load_params, with_note, write_new, AcceptUnconverged, NoteStyle};
 use armcal::measure::csv;
-use armcal::sim::simulate;
+use armcal::sim::predict;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -28,24 +28,13 @@ pub struct Args {
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
-    let (params, note) = match &a.estimate {
-        Some(p) => {
-            let (est, note) = load_estimate(p, &a.accept, Some(model))?;
-            (est.params_for(model)?, note)
-        }
-        None => (model.nominal(), None),
-    };
+    let (params, note) = load_params(a.estimate.as_deref(), &a.accept, model)?;
     let poses = csv::read_configurations(
         &a.joints,
         model,
         cell.data_columns.as_ref().map(|d| d.joints.as_slice()),
     )?;
-    let qs: Vec<Vec<f64>> = poses.iter().map(|(_, q)| q.clone()).collect();
-    let mut data = simulate(model, &params, &qs, None, 0)?;
-    for (k, (id, _)) in poses.iter().enumerate() {
-        data.config_ids[k] = id.clone();
-    }
-    data.source = "prediction".into();
+    let data = predict(model, &params, &poses)?;
     write_new(
         &a.out,
         &with_note(
@@ -58,7 +47,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     println!(
         "predicted {} measurements at {} configurations with the {} model → {}",
         data.measurements.len(),
-        qs.len(),
+        poses.len(),
         if a.estimate.is_some() {
             "identified"
         } else {

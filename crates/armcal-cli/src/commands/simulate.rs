@@ -2,7 +2,7 @@
 
 use super::output::{load_cell, write_new};
 use armcal::measure::csv;
-use armcal::sim::{perturbed_truth, simulate, Perturbation};
+use armcal::sim::{simulate_poses, Perturbation};
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -43,43 +43,32 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
     let poses = csv::read_configurations(&a.poses, model, None)?;
-    let qs: Vec<Vec<f64>> = poses.iter().map(|(_, q)| q.clone()).collect();
     let pert = Perturbation {
         length: a.perturb_mm,
         angle: a.perturb_deg.to_radians(),
         all: a.perturb_all,
         ..Perturbation::default()
     };
-    let truth = perturbed_truth(model, &pert, a.seed);
     let noise = cell.noise();
-    let mut data = simulate(
+    let sim = simulate_poses(
+        &cell.name,
         model,
-        &truth,
-        &qs,
+        &poses,
+        &pert,
         (!a.noise_free).then_some(&noise),
-        a.seed.wrapping_add(0x5eed),
+        a.seed,
     )?;
-    for (k, (id, _)) in poses.iter().enumerate() {
-        data.config_ids[k] = id.clone();
-    }
-    write_new(&a.out, &csv::write_string(&data, model)?, a.force)?;
+    write_new(&a.out, &csv::write_string(&sim.data, model)?, a.force)?;
     println!(
         "simulated {} measurements at {} configurations of `{}` (seed {}) → {}",
-        data.measurements.len(),
-        qs.len(),
+        sim.data.measurements.len(),
+        poses.len(),
         cell.name,
         a.seed,
         a.out.display()
     );
     if let Some(t) = &a.truth_out {
-        let params: Vec<_> = model
-            .registry
-            .iter()
-            .zip(&truth)
-            .map(|(p, v)| serde_json::json!({"name": p.name, "unit": p.unit.display_name(), "nominal": p.nominal * p.unit.display_factor(), "truth": v * p.unit.display_factor()}))
-            .collect();
-        let json = serde_json::json!({"cell": cell.name, "seed": a.seed, "parameters": params});
-        write_new(t, &serde_json::to_string_pretty(&json)?, a.force)?;
+        write_new(t, &sim.truth.to_json()?, a.force)?;
         println!("true parameters → {}", t.display());
     }
     Ok(())

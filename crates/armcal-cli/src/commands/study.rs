@@ -2,10 +2,8 @@
 //! `armcal study puma`: the book's Chapter 6 PUMA case (Tables 6.9/6.10 and 6.13).
 
 use super::output::write_new;
-use armcal::study::paper::{
-    notional_robots, run, table6_robots, StudyRow, StudySettings, PAPER_SUMMARY, PAPER_TABLE6,
-};
-use armcal::study::puma;
+use armcal::study::paper::{self, RobotSelection, StudySettings, PAPER_SUMMARY, PAPER_TABLE6};
+use armcal::study::{puma, puma_record};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -34,14 +32,6 @@ pub struct Args {
     pub force: bool,
 }
 
-fn mean(rows: &[&StudyRow], f: impl Fn(&StudyRow) -> f64) -> (f64, f64, f64) {
-    let v: Vec<f64> = rows.iter().map(|r| f(r)).collect();
-    let m = v.iter().sum::<f64>() / v.len().max(1) as f64;
-    let lo = v.iter().cloned().fold(f64::INFINITY, f64::min);
-    let hi = v.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
-    (m, lo, hi)
-}
-
 pub fn run_study(a: &Args) -> anyhow::Result<()> {
     if a.which == "puma" {
         return run_puma(a);
@@ -51,13 +41,9 @@ pub fn run_study(a: &Args) -> anyhow::Result<()> {
         .clone()
         .unwrap_or_else(|| PathBuf::from("out/study-paper"));
     let collisions = a.collisions == "on";
-    let mut robots = Vec::new();
-    if a.robots != "notional" {
-        robots.extend(table6_robots());
-    }
-    if a.robots != "table6" {
-        robots.extend(notional_robots());
-    }
+    let robots = RobotSelection::from_name(&a.robots)
+        .expect("clap checked")
+        .robots();
     let settings = StudySettings {
         collisions,
         seed: a.seed,
@@ -71,21 +57,21 @@ pub fn run_study(a: &Args) -> anyhow::Result<()> {
         ProgressStyle::with_template("{bar:40} {pos}/{len} robots, {elapsed} (eta {eta})")
             .expect("valid template"),
     );
-    let t0 = std::time::Instant::now();
-    let all = run(&robots, &settings, &|| bar.inc(1));
-    for r in all.iter().filter(|r| r.error.is_some()) {
+    let study = paper::run_study(&robots, &settings, &|| bar.inc(1));
+    for r in &study.failed {
         println!(
             "{}: no result: {}",
             r.robot,
             r.error.as_deref().unwrap_or("")
         );
     }
-    let rows: Vec<StudyRow> = all.iter().filter(|r| r.error.is_none()).cloned().collect();
     bar.finish_and_clear();
-    let secs = t0.elapsed().as_secs_f64();
+    let record = &study.record;
+    let rows = &record.rows;
+    let secs = record.seconds;
     let col = if collisions { "with" } else { "without" };
     println!("paper study, {col} collision avoidance, 60 poses, (1/3) tr C_s in mm² — {} robots in {secs:.1} s", rows.len());
-    let t6: Vec<&StudyRow> = rows.iter().filter(|r| r.robot.starts_with("kr")).collect();
+    let t6 = record.table6();
     if !t6.is_empty() {
         println!(
             "\nTable 6 {:>22} {:>22} {:>22}",
@@ -107,84 +93,43 @@ pub fn run_study(a: &Args) -> anyhow::Result<()> {
             );
         }
     }
-    let nt: Vec<&StudyRow> = rows
-        .iter()
-        .filter(|r| r.robot.starts_with("paper-"))
-        .collect();
-    if !nt.is_empty() {
+    if let Some(nt) = record.notional_summary() {
         println!(
             "\nTables 7–8, {} notional manipulators: mean (min–max)",
-            nt.len()
+            nt.robots
         );
-        let paper_col = |i: usize| {
-            if collisions {
-                PAPER_SUMMARY[i].2
-            } else {
-                PAPER_SUMMARY[i].1
-            }
-        };
-        for (i, (name, f)) in [
-            (
-                "heuristic",
-                Box::new(|r: &StudyRow| r.heuristic) as Box<dyn Fn(&StudyRow) -> f64>,
-            ),
-            ("C_p-optimal", Box::new(|r: &StudyRow| r.cp_optimal)),
-            ("C_s-optimal (KPI)", Box::new(|r: &StudyRow| r.cs_optimal)),
+        for (i, (name, s)) in [
+            ("heuristic", nt.heuristic),
+            ("C_p-optimal", nt.cp_optimal),
+            ("C_s-optimal (KPI)", nt.cs_optimal),
         ]
         .into_iter()
         .enumerate()
         {
-            let (m, lo, hi) = mean(&nt, f);
+            let paper = if collisions {
+                PAPER_SUMMARY[i].2
+            } else {
+                PAPER_SUMMARY[i].1
+            };
             println!(
-                "  {name:<18} armcal {m:.3} ({lo:.3}–{hi:.3})   paper {:.2}",
-                paper_col(i)
+                "  {name:<18} armcal {:.3} ({:.3}–{:.3})   paper {paper:.2}",
+                s.mean, s.min, s.max
             );
         }
-        let (gh, ghl, ghh) = mean(&nt, |r| r.gain_vs_heuristic);
-        let (gc, gcl, gch) = mean(&nt, |r| r.gain_vs_cp);
+        let (gh, gc) = (nt.gain_vs_heuristic, nt.gain_vs_cp);
         println!(
             "  KPI design vs heuristic: −{:.0} % ({:.0}–{:.0} %), vs C_p design: −{:.0} % ({:.0}–{:.0} %)   paper: 40–44 %, 10–19 %",
-            100.0 * gh, 100.0 * ghl, 100.0 * ghh, 100.0 * gc, 100.0 * gcl, 100.0 * gch
+            100.0 * gh.mean, 100.0 * gh.min, 100.0 * gh.max, 100.0 * gc.mean, 100.0 * gc.min, 100.0 * gc.max
         );
     }
-    let infeasible: Vec<&str> = rows
-        .iter()
-        .filter(|r| !r.feasible)
-        .map(|r| r.robot.as_str())
-        .collect();
+    let infeasible = record.infeasible();
     if !infeasible.is_empty() {
         println!("designs violating constraints: {}", infeasible.join(", "));
     }
-    let mut csv = String::from("robot,collisions,heuristic_mm2,cp_optimal_mm2,cs_optimal_mm2,gain_vs_heuristic,gain_vs_cp,feasible,seconds\n");
-    for r in &rows {
-        csv.push_str(&format!(
-            "{},{},{:.6},{:.6},{:.6},{:.4},{:.4},{},{:.2}\n",
-            r.robot,
-            r.collisions,
-            r.heuristic,
-            r.cp_optimal,
-            r.cs_optimal,
-            r.gain_vs_heuristic,
-            r.gain_vs_cp,
-            r.feasible,
-            r.seconds
-        ));
-    }
-    let suffix = if collisions {
-        "collisions"
-    } else {
-        "no-collisions"
-    };
-    let csv_path = out.join(format!("study-{suffix}.csv"));
-    let json_path = out.join(format!("study-{suffix}.json"));
-    write_new(&csv_path, &csv, a.force)?;
-    write_new(
-        &json_path,
-        &serde_json::to_string_pretty(
-            &serde_json::json!({"study": "paper", "collisions": collisions, "seconds": secs, "rows": rows}),
-        )?,
-        a.force,
-    )?;
+    let csv_path = out.join(format!("{}.csv", record.file_stem()));
+    let json_path = out.join(format!("{}.json", record.file_stem()));
+    write_new(&csv_path, &record.to_csv(), a.force)?;
+    write_new(&json_path, &record.to_json()?, a.force)?;
     println!("\n→ {}, {}", csv_path.display(), json_path.display());
     Ok(())
 }
@@ -196,12 +141,12 @@ fn run_puma(a: &Args) -> anyhow::Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out/study-puma"));
-    let t0 = std::time::Instant::now();
-    let s = puma::run(&puma::PumaSettings {
+    let record = puma_record::run_record(&puma::PumaSettings {
         seed: a.seed,
         ..Default::default()
     })?;
-    let secs = t0.elapsed().as_secs_f64();
+    let s = &record.result;
+    let secs = record.seconds;
     println!(
         "PUMA 560 study (book ch. 6): truth Table 6.5, {} full poses with Table 6.4 noise \
          (σ {:.4}/{:.4}/{:.4} mm, {:.4} mrad; seed {}), {} held-out poses — {secs:.1} s",
@@ -320,75 +265,12 @@ fn run_puma(a: &Args) -> anyhow::Result<()> {
          errors include non-geometric errors and the CMM's accuracy)"
     );
 
-    let mut conv = String::from(
-        "transform,link,field1,field2,field3,conv_p1,conv_p2,conv_p3,ident_p1,ident_p2,ident_p3,\
-         sigma_p1,sigma_p2,sigma_p3,truth_p1,truth_p2,truth_p3,book_conv_p1,book_conv_p2,book_conv_p3,book_ident_p1,\
-         book_ident_p2,book_ident_p3\n",
-    );
-    for r in &s.conversion {
-        let v: Vec<String> = [
-            r.converted,
-            r.identified,
-            r.identified_sigma,
-            r.truth,
-            r.book_converted,
-            r.book_identified,
-        ]
-        .iter()
-        .flatten()
-        .map(|x| format!("{x:.6}"))
-        .collect();
-        conv.push_str(&format!(
-            "{},{},{},{}\n",
-            r.transform,
-            r.link,
-            r.fields.join(","),
-            v.join(",")
-        ));
-    }
-    let mut acc = String::from(
-        "pose,nominal_dr_in,nominal_dtheta_deg,mdh_dr_in,mdh_dtheta_deg,zrp_dr_in,zrp_dtheta_deg,\
-         book_nominal_dr_in,book_nominal_dtheta_deg,book_mdh_dr_in,book_mdh_dtheta_deg,\
-         book_zrp_dr_in,book_zrp_dtheta_deg\n",
-    );
-    for r in &s.held_out {
-        let b = r
-            .book
-            .map(|b| {
-                format!(
-                    "{},{},{},{},{},{}",
-                    b.nominal_dr_in,
-                    b.nominal_dtheta_deg,
-                    b.mdh_dr_in,
-                    b.mdh_dtheta_deg,
-                    b.zrp_dr_in,
-                    b.zrp_dtheta_deg
-                )
-            })
-            .unwrap_or_else(|| ",,,,,".into());
-        acc.push_str(&format!(
-            "{},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{b}\n",
-            r.pose,
-            r.nominal_dr_in,
-            r.nominal_dtheta_deg,
-            r.mdh_dr_in,
-            r.mdh_dtheta_deg,
-            r.zrp_dr_in,
-            r.zrp_dtheta_deg
-        ));
-    }
     let json_path = out.join("puma.json");
     let conv_path = out.join("puma-conversion.csv");
     let acc_path = out.join("puma-accuracy.csv");
-    write_new(&conv_path, &conv, a.force)?;
-    write_new(&acc_path, &acc, a.force)?;
-    write_new(
-        &json_path,
-        &serde_json::to_string_pretty(
-            &serde_json::json!({"study": "puma", "seconds": secs, "result": s}),
-        )?,
-        a.force,
-    )?;
+    write_new(&conv_path, &s.conversion_csv(), a.force)?;
+    write_new(&acc_path, &s.accuracy_csv(), a.force)?;
+    write_new(&json_path, &record.to_json()?, a.force)?;
     println!(
         "\n→ {}, {}, {}",
         json_path.display(),

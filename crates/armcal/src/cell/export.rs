@@ -6,8 +6,9 @@
 //! `free = "auto"`.
 
 use super::{Cell, NoiseModel, Obstacle};
-use crate::model::export::{to_cell_toml_with, CellSections};
-use crate::model::{Model, ModelSpec, Status, Unit};
+use crate::model::complete::LinkForm;
+use crate::model::export::{self as model_export, to_cell_toml_with, CellSections};
+use crate::model::{urdf, Model, ModelSpec, Status, Unit};
 use crate::robots::transfer_capsules;
 use crate::Error;
 use std::fmt::Write;
@@ -116,4 +117,85 @@ fn parameters(cell: &Cell, exported: &Model) -> String {
         let _ = writeln!(out, "priors = {{ {} }}", priors.join(", "));
     }
     out
+}
+
+/// The formats of `armcal export`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ExportFormat {
+    /// A cell file with the links in this form (DH, modified DH, zero reference, or as
+    /// identified), with a parameter table.
+    Cell(LinkForm),
+    /// The model spec as JSON.
+    Json,
+    /// URDF (the model's links as joints and fixed frames).
+    Urdf,
+}
+
+impl ExportFormat {
+    /// `dh`, `mdh`, `zrp`, `cell` (links as identified), `json` or `urdf`.
+    pub fn from_name(s: &str) -> Option<ExportFormat> {
+        Some(match s {
+            "dh" => ExportFormat::Cell(LinkForm::Dh),
+            "mdh" => ExportFormat::Cell(LinkForm::Mdh),
+            "zrp" => ExportFormat::Cell(LinkForm::Zrp),
+            "cell" => ExportFormat::Cell(LinkForm::AsGiven),
+            "json" => ExportFormat::Json,
+            "urdf" => ExportFormat::Urdf,
+            _ => return None,
+        })
+    }
+}
+
+/// An exported model: the file's content, the parameter table (CSV) of a cell export, and
+/// the values a user should look at before loading it
+/// ([`model_export::suspicious_values`]).
+#[derive(Clone, Debug)]
+pub struct Exported {
+    /// The exported file.
+    pub content: String,
+    /// The parameter table beside a cell export.
+    pub table_csv: Option<String>,
+    /// Values to check before loading the export, each as a sentence.
+    pub warnings: Vec<String>,
+}
+
+/// Exports the identified model `identified` (the estimate's spec) in `format`
+/// ([`model_export::export_form`]); with the `cell` it was identified in, a cell export
+/// carries the cell's other sections ([`to_cell_toml`]), else the model alone, and the
+/// suspicious values are judged against the cell's nominal model in the same form.
+pub fn export_model(
+    identified: &ModelSpec,
+    cell: Option<&Cell>,
+    format: ExportFormat,
+) -> Result<Exported, Error> {
+    let form = match format {
+        ExportFormat::Cell(form) => form,
+        ExportFormat::Json | ExportFormat::Urdf => LinkForm::AsGiven,
+    };
+    let model = Model::from_spec(identified)?;
+    let spec = model_export::export_form(identified, form)?;
+    let reference = match cell {
+        Some(c) => model_export::export_form(&c.model.spec(), form)?,
+        None => spec.clone(),
+    };
+    let warnings = model_export::suspicious_values(&Model::from_spec(&reference)?, &spec)?;
+    let (content, table_csv) = match format {
+        ExportFormat::Json => (
+            serde_json::to_string_pretty(&spec).map_err(|e| Error::Input(e.to_string()))?,
+            None,
+        ),
+        ExportFormat::Urdf => (urdf::to_urdf(&spec)?, None),
+        ExportFormat::Cell(_) => (
+            match cell {
+                Some(c) => to_cell_toml(c, &model, &spec)?,
+                None => model_export::to_cell_toml(&spec)?,
+            },
+            Some(model_export::to_table_csv(&spec)),
+        ),
+    };
+    Ok(Exported {
+        content,
+        table_csv,
+        warnings,
+    })
 }

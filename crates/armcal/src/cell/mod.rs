@@ -5,6 +5,7 @@
 
 pub mod builtin;
 pub mod export;
+pub mod model_analysis;
 mod raw;
 
 pub use crate::measure::NoiseModel;

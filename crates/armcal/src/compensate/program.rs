@@ -8,10 +8,16 @@
 //! [`ResidualCorrection`] (book §5.4) the remaining, non-kinematic position error it
 //! predicts is compensated too: the calibrated model is asked to reach `t − ê(q)` so that
 //! the real robot, which lands at `FK_cal(q) + e(q)`, reaches `t`.
+//!
+//! [`compensate_program`] does either for a program file (`armcal compensate`): Cartesian
+//! targets if its header has orientation columns, a joint program otherwise, and returns the
+//! compensated program as CSV with a status per row.
 
-use crate::compensate::ik::{CalibratedIk, IkResult, IkSettings, IkTarget};
+use crate::compensate::ik::{CalibratedIk, IkResult, IkSettings, IkStatus, IkTarget};
 use crate::compensate::nonparametric::ResidualCorrection;
-use crate::model::{forward_kinematics, Data, Model, Pose};
+use crate::measure::{csv, MeasurementKind};
+use crate::model::{forward_kinematics, Data, JointKind, Model, Pose};
+use crate::Error;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -23,6 +29,7 @@ const CORRECTION_PASSES: usize = 2;
 /// One filtered program row.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct FilteredRow {
+    /// The row's `pose_id`.
     pub id: String,
     /// The program's joint values (nominal model).
     pub q_nominal: Vec<f64>,
@@ -112,6 +119,7 @@ pub fn filter_joint_program_corrected(
 pub struct CorrectedTarget {
     /// The pose to send to the controller (its nominal model's pose at the solution).
     pub pose: Pose<f64>,
+    /// The solve with the calibrated model.
     pub result: IkResult,
     /// The nonparametric correction applied to the target position (world, mm).
     pub correction: Vector3<f64>,
@@ -147,4 +155,193 @@ pub fn corrected_cartesian_targets(
             }
         })
         .collect()
+}
+
+/// A compensated program file.
+#[derive(Clone, Debug)]
+pub struct CompensatedProgram {
+    /// Whether the file held Cartesian targets (else a joint program).
+    pub cartesian: bool,
+    /// Rows compensated.
+    pub rows: usize,
+    /// Rows whose solve did not converge (their status column says why).
+    pub not_converged: usize,
+    /// The output CSV: `pose_id`, the joints, for Cartesian targets the pose to send, with a
+    /// correction the `correction_*_mm` shift, then `status`, `position_error_mm`,
+    /// `orientation_error_deg`.
+    pub csv: String,
+}
+
+/// A program file as read: its text and name, whether it holds Cartesian targets (its
+/// header has a `roll…` column) and its rows' ids and joint values.
+#[derive(Clone, Debug)]
+pub struct ProgramFile {
+    /// The file's text.
+    pub text: String,
+    /// The file's name, for messages.
+    pub file: String,
+    /// Whether the rows are Cartesian tool targets (else joint configurations).
+    pub cartesian: bool,
+    /// `(pose_id, q)` per row: the program, or the Cartesian targets' starting guesses.
+    pub rows: Vec<(String, Vec<f64>)>,
+}
+
+impl ProgramFile {
+    /// Reads a program file's text for `model`.
+    pub fn read(text: String, file: &str, model: &Model) -> Result<ProgramFile, Error> {
+        let header = text.lines().find(|l| !l.starts_with('#')).unwrap_or("");
+        let cartesian = header.split(',').any(|h| h.trim().starts_with("roll"));
+        let rows = csv::read_configurations_str(&text, file, model, None)?;
+        Ok(ProgramFile {
+            file: file.into(),
+            cartesian,
+            rows,
+            text,
+        })
+    }
+}
+
+/// Compensates `program` for `model` with the `calibrated` parameters (and the residual
+/// `correction`, if any): Cartesian targets ([`corrected_cartesian_targets`], the joint
+/// columns their starting guesses) or a joint program ([`filter_joint_program_corrected`]).
+pub fn compensate_program(
+    model: &Model,
+    calibrated: &[f64],
+    program: &ProgramFile,
+    settings: &IkSettings,
+    correction: Option<&ResidualCorrection>,
+) -> Result<CompensatedProgram, Error> {
+    let nominal = model.nominal();
+    let (text, file, cartesian) = (
+        program.text.as_str(),
+        program.file.as_str(),
+        program.cartesian,
+    );
+    let with = correction.is_some();
+    let correction_header = if with {
+        "correction_x_mm,correction_y_mm,correction_z_mm,"
+    } else {
+        ""
+    };
+    let joints_header = model
+        .joints
+        .iter()
+        .map(csv::joint_column)
+        .collect::<Vec<_>>()
+        .join(",");
+    let mut out = String::new();
+    let mut failed = 0;
+    if cartesian {
+        // Read the tool poses with a robot-only model: rows become world-frame poses.
+        let mut robot_only = model.spec();
+        robot_only.instrument = None;
+        robot_only.targets.clear();
+        let robot = Model::from_spec(&robot_only)?;
+        let (data, _) = csv::read_str(text, file, &robot, None)?;
+        let poses: Vec<Pose<f64>> = data
+            .measurements
+            .iter()
+            .map(|m| match &m.kind {
+                MeasurementKind::Pose { value, .. } => Ok(*value),
+                _ => Err(Error::Input(format!(
+                    "line {}: Cartesian targets need x, y, z, roll, pitch, yaw",
+                    m.line
+                ))),
+            })
+            .collect::<Result<_, Error>>()?;
+        let seeds: Vec<Vec<f64>> = data
+            .measurements
+            .iter()
+            .map(|m| data.configurations[m.config].clone())
+            .collect();
+        let rows = corrected_cartesian_targets(
+            model, &nominal, calibrated, &poses, &seeds, settings, correction,
+        );
+        out.push_str(&format!(
+            "pose_id,{joints_header},x_mm,y_mm,z_mm,roll_deg,pitch_deg,yaw_deg,{correction_header}status,position_error_mm,orientation_error_deg\n",
+        ));
+        for (i, row) in rows.iter().enumerate() {
+            let (xyz, rpy) = row.pose.to_xyz_rpy();
+            failed += usize::from(row.result.status != IkStatus::Converged);
+            out.push_str(&format!(
+                "{},{},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{}{}\n",
+                data.config_ids[data.measurements[i].config],
+                joint_values(model, &row.result.q),
+                xyz[0],
+                xyz[1],
+                xyz[2],
+                rpy[0].to_degrees(),
+                rpy[1].to_degrees(),
+                rpy[2].to_degrees(),
+                correction_columns(&row.correction, with),
+                status_columns(model, &row.result)
+            ));
+        }
+    } else {
+        let rows = filter_joint_program_corrected(
+            model,
+            &nominal,
+            calibrated,
+            &program.rows,
+            settings,
+            correction,
+        );
+        out.push_str(&format!(
+            "pose_id,{joints_header},{correction_header}status,position_error_mm,orientation_error_deg\n",
+        ));
+        for row in &rows {
+            failed += usize::from(row.result.status != IkStatus::Converged);
+            out.push_str(&format!(
+                "{},{},{}{}\n",
+                row.id,
+                joint_values(model, &row.result.q),
+                correction_columns(&row.correction, with),
+                status_columns(model, &row.result)
+            ));
+        }
+    }
+    Ok(CompensatedProgram {
+        cartesian,
+        rows: program.rows.len(),
+        not_converged: failed,
+        csv: out,
+    })
+}
+
+/// The joint values of a row in display units (deg, mm), 9 decimals.
+fn joint_values(model: &Model, q: &[f64]) -> String {
+    q.iter()
+        .zip(&model.joints)
+        .map(|(v, j)| {
+            format!(
+                "{:.9}",
+                if j.kind == JointKind::Revolute {
+                    v.to_degrees()
+                } else {
+                    *v
+                }
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+/// Status (with the joint and limit, or the residual, for a row that did not converge) and
+/// residual columns.
+fn status_columns(model: &Model, r: &IkResult) -> String {
+    format!(
+        "{},{:.9},{:.9}",
+        r.describe(model),
+        r.position_error,
+        r.orientation_error.to_degrees()
+    )
+}
+
+/// `correction_x_mm,…,` columns (empty without a correction).
+fn correction_columns(c: &Vector3<f64>, with: bool) -> String {
+    if with {
+        format!("{:.6},{:.6},{:.6},", c.x, c.y, c.z)
+    } else {
+        String::new()
+    }
 }

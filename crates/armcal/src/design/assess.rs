@@ -1,8 +1,10 @@
 //! What a design gives, before anything is measured: predicted C_p (paper §1.1), C_s at
 //! the working configurations, observability indices and every criterion's value — for a
-//! planned design or one a user made by hand.
+//! planned design or one a user made by hand; with its constraint margins, the record of
+//! `armcal evaluate` ([`evaluate_design`]).
 
 use crate::cell::Cell;
+use crate::design::plan::{constraint_set, CellConstraints, DesignMargin};
 use crate::design::{Criterion, DesignModel, DesignObjective, InformationWorkspace};
 use crate::identify::uncertainty::{self, Observability, TcpCovariance};
 use crate::Error;
@@ -16,15 +18,19 @@ pub struct DesignAssessment {
     pub parameters: Vec<String>,
     /// Predicted σ of each free parameter (mm, rad).
     pub sigma: Vec<f64>,
+    /// The predicted covariance of the free parameters, C_p (paper §1.1).
     pub c_p: DMatrix<f64>,
     /// tr(C_p)/n_p (the paper's φ_A(C_p), mm and rad unscaled).
     pub phi_a_cp: f64,
+    /// C_s at each working configuration.
     pub tcp: Vec<TcpCovariance>,
+    /// The observability indices O1…O5 of the design's Jacobian.
     pub observability: Observability,
     /// Every criterion's value (see [`Criterion`]).
     pub criteria: Vec<(Criterion, f64)>,
 }
 
+/// The predicted precision of `design` (internal units) for `cell`, before anything is measured.
 pub fn assess(cell: &Cell, design: &[Vec<f64>]) -> Result<DesignAssessment, Error> {
     let d = DesignModel::from_cell(cell)?;
     let mut ws = InformationWorkspace::new(&d);
@@ -61,5 +67,51 @@ pub fn assess(cell: &Cell, design: &[Vec<f64>]) -> Result<DesignAssessment, Erro
         tcp,
         observability: uncertainty::observability(&j),
         criteria,
+    })
+}
+
+/// What `armcal evaluate --json` prints: a design's assessment and how it meets the cell's
+/// constraints at the nominal parameters.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct DesignEvaluation {
+    /// The cell's name.
+    pub cell: String,
+    /// Number of poses.
+    pub poses: usize,
+    /// The predicted precision ([`assess`]).
+    pub assessment: DesignAssessment,
+    /// The poses (1-based) outside the joint limits or violating a constraint.
+    pub infeasible_poses: Vec<usize>,
+    /// The smallest constraint margin over the design (none without constraints).
+    pub min_margin: Option<DesignMargin>,
+}
+
+impl DesignEvaluation {
+    /// The record as JSON (keys in alphabetical order, see [`crate::json`]).
+    pub fn to_json(&self) -> Result<String, Error> {
+        crate::json::sorted_pretty(self)
+    }
+}
+
+/// The assessment of `design` (internal units) for `cell`, its infeasible poses and its
+/// smallest margin, with or without the collision and line-of-sight constraints.
+pub fn evaluate_design(
+    cell: &Cell,
+    design: &[Vec<f64>],
+    collisions: bool,
+) -> Result<DesignEvaluation, Error> {
+    let assessment = assess(cell, design)?;
+    let set = constraint_set(cell, collisions)?;
+    let params = cell.model.nominal();
+    let cons = CellConstraints::new(&set, &params);
+    Ok(DesignEvaluation {
+        cell: cell.name.clone(),
+        poses: design.len(),
+        assessment,
+        infeasible_poses: (0..design.len())
+            .filter(|&i| !cons.feasible(&design[i]))
+            .map(|i| i + 1)
+            .collect(),
+        min_margin: cons.design_margin(design),
     })
 }

@@ -53,6 +53,22 @@ impl Criterion {
         })
     }
 
+    /// The name [`Criterion::from_name`] reads (and the files carry): `a`, `d`, `e`, `kpi`,
+    /// `o1` … `o5`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Criterion::A => "a",
+            Criterion::D => "d",
+            Criterion::E => "e",
+            Criterion::Kpi => "kpi",
+            Criterion::O1 => "o1",
+            Criterion::O2 => "o2",
+            Criterion::O3 => "o3",
+            Criterion::O4 => "o4",
+            Criterion::O5 => "o5",
+        }
+    }
+
     pub const ALL: [Criterion; 9] = [
         Criterion::A,
         Criterion::D,

@@ -12,6 +12,7 @@ pub mod information;
 pub mod objective;
 pub mod order;
 pub mod plan;
+pub mod record;
 pub mod refine;
 pub mod small_cholesky;
 
@@ -21,3 +22,4 @@ pub use cell_constraints::{
 pub use criteria::{Criterion, CriterionValue};
 pub use information::{DesignModel, InformationWorkspace};
 pub use objective::{DesignObjective, ObjectiveWorkspace};
+pub use record::DesignRecord;

@@ -480,9 +480,7 @@ pub fn write_string(data: &Dataset, model: &Model) -> Result<String, Error> {
     });
     let mut w = csv::Writer::from_writer(Vec::new());
     let mut header = vec!["pose_id".to_string()];
-    for j in &model.joints {
-        header.push(joint_column(j));
-    }
+    header.extend(model.joints.iter().map(joint_column));
     header.extend(["target", "x_mm", "y_mm", "z_mm"].map(String::from));
     if any_pose {
         header.extend(["roll_deg", "pitch_deg", "yaw_deg"].map(String::from));

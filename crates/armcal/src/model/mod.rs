@@ -6,6 +6,7 @@ pub mod chain;
 pub mod complete;
 pub mod convert;
 pub mod export;
+pub mod frames;
 pub mod identifiability;
 pub mod jacobian;
 pub mod kinematics;

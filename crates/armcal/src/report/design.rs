@@ -2,11 +2,11 @@
 //! optimality bound and efficiency), its predicted precision (C_p, C_s), the poses as joint
 //! plots against the joint limits, and the smallest margin of every kind of constraint.
 
-use super::design_record::DesignRecord;
 use super::estimate::observability_table;
 use super::figures::{bar_figure, joint_figure, JointTrace};
 use super::html::{escape, facts, fixed, number, table, Section};
 use crate::design::Criterion;
+use crate::design::DesignRecord;
 use crate::Error;
 
 /// What a criterion measures (all are minimised; paper §2.1–2.3, book §4.5).

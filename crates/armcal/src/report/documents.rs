@@ -2,21 +2,12 @@
 //! (`armcal identify`, `armcal demo`), a design (`armcal plan`, `armcal demo`), a study
 //! (`armcal study paper`) or the demo's summary.
 
-use super::design_record::DesignRecord;
+use crate::design::DesignRecord;
 use crate::identify::Estimate;
 use crate::study::demo::DemoSummary;
-use crate::study::paper::StudyRow;
+use crate::study::paper::StudyRecord;
 use crate::Error;
-use serde::{Deserialize, Serialize};
 use std::path::Path;
-
-/// The result file of `armcal study paper`.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct StudyRecord {
-    pub study: String,
-    pub collisions: bool,
-    pub rows: Vec<StudyRow>,
-}
 
 /// One input of a report.
 #[derive(Clone, Debug)]

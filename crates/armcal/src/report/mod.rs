@@ -8,21 +8,21 @@
 pub mod cell_view;
 pub mod demo_summary;
 pub mod design;
-pub mod design_record;
 pub mod documents;
 pub mod ellipse;
 pub mod estimate;
 pub mod figures;
+pub mod files;
 pub mod font;
 pub mod html;
 pub mod study;
 pub mod tcp;
 
-pub use design_record::DesignRecord;
-pub use documents::{Document, StudyRecord};
+pub use documents::Document;
 
 use crate::cell::Cell;
 use crate::study::demo::DemoSummary;
+use crate::study::paper::StudyRecord;
 use crate::Error;
 use html::{escape, table, Page, Section};
 use tcp::TcpItem;

@@ -2,10 +2,9 @@
 //! numbers, and a Figure 8-style chart of the KPI design's improvement over the heuristic
 //! and the φ_A(C_p)-optimal designs for each of the 90 notional manipulators.
 
-use super::documents::StudyRecord;
 use super::figures::{series_figure, Reference};
 use super::html::{escape, fixed, table, Section};
-use crate::study::paper::{StudyRow, PAPER_SUMMARY, PAPER_TABLE6};
+use crate::study::paper::{StudyRecord, StudyRow, PAPER_SUMMARY, PAPER_TABLE6};
 use crate::Error;
 
 /// The paper's Table 7: (design, min and max without collision avoidance, min and max with

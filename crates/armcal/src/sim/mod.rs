@@ -137,3 +137,109 @@ pub fn simulate(
     }
     Ok(data)
 }
+
+/// One parameter of a simulated robot, display units (mm, deg).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TrueParameter {
+    /// The parameter's name.
+    pub name: String,
+    /// Its display unit.
+    pub unit: String,
+    /// Its nominal value.
+    pub nominal: f64,
+    /// Its true value.
+    pub truth: f64,
+}
+
+/// The true parameters of a simulation (`armcal simulate --truth-out`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TruthRecord {
+    /// The cell's name.
+    pub cell: String,
+    /// The seed of the perturbation and of the noise.
+    pub seed: u64,
+    /// Every parameter of the model, nominal and true.
+    pub parameters: Vec<TrueParameter>,
+}
+
+impl TruthRecord {
+    /// The record of `truth` (internal units) for `model` of the cell `cell`.
+    pub fn new(cell: &str, model: &Model, truth: &[f64], seed: u64) -> TruthRecord {
+        TruthRecord {
+            cell: cell.to_string(),
+            seed,
+            parameters: model
+                .registry
+                .iter()
+                .zip(truth)
+                .map(|(p, v)| TrueParameter {
+                    name: p.name.clone(),
+                    unit: p.unit.display_name().to_string(),
+                    nominal: p.nominal * p.unit.display_factor(),
+                    truth: v * p.unit.display_factor(),
+                })
+                .collect(),
+        }
+    }
+
+    /// The record as JSON (keys in alphabetical order, see [`crate::json`]).
+    pub fn to_json(&self) -> Result<String, Error> {
+        crate::json::sorted_pretty(self)
+    }
+}
+
+/// A simulated campaign: the data measured and the robot that was measured.
+#[derive(Clone, Debug)]
+pub struct Simulation {
+    /// The data measured.
+    pub data: Dataset,
+    /// The true parameters.
+    pub truth: TruthRecord,
+}
+
+/// Measures the poses `(id, q)` on a robot perturbed from `model` ([`perturbed_truth`] with
+/// `seed`), with the instrument's `noise` (seed `seed + 0x5eed`; noise-free if `None`);
+/// configurations keep their ids. `cell` names the model in the truth record.
+pub fn simulate_poses(
+    cell: &str,
+    model: &Model,
+    poses: &[(String, Vec<f64>)],
+    perturbation: &Perturbation,
+    noise: Option<&NoiseModel>,
+    seed: u64,
+) -> Result<Simulation, Error> {
+    let truth = perturbed_truth(model, perturbation, seed);
+    let data = simulate_with_ids(model, &truth, poses, noise, seed.wrapping_add(0x5eed))?;
+    Ok(Simulation {
+        data,
+        truth: TruthRecord::new(cell, model, &truth, seed),
+    })
+}
+
+/// What the instrument measures at the poses `(id, q)` according to the model with
+/// parameters `params`, without noise; the data's source is "prediction".
+pub fn predict(
+    model: &Model,
+    params: &[f64],
+    poses: &[(String, Vec<f64>)],
+) -> Result<Dataset, Error> {
+    let mut data = simulate_with_ids(model, params, poses, None, 0)?;
+    data.source = "prediction".into();
+    Ok(data)
+}
+
+/// [`simulate`] at the configurations of `poses`, which keep their ids.
+fn simulate_with_ids(
+    model: &Model,
+    params: &[f64],
+    poses: &[(String, Vec<f64>)],
+    noise: Option<&NoiseModel>,
+    seed: u64,
+) -> Result<Dataset, Error> {
+    let qs: Vec<Vec<f64>> = poses.iter().map(|(_, q)| q.clone()).collect();
+    let mut data = simulate(model, params, &qs, noise, seed)?;
+    for (k, (id, _)) in poses.iter().enumerate() {
+        data.config_ids[k] = id.clone();
+    }
+    Ok(data)
+}

@@ -1,19 +1,19 @@
 //! The whole workflow on the paper cell in one call: plan a KPI design with collision
 //! avoidance and a random heuristic design, simulate a measurement campaign on a perturbed
 //! "true" robot for each, identify, compensate a small working program, and evaluate on
-//! held-out poses. Every intermediate file and the HTML report are returned for writing; the
-//! same seed gives the same files (solver times are left out of them).
+//! held-out poses. Every intermediate file is returned for writing, with the records a report
+//! shows ([`crate::workflow::demo`] adds the HTML report); the same seed gives the same files
+//! (solver times are left out of them).
 
 use crate::accuracy::ErrorStats;
 use crate::compensate::program::filter_joint_program;
 use crate::compensate::IkSettings;
 use crate::design::baselines::random_feasible;
 use crate::design::plan::{constraint_set, plan, CellConstraints, PlanSettings};
-use crate::design::DesignModel;
+use crate::design::{DesignModel, DesignRecord};
 use crate::identify::{identify, Estimate, IdentifyOptions, Silent};
 use crate::measure::csv;
 use crate::model::{forward_kinematics, observed_position, Data, Observed};
-use crate::report::{self, DesignRecord, Document, Input, ReportContent};
 use crate::sim::{perturbed_truth, simulate, Perturbation};
 use crate::Error;
 use serde::{Deserialize, Serialize};
@@ -23,6 +23,7 @@ use crate::cell::builtin::PAPER_CELL_OBSTACLES as CELL;
 /// One design's campaign.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Campaign {
+    /// `heuristic` or `kpi`.
     pub design: String,
     /// Predicted σ of the TCP at the working pose, √((1/3) tr C_s) (mm).
     pub tcp_sigma_predicted: f64,
@@ -37,24 +38,45 @@ pub struct Campaign {
 /// The demo's numbers.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct DemoSummary {
+    /// The seed of the truth, the designs and the noise.
     pub seed: u64,
+    /// Poses per design.
     pub poses: usize,
+    /// Held-out position error of the nominal model against the true robot (mm).
     pub nominal_held_out: ErrorStats,
     /// The nominal model's error per held-out pose (mm).
     pub nominal_held_out_errors: Vec<f64>,
+    /// The heuristic design's campaign.
     pub heuristic: Campaign,
+    /// The KPI design's campaign.
     pub kpi: Campaign,
     /// Largest miss of the working program on the true robot: nominal joints and filtered
     /// joints (mm).
     pub program_miss_nominal: f64,
+    /// (see `program_miss_nominal`)
     pub program_miss_compensated: f64,
+    /// Efficiency of the KPI design against the optimality bound, if computed.
     pub kpi_bound_efficiency: Option<f64>,
 }
 
-/// The demo: its summary and the files it produced (name, content).
+/// The demo: its summary, the files it produced (name, content) and the records a report
+/// of it shows.
 pub struct Demo {
+    /// The demo's numbers.
     pub summary: DemoSummary,
+    /// Every file of the demo but the report (name, content).
     pub files: Vec<(String, String)>,
+    /// The cell calibrated (`cell.toml` among the files).
+    pub cell: crate::cell::Cell,
+    /// The records of the KPI and the heuristic design (`design-kpi.json`,
+    /// `design-heuristic.json`).
+    pub kpi_design: DesignRecord,
+    /// (see `kpi_design`)
+    pub heuristic_design: DesignRecord,
+    /// The estimates from the two campaigns (`estimate-kpi.json`, `estimate-heuristic.json`).
+    pub kpi_estimate: Estimate,
+    /// (see `kpi_estimate`)
+    pub heuristic_estimate: Estimate,
 }
 
 /// Runs the demo; `progress` receives a short label before each stage.
@@ -258,44 +280,13 @@ pub fn run_demo(seed: u64, progress: &dyn Fn(&str)) -> Result<Demo, Error> {
         serde_json::to_string_pretty(&summary).map_err(|e| Error::Input(e.to_string()))?,
     ));
 
-    progress("writing the report");
-    let inputs = [
-        (
-            "KPI design",
-            "design-kpi.json",
-            Document::Design(Box::new(kpi_record)),
-        ),
-        (
-            "heuristic design",
-            "design-heuristic.json",
-            Document::Design(Box::new(heuristic_record)),
-        ),
-        (
-            "KPI design",
-            "estimate-kpi.json",
-            Document::Estimate(Box::new(kpi_est)),
-        ),
-        (
-            "heuristic design",
-            "estimate-heuristic.json",
-            Document::Estimate(Box::new(heuristic_est)),
-        ),
-    ]
-    .map(|(label, source, document)| Input {
-        label: label.into(),
-        source: source.into(),
-        document,
-    });
-    let html = report::render(&ReportContent {
-        title: "armcal demo: calibrating the paper cell",
-        subtitle: &format!(
-            "KPI-optimal vs heuristic measurement poses, {poses} poses each, seed {seed}; simulated laser-tracker campaign on a perturbed robot"
-        ),
-        inputs: &inputs,
-        demo: Some(&summary),
-        cell_view: report::cell_view_of(&cell, &inputs)?,
-        notes: &[],
-    })?;
-    files.push(("report.html".into(), html));
-    Ok(Demo { summary, files })
+    Ok(Demo {
+        summary,
+        files,
+        cell,
+        kpi_design: kpi_record,
+        heuristic_design: heuristic_record,
+        kpi_estimate: kpi_est,
+        heuristic_estimate: heuristic_est,
+    })
 }

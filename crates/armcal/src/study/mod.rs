@@ -3,3 +3,4 @@
 pub mod demo;
 pub mod paper;
 pub mod puma;
+pub mod puma_record;

@@ -36,15 +36,23 @@ pub fn cell_for(robot: &str, collisions: bool) -> Result<Cell, Error> {
 /// One robot, one collision setting: the KPI of each design (mm²).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct StudyRow {
+    /// The robot's name in the library.
     pub robot: String,
+    /// Whether collision avoidance applied.
     pub collisions: bool,
+    /// KPI of the heuristic design (mm²).
     pub heuristic: f64,
+    /// KPI of the C_p-optimal design (mm²).
     pub cp_optimal: f64,
+    /// KPI of the C_s-optimal (KPI) design (mm²).
     pub cs_optimal: f64,
     /// Improvement of the KPI design over the heuristic and over the C_p design (fractions).
     pub gain_vs_heuristic: f64,
+    /// (see `gain_vs_heuristic`)
     pub gain_vs_cp: f64,
+    /// Whether both optimal designs are feasible.
     pub feasible: bool,
+    /// Wall-clock time for this robot (s).
     pub seconds: f64,
     /// Why this robot has no result (e.g. no feasible configuration in the cell).
     pub error: Option<String>,
@@ -53,8 +61,11 @@ pub struct StudyRow {
 /// Settings of the study.
 #[derive(Clone, Debug)]
 pub struct StudySettings {
+    /// Collision avoidance (the cell with obstacles).
     pub collisions: bool,
+    /// Poses per design.
     pub poses: usize,
+    /// Seed of the candidate pool and of the heuristic design.
     pub seed: u64,
     /// The planner's settings (poses, criterion and collisions are set per run).
     pub plan: PlanSettings,
@@ -82,11 +93,47 @@ impl Default for StudySettings {
     }
 }
 
+/// Which robots a study covers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RobotSelection {
+    /// The three KUKA robots of Table 6.
+    Table6,
+    /// The 90 notional manipulators of Tables 7–8.
+    Notional,
+    /// Both.
+    All,
+}
+
+impl RobotSelection {
+    /// `table6`, `notional` or `all`.
+    pub fn from_name(s: &str) -> Option<RobotSelection> {
+        match s {
+            "table6" => Some(RobotSelection::Table6),
+            "notional" => Some(RobotSelection::Notional),
+            "all" => Some(RobotSelection::All),
+            _ => None,
+        }
+    }
+
+    /// The robots: Table 6's first, then the notional ones.
+    pub fn robots(self) -> Vec<String> {
+        let mut robots = Vec::new();
+        if self != RobotSelection::Notional {
+            robots.extend(table6_robots());
+        }
+        if self != RobotSelection::Table6 {
+            robots.extend(notional_robots());
+        }
+        robots
+    }
+}
+
 /// The robots of Table 6 and of Tables 7–8.
 pub fn table6_robots() -> Vec<String> {
     ["kr15", "kr300", "kr500"].map(String::from).to_vec()
 }
 
+/// The 90 notional manipulators of Tables 7–8: `paper-<λ>-<μ>`, λ ∈ {650, …, 1100} mm, μ ∈ {600, …, 1000} mm.
 pub fn notional_robots() -> Vec<String> {
     let mut v = Vec::new();
     for l in (650..=1100).step_by(50) {
@@ -183,6 +230,163 @@ pub fn run(robots: &[String], s: &StudySettings, progress: &(dyn Fn() + Sync)) -
             row
         })
         .collect()
+}
+
+/// The result file of `armcal study paper` (`study-collisions.json` or
+/// `study-no-collisions.json`), what `armcal report` reads.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct StudyRecord {
+    /// "paper".
+    pub study: String,
+    /// Whether collision avoidance applied.
+    pub collisions: bool,
+    /// Wall-clock time of the whole study (s); 0 in files written before it was recorded.
+    #[serde(default)]
+    pub seconds: f64,
+    /// The robots with a result.
+    pub rows: Vec<StudyRow>,
+}
+
+/// Mean, smallest and largest value of one column over some rows.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Spread {
+    /// Mean.
+    pub mean: f64,
+    /// Smallest value.
+    pub min: f64,
+    /// Largest value.
+    pub max: f64,
+}
+
+impl Spread {
+    /// The spread of `f` over `rows` (mean 0, min +∞, max −∞ for no rows).
+    pub fn of(rows: &[&StudyRow], f: impl Fn(&StudyRow) -> f64) -> Spread {
+        let v: Vec<f64> = rows.iter().map(|r| f(r)).collect();
+        Spread {
+            mean: v.iter().sum::<f64>() / v.len().max(1) as f64,
+            min: v.iter().cloned().fold(f64::INFINITY, f64::min),
+            max: v.iter().cloned().fold(f64::NEG_INFINITY, f64::max),
+        }
+    }
+}
+
+/// Tables 7–8: the notional manipulators' KPI per design and the KPI design's gains.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NotionalSummary {
+    /// Number of notional robots.
+    pub robots: usize,
+    /// KPI of the heuristic designs (mm²).
+    pub heuristic: Spread,
+    /// KPI of the C_p-optimal designs (mm²).
+    pub cp_optimal: Spread,
+    /// KPI of the KPI designs (mm²).
+    pub cs_optimal: Spread,
+    /// Gain of the KPI design over the heuristic (fraction).
+    pub gain_vs_heuristic: Spread,
+    /// Gain of the KPI design over the C_p design (fraction).
+    pub gain_vs_cp: Spread,
+}
+
+impl StudyRecord {
+    /// The rows of Table 6's robots (`kr…`).
+    pub fn table6(&self) -> Vec<&StudyRow> {
+        self.rows
+            .iter()
+            .filter(|r| r.robot.starts_with("kr"))
+            .collect()
+    }
+
+    /// The rows of the notional manipulators (`paper-…`).
+    pub fn notional(&self) -> Vec<&StudyRow> {
+        self.rows
+            .iter()
+            .filter(|r| r.robot.starts_with("paper-"))
+            .collect()
+    }
+
+    /// Tables 7–8 over [`StudyRecord::notional`]; `None` without notional rows.
+    pub fn notional_summary(&self) -> Option<NotionalSummary> {
+        let nt = self.notional();
+        (!nt.is_empty()).then(|| NotionalSummary {
+            robots: nt.len(),
+            heuristic: Spread::of(&nt, |r| r.heuristic),
+            cp_optimal: Spread::of(&nt, |r| r.cp_optimal),
+            cs_optimal: Spread::of(&nt, |r| r.cs_optimal),
+            gain_vs_heuristic: Spread::of(&nt, |r| r.gain_vs_heuristic),
+            gain_vs_cp: Spread::of(&nt, |r| r.gain_vs_cp),
+        })
+    }
+
+    /// The robots whose designs violate constraints.
+    pub fn infeasible(&self) -> Vec<&str> {
+        self.rows
+            .iter()
+            .filter(|r| !r.feasible)
+            .map(|r| r.robot.as_str())
+            .collect()
+    }
+
+    /// The file name without extension: `study-collisions` or `study-no-collisions`.
+    pub fn file_stem(&self) -> &'static str {
+        if self.collisions {
+            "study-collisions"
+        } else {
+            "study-no-collisions"
+        }
+    }
+
+    /// The record as JSON (keys in alphabetical order, see [`crate::json`]).
+    pub fn to_json(&self) -> Result<String, Error> {
+        crate::json::sorted_pretty(self)
+    }
+
+    /// One CSV line per row.
+    pub fn to_csv(&self) -> String {
+        let mut csv = String::from("robot,collisions,heuristic_mm2,cp_optimal_mm2,cs_optimal_mm2,gain_vs_heuristic,gain_vs_cp,feasible,seconds\n");
+        for r in &self.rows {
+            csv.push_str(&format!(
+                "{},{},{:.6},{:.6},{:.6},{:.4},{:.4},{},{:.2}\n",
+                r.robot,
+                r.collisions,
+                r.heuristic,
+                r.cp_optimal,
+                r.cs_optimal,
+                r.gain_vs_heuristic,
+                r.gain_vs_cp,
+                r.feasible,
+                r.seconds
+            ));
+        }
+        csv
+    }
+}
+
+/// What [`run_study`] gives: the record of the robots with a result, and the rows of those
+/// without one (with their error).
+#[derive(Clone, Debug)]
+pub struct PaperStudy {
+    /// The robots with a result.
+    pub record: StudyRecord,
+    /// The robots without one, with their error.
+    pub failed: Vec<StudyRow>,
+}
+
+/// The study over `robots` ([`run`]), timed, as its record; `progress` is called after
+/// each robot.
+pub fn run_study(robots: &[String], s: &StudySettings, progress: &(dyn Fn() + Sync)) -> PaperStudy {
+    let t0 = Instant::now();
+    let (failed, rows): (Vec<StudyRow>, Vec<StudyRow>) = run(robots, s, progress)
+        .into_iter()
+        .partition(|r| r.error.is_some());
+    PaperStudy {
+        record: StudyRecord {
+            study: "paper".into(),
+            collisions: s.collisions,
+            seconds: t0.elapsed().as_secs_f64(),
+            rows,
+        },
+        failed,
+    }
 }
 
 /// The paper's published values: (design, no collision avoidance, with collision avoidance),

@@ -51,4 +51,5 @@ mod report {
 }
 mod repository {
     mod builtin_cells;
+    mod layering;
 }

@@ -3,19 +3,20 @@
 
 use crate::common;
 use armcal::cell::Cell;
+use armcal::design::record::kind_margins;
+use armcal::design::DesignRecord;
 use armcal::identify::{identify, Estimate, IdentifyOptions, Silent};
 use armcal::model::random_configurations;
 use armcal::model::{forward_kinematics, Data};
-use armcal::report::design_record::kind_margins;
 use armcal::report::ellipse::{confidence_scale, ellipse_axes, ellipse_points, Plane};
 use armcal::report::figures::{
     bar_figure, cdf_figure, colour, ellipse_figure, histogram_figure, joint_figure, series_figure,
     EllipseSeries, JointTrace, Reference,
 };
 use armcal::report::html::{escape, number};
-use armcal::report::{self, DesignRecord, Document, Input, ReportContent, StudyRecord};
+use armcal::report::{self, Document, Input, ReportContent};
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
-use armcal::study::paper::{notional_robots, StudyRow};
+use armcal::study::paper::{notional_robots, StudyRecord, StudyRow};
 use common::example_cell;
 use nalgebra::{Matrix2, Matrix3, Vector2};
 use std::sync::OnceLock;
@@ -485,6 +486,7 @@ fn study(collisions: bool) -> StudyRecord {
     StudyRecord {
         study: "paper".into(),
         collisions,
+        seconds: 0.0,
         rows,
     }
 }

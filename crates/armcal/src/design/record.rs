@@ -5,7 +5,7 @@
 
 use crate::cell::Cell;
 use crate::design::assess::{assess, DesignAssessment};
-use crate::design::plan::{constraint_set, PlanReport};
+use crate::design::plan::{constraint_set, plan, PlanReport, PlanSettings};
 use crate::design::ConstraintKind;
 use crate::model::Model;
 use crate::Error;
@@ -14,9 +14,13 @@ use serde::{Deserialize, Serialize};
 /// A joint's name, display unit and limits (deg or mm).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct JointRange {
+    /// The joint's name.
     pub name: String,
+    /// Its display unit (`deg` or `mm`).
     pub unit: String,
+    /// Lower limit (display unit).
     pub lower: f64,
+    /// Upper limit (display unit).
     pub upper: f64,
 }
 
@@ -35,12 +39,14 @@ pub struct KindMargin {
     pub value: f64,
     /// The constraint (or joint) with the smallest margin, and its pose (1-based).
     pub constraint: String,
+    /// The pose of that constraint (1-based).
     pub pose: usize,
 }
 
 /// Everything the report shows about a design.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct DesignRecord {
+    /// The cell's name.
     pub cell: String,
     /// The cell as given to the planner (a cell-file path or a built-in robot), so a report
     /// can rebuild it for the 3D view.
@@ -49,13 +55,16 @@ pub struct DesignRecord {
     pub method: String,
     /// Whether collision and line-of-sight constraints applied (the margins include them).
     pub collisions: bool,
+    /// The joints' names, units and limits.
     pub joints: Vec<JointRange>,
     /// The poses in design-file order, display units (deg, mm).
     pub poses: Vec<Vec<f64>>,
     /// The planner's report (its `design` in internal units: rad, mm); absent for a design
     /// not planned by armcal.
     pub plan: Option<PlanReport>,
+    /// The predicted precision ([`assess`]).
     pub assessment: DesignAssessment,
+    /// The smallest margin of every kind of constraint ([`kind_margins`]).
     pub margins: Vec<KindMargin>,
 }
 
@@ -200,6 +209,27 @@ impl DesignRecord {
             margins: kind_margins(cell, design, collisions)?,
             plan,
         })
+    }
+
+    /// Plans a design for `cell` ([`plan`], augmenting the `measured` poses) and makes its
+    /// record; `method` says how it was asked for.
+    pub fn planned(
+        cell: &Cell,
+        cell_source: Option<&str>,
+        method: &str,
+        settings: &PlanSettings,
+        measured: &[Vec<f64>],
+    ) -> Result<DesignRecord, Error> {
+        let report = plan(cell, settings, measured)?;
+        let design = report.design.clone();
+        DesignRecord::new(
+            cell,
+            cell_source,
+            method,
+            &design,
+            Some(report),
+            settings.collisions,
+        )
     }
 
     /// The poses in internal units (rad, mm) for `model`, whose joints must match the
