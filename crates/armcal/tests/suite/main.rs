@@ -47,7 +47,7 @@ mod real_data {
 }
 mod report {
     mod cell_view;
-    mod report;
+    mod html;
 }
 mod repository {
     mod builtin_cells;
