@@ -14,9 +14,11 @@ pub mod geometry;
 pub mod identify;
 pub mod measure;
 pub mod model;
+pub mod progress;
 pub mod report;
 pub mod robots;
 pub mod sim;
+pub mod solve;
 pub mod study;
 
 pub use error::{Error, Result};

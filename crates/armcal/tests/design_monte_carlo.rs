@@ -34,6 +34,7 @@ fn kpi_design_variance_gain_holds_in_monte_carlo() {
             ..Default::default()
         },
         &[],
+        &mut Silent,
     )
     .unwrap();
     let obj = DesignObjective::new(&d, Criterion::Kpi, &[]);

@@ -99,7 +99,7 @@ fn unconverged_and_unverified_estimates_are_refused_unless_accepted() {
     opts.lm.tolerances.max_iterations = 1;
     let est = identify(&cell, &data, &opts, &mut Silent).unwrap();
     let v = est.verdicts.as_ref().unwrap();
-    assert_eq!(v.solver, Status::MaxIterations);
+    assert_eq!(v.solver, Status::IterationLimit);
     let e = est.check_usable(false).unwrap_err().to_string();
     assert!(
         e.contains("did not converge")

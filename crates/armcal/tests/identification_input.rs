@@ -238,7 +238,7 @@ fn a_fit_that_cannot_converge_reports_its_status() {
     let mut opts = IdentifyOptions::default();
     opts.lm.tolerances.max_iterations = 2;
     let est = identify(&cell, &data, &opts, &mut Silent).unwrap();
-    assert_eq!(est.solver.status, Status::MaxIterations);
+    assert_eq!(est.solver.status, Status::IterationLimit);
     // Undamped Gauss–Newton from a start far away: diverges or stops, with a reason.
     let far = perturbed_truth(
         model,

@@ -1,10 +1,9 @@
 //! `armcal identify`: calibrate the cell's free parameters from a data file.
 
 use super::output::{load_cell, load_data, write_new};
+use super::progress::Progress;
 use anyhow::bail;
-use armcal::identify::{
-    identify, Estimate, IdentifyOptions, LmSettings, Loss, Method, Silent, Tolerances,
-};
+use armcal::identify::{identify, Estimate, IdentifyOptions, LmSettings, Loss, Method, Tolerances};
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -64,7 +63,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     if a.out.exists() && !a.force {
         bail!("{} exists; pass --force to overwrite it", a.out.display());
     }
-    let est = identify(&cell, &data, &opts, &mut Silent)?;
+    let est = identify(&cell, &data, &opts, &mut Progress::new(false))?;
     print_summary(&est);
     write_new(&a.out, &serde_json::to_string_pretty(&est)?, a.force)?;
     println!("\nestimate → {}", a.out.display());

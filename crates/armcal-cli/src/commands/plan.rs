@@ -2,6 +2,7 @@
 //! (including a hand-made one) gives.
 
 use super::output::{load_cell, write_new};
+use super::progress::Progress;
 use anyhow::bail;
 use armcal::design::assess::assess;
 use armcal::design::plan::{constraint_set, plan, CellConstraints, PlanSettings};
@@ -83,7 +84,7 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         seed: a.seed,
         ..PlanSettings::default()
     };
-    let rep = plan(&cell, &settings, &measured)?;
+    let rep = plan(&cell, &settings, &measured, &mut Progress::new(false))?;
     write_new(
         &a.out,
         &csv::write_configurations(&cell.model, &rep.design),

@@ -2,12 +2,11 @@
 //! `armcal study puma`: the book's Chapter 6 PUMA case (Tables 6.9/6.10 and 6.13).
 
 use super::output::write_new;
+use super::progress::Progress;
 use armcal::study::paper::{
     notional_robots, run, table6_robots, StudyRow, StudySettings, PAPER_SUMMARY, PAPER_TABLE6,
 };
 use armcal::study::puma;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::io::IsTerminal;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -63,16 +62,8 @@ pub fn run_study(a: &Args) -> anyhow::Result<()> {
         seed: a.seed,
         ..StudySettings::default()
     };
-    let bar = ProgressBar::new(robots.len() as u64);
-    if a.quiet || !std::io::stderr().is_terminal() {
-        bar.set_draw_target(ProgressDrawTarget::hidden());
-    }
-    bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} robots, {elapsed} (eta {eta})")
-            .expect("valid template"),
-    );
     let t0 = std::time::Instant::now();
-    let all = run(&robots, &settings, &|| bar.inc(1));
+    let all = run(&robots, &settings, &mut Progress::new(a.quiet));
     for r in all.iter().filter(|r| r.error.is_some()) {
         println!(
             "{}: no result: {}",
@@ -81,7 +72,6 @@ pub fn run_study(a: &Args) -> anyhow::Result<()> {
         );
     }
     let rows: Vec<StudyRow> = all.iter().filter(|r| r.error.is_none()).cloned().collect();
-    bar.finish_and_clear();
     let secs = t0.elapsed().as_secs_f64();
     let col = if collisions { "with" } else { "without" };
     println!("paper study, {col} collision avoidance, 60 poses, (1/3) tr C_s in mm² — {} robots in {secs:.1} s", rows.len());

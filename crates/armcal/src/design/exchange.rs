@@ -12,6 +12,7 @@ use crate::design::criteria::{evaluate, kpi_matrix, Criterion};
 use crate::design::information::{DesignModel, InformationWorkspace};
 use crate::design::objective::triangular_factor;
 use crate::design::small_cholesky;
+use crate::progress::Observer;
 use crate::Error;
 use nalgebra::DMatrix;
 use rand::seq::SliceRandom;
@@ -91,6 +92,7 @@ pub fn exchange(
     prior: &DMatrix<f64>,
     n_points: usize,
     settings: &ExchangeSettings,
+    observer: &mut dyn Observer,
 ) -> Result<ExchangeResult, Error> {
     let t0 = Instant::now();
     if pool.len() < n_points {
@@ -137,6 +139,7 @@ pub fn exchange(
     let mut t_buf = vec![0.0; rows];
     let mut in_design = vec![false; pool.len()];
     let mut scores: Vec<(f64, usize)> = Vec::with_capacity(pool.len());
+    observer.start("exchange", Some(settings.max_sweeps));
     while sweeps < settings.max_sweeps {
         sweeps += 1;
         let start_value = value;
@@ -235,10 +238,12 @@ pub fn exchange(
             }
         }
         history.push(value);
+        observer.iteration(sweeps, value, 0.0);
         if start_value - value <= settings.tolerance * value.abs() {
             break;
         }
     }
+    observer.finish();
     Ok(ExchangeResult {
         chosen,
         value,

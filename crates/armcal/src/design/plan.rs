@@ -12,6 +12,7 @@ use crate::design::order::order_for_travel;
 use crate::design::refine::{refine, ConfigurationConstraints, RefineSettings};
 use crate::design::Criterion;
 use crate::geometry::{ConstraintOptions, ConstraintSet, ConstraintWorkspace};
+use crate::progress::{Observer, Shared};
 use crate::Error;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -313,11 +314,13 @@ pub fn constraint_set(cell: &Cell, collisions: bool) -> Result<ConstraintSet, Er
     )
 }
 
-/// Plans `settings.poses` measurement configurations for `cell`, augmenting `measured`.
+/// Plans `settings.poses` measurement configurations for `cell`, augmenting `measured`;
+/// `observer` follows the starts, their exchange and their refinement.
 pub fn plan(
     cell: &Cell,
     settings: &PlanSettings,
     measured: &[Vec<f64>],
+    observer: &mut dyn Observer,
 ) -> Result<PlanReport, Error> {
     let t0 = Instant::now();
     let d = DesignModel::from_cell(cell)?;
@@ -343,7 +346,7 @@ pub fn plan(
         exchange_value,
         sweeps,
         refine: refine_info,
-    } = design_from_pool(&d, &set, &pool, settings, measured)?;
+    } = design_from_pool(&d, &set, &pool, settings, measured, observer)?;
     let order = order_for_travel(&design);
     let design: Vec<Vec<f64>> = order.iter().map(|&i| design[i].clone()).collect();
     let cons = CellConstraints::new(&set, &params);
@@ -377,19 +380,26 @@ pub fn plan(
 /// Runs `settings.starts` exchange + refinement starts (in parallel) from the feasible
 /// candidate `pool` and returns the best design; a refined design that violates a
 /// constraint is replaced by its exchange design. The planner's core, shared with the
-/// paper's study (which reuses one pool for several criteria).
+/// paper's study (which reuses one pool for several criteria). `observer` receives the task
+/// `planning starts` with a step per finished start, and (interleaved, from the parallel
+/// starts) each start's exchange and refinement.
 pub fn design_from_pool(
     d: &DesignModel,
     set: &ConstraintSet,
     pool: &[Vec<f64>],
     settings: &PlanSettings,
     measured: &[Vec<f64>],
+    observer: &mut dyn Observer,
 ) -> Result<PoolDesign, Error> {
     let prior_rows = DesignObjective::new(d, settings.criterion, measured).prior_rows;
     let (lo, hi) = d.model.joint_limits();
-    let runs: Vec<Result<PoolDesign, Error>> = (0..settings.starts.max(1))
+    let starts = settings.starts.max(1);
+    observer.start("planning starts", Some(starts));
+    let shared = Shared::new(observer);
+    let runs: Vec<Result<PoolDesign, Error>> = (0..starts)
         .into_par_iter()
         .map(|s| {
+            let mut observer = &shared;
             let ex = exchange(
                 d,
                 settings.criterion,
@@ -407,9 +417,11 @@ pub fn design_from_pool(
                     },
                     ..ExchangeSettings::default()
                 },
+                &mut observer,
             )?;
             let start: Vec<Vec<f64>> = ex.chosen.iter().map(|&i| pool[i].clone()).collect();
             if settings.exchange_only {
+                observer.step();
                 return Ok(PoolDesign {
                     design: start,
                     value: ex.value,
@@ -427,16 +439,18 @@ pub fn design_from_pool(
                 &hi,
                 (!set.is_empty()).then_some(&cons as &dyn ConfigurationConstraints),
                 &settings.refine,
+                &mut observer,
             )?;
+            observer.step();
             // Only a design that violates nothing counts; otherwise keep the exchange design.
             let ok = r.q.iter().all(|q| cons.feasible(q));
             if ok && r.value <= ex.value {
                 Ok(PoolDesign {
+                    refine: Some((r.describe(), r.iterations)),
                     design: r.q,
                     value: r.value,
                     exchange_value: ex.value,
                     sweeps: ex.sweeps,
-                    refine: Some((r.status, r.iterations)),
                 })
             } else {
                 Ok(PoolDesign {
@@ -447,7 +461,7 @@ pub fn design_from_pool(
                     refine: Some((
                         format!(
                             "{} (refined design rejected: {})",
-                            r.status,
+                            r.describe(),
                             if ok { "no better" } else { "infeasible" }
                         ),
                         r.iterations,
@@ -456,6 +470,8 @@ pub fn design_from_pool(
             }
         })
         .collect();
+    drop(shared);
+    observer.finish();
     let mut best: Option<PoolDesign> = None;
     for r in runs {
         let r = r?;

@@ -12,9 +12,8 @@
 //! only at rounding level; otherwise the status says the iteration stalled.
 
 use super::problem::Problem;
-use super::solver::{
-    gradient_cosine, no_decrease_status, Iterate, Observer, Solution, Status, Tolerances,
-};
+use super::solver::{gradient_cosine, no_decrease_status, Iterate, Solution, Status, Tolerances};
+use crate::progress::Observer;
 use crate::Error;
 use nalgebra::DVector;
 use std::time::Instant;
@@ -33,9 +32,10 @@ pub fn gauss_newton(
     let t0 = Instant::now();
     let (m, n) = (problem.rows(), problem.columns());
     let mut it = Iterate::start(problem, start)?;
+    observer.start("Gauss–Newton", Some(tol.max_iterations));
     let mut cost = it.cost();
     let mut history = vec![cost];
-    let mut status = Status::MaxIterations;
+    let mut status = Status::IterationLimit;
     let mut iterations = 0;
     let mut trial_params = it.params.clone();
     let mut r_trial = DVector::zeros(m);
@@ -110,5 +110,6 @@ pub fn gauss_newton(
             break;
         }
     }
+    observer.finish();
     Ok(it.into_solution(status, iterations, history, t0))
 }

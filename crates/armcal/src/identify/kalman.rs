@@ -20,8 +20,9 @@
 //! changed by more than 10⁻⁷ of its posterior standard deviation.
 
 use super::problem::Problem;
-use super::solver::{Iterate, Observer, Solution, Status, Tolerances};
+use super::solver::{Iterate, Solution, Status, Tolerances};
 use crate::model::Unit;
+use crate::progress::Observer;
 use crate::Error;
 use nalgebra::{DMatrix, DVector};
 use std::time::Instant;
@@ -88,7 +89,8 @@ pub fn kalman_filter(
         .collect();
     blocks.extend((problem.data_rows()..m).map(|row| (row, 1)));
     let tol = &settings.tolerances;
-    let mut status = Status::MaxIterations;
+    observer.start("Kalman filter", Some(tol.max_iterations));
+    let mut status = Status::IterationLimit;
     let mut iterations = 0;
     let mut prior = p0;
     let mut p = prior.clone();
@@ -148,6 +150,7 @@ pub fn kalman_filter(
             break;
         }
     }
+    observer.finish();
     Ok(KalmanSolution {
         solution: it.into_solution(status, iterations, history, t0),
         covariance: p,

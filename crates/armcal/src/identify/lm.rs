@@ -7,9 +7,8 @@
 //! explicit criteria and an observer, which are a few lines here.
 
 use super::problem::Problem;
-use super::solver::{
-    gradient_cosine, no_decrease_status, Iterate, Observer, Solution, Status, Tolerances,
-};
+use super::solver::{gradient_cosine, no_decrease_status, Iterate, Solution, Status, Tolerances};
+use crate::progress::Observer;
 use crate::Error;
 use nalgebra::DVector;
 use std::time::Instant;
@@ -45,13 +44,17 @@ pub fn levenberg_marquardt(
     let t0 = Instant::now();
     let (m, n) = (problem.rows(), problem.columns());
     let mut it = Iterate::start(problem, start)?;
+    observer.start(
+        "Levenberg–Marquardt",
+        Some(settings.tolerances.max_iterations),
+    );
     let mut cost = it.cost();
     let mut history = vec![cost];
     let mut mu = settings.mu0;
     let mut trial_params = it.params.clone();
     let mut r_trial = DVector::zeros(m);
     let tol = &settings.tolerances;
-    let mut status = Status::MaxIterations;
+    let mut status = Status::IterationLimit;
     let mut iterations = 0;
     while iterations < tol.max_iterations {
         iterations += 1;
@@ -135,5 +138,6 @@ pub fn levenberg_marquardt(
             break;
         }
     }
+    observer.finish();
     Ok(it.into_solution(status, iterations, history, t0))
 }

@@ -12,13 +12,14 @@ pub mod solver;
 pub mod uncertainty;
 pub mod verdicts;
 
+pub use crate::progress::{Observer, Silent};
 pub use fingerprint::ModelFingerprint;
 pub use gauss_newton::gauss_newton;
 pub use kalman::{kalman_filter, KalmanSettings};
 pub use lm::{levenberg_marquardt, LmSettings};
 pub use problem::Problem;
 pub use robust::{robust_fit, Loss, Outlier};
-pub use solver::{Observer, Silent, Solution, Status, Tolerances};
+pub use solver::{Solution, Status, Tolerances};
 pub use uncertainty::{
     Chi2Outcome, ErrorStats, Observability, ParameterUncertainty, TcpCovariance,
 };

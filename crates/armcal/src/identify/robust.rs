@@ -9,7 +9,8 @@
 
 use super::lm::{levenberg_marquardt, LmSettings};
 use super::problem::Problem;
-use super::solver::{Observer, Solution};
+use super::solver::Solution;
+use crate::progress::Observer;
 use crate::Error;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
@@ -89,6 +90,7 @@ pub fn robust_fit(
         .map(|(&row, m)| (row, m.kind.rows()))
         .collect();
     problem.row_weights.fill(1.0);
+    observer.start("robust reweighting", None);
     let mut sol = levenberg_marquardt(problem, start, settings, observer)?;
     let mut scale = 1.0;
     let mut reweightings = 0;
@@ -153,6 +155,7 @@ pub fn robust_fit(
         }
     }
     (sol.residual, sol.jacobian) = kept_rows(problem, &sol.params, &outliers);
+    observer.finish();
     Ok(RobustSolution {
         solution: sol,
         outliers,

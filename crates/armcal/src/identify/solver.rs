@@ -1,36 +1,10 @@
-//! What every identification solver reports, and the observer that receives progress.
+//! What every identification solver reports ([`Solution`], with the shared
+//! [`crate::solve::Status`]) and the stopping rules they share.
 
+pub use crate::solve::Status;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 use std::time::Duration;
-
-/// How a solver ended.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "status", rename_all = "kebab-case")]
-pub enum Status {
-    /// A convergence criterion was met; `criterion` says which.
-    Converged { criterion: String },
-    /// The iteration limit was reached before convergence.
-    MaxIterations,
-    /// The iteration failed (non-finite values, or no step reduces the cost).
-    Diverged { reason: String },
-}
-
-impl std::fmt::Display for Status {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Status::Converged { criterion } => write!(f, "converged ({criterion})"),
-            Status::MaxIterations => f.write_str("stopped at the iteration limit"),
-            Status::Diverged { reason } => write!(f, "diverged: {reason}"),
-        }
-    }
-}
-
-impl Status {
-    pub fn is_converged(&self) -> bool {
-        matches!(self, Status::Converged { .. })
-    }
-}
 
 /// Result of a solver run.
 #[derive(Clone, Debug)]
@@ -70,17 +44,6 @@ impl Solution {
         self
     }
 }
-
-/// Receives progress from solvers (argmin / clarabel style): no solver prints.
-pub trait Observer {
-    /// Called after every accepted or rejected step.
-    fn iteration(&mut self, _iteration: usize, _cost: f64, _damping: f64) {}
-}
-
-/// An observer that ignores everything.
-pub struct Silent;
-
-impl Observer for Silent {}
 
 /// Stopping rules shared by the iterative solvers.
 #[derive(Clone, Debug, Serialize, Deserialize)]
