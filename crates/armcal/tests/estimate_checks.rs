@@ -12,6 +12,15 @@ use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use common::example_cell;
 use std::path::Path;
 
+/// Acceptance in the CLI's words, as the CLI passes it.
+fn cli(accepted: bool) -> Acceptance<'static> {
+    Acceptance {
+        accepted,
+        accept: "--accept-unconverged",
+        raise_iterations: "--max-iterations",
+    }
+}
+
 fn constant(sigma: f64) -> NoiseModel {
     NoiseModel::Constant {
         sigma: [sigma; 3],
@@ -60,7 +69,7 @@ fn chi2_verdict_says_what_a_wrong_sigma_means_for_the_reported_sigmas() {
             "{}",
             v.chi2.meaning
         );
-        let usable = wrong.check_usable(false).unwrap();
+        let usable = wrong.check_usable(&cli(false)).unwrap();
         assert!(
             usable.overridden.is_none() && usable.notes.iter().any(|n| n.contains(words)),
             "{usable:?}"
@@ -77,7 +86,7 @@ fn chi2_verdict_says_what_a_wrong_sigma_means_for_the_reported_sigmas() {
             "{}",
             rv.chi2.meaning
         );
-        assert!(right.check_usable(false).unwrap().notes.is_empty());
+        assert!(right.check_usable(&cli(false)).unwrap().notes.is_empty());
         for (s_wrong, s_right) in sigmas(&wrong).iter().zip(sigmas(&right)) {
             let ratio = s_right / (k * s_wrong);
             assert!(
@@ -100,14 +109,14 @@ fn unconverged_and_unverified_estimates_are_refused_unless_accepted() {
     let est = identify(&cell, &data, &opts, &mut Silent).unwrap();
     let v = est.verdicts.as_ref().unwrap();
     assert_eq!(v.solver, Status::IterationLimit);
-    let e = est.check_usable(false).unwrap_err().to_string();
+    let e = est.check_usable(&cli(false)).unwrap_err().to_string();
     assert!(
         e.contains("did not converge")
             && e.contains("stopped at the iteration limit")
             && e.contains("--accept-unconverged"),
         "{e}"
     );
-    let accepted = est.check_usable(true).unwrap();
+    let accepted = est.check_usable(&cli(true)).unwrap();
     let line = accepted.overridden.unwrap();
     assert!(
         line.contains("did not converge (stopped at the iteration limit)")
@@ -124,13 +133,13 @@ fn unconverged_and_unverified_estimates_are_refused_unless_accepted() {
     std::fs::write(&path, serde_json::to_string(&json).unwrap()).unwrap();
     let old = Estimate::from_file(&path).unwrap();
     assert!(old.verdicts.is_none() && old.fingerprint.is_none());
-    let e = old.check_usable(false).unwrap_err().to_string();
+    let e = old.check_usable(&cli(false)).unwrap_err().to_string();
     assert!(
         e.contains("older armcal") && e.contains("--accept-unconverged"),
         "{e}"
     );
     assert!(old
-        .check_usable(true)
+        .check_usable(&cli(true))
         .unwrap()
         .overridden
         .unwrap()

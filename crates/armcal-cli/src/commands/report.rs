@@ -50,7 +50,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         let document = Document::from_file(f)?;
         if let Document::Estimate(e) = &document {
             let usable = e
-                .check_usable(a.accept.accept_unconverged)
+                .check_usable(&a.accept.acceptance())
                 .map_err(|e| anyhow::anyhow!("{}: {e}", f.display()))?;
             notes.extend(usable.overridden.map(|o| format!("{}: {o}", f.display())));
         }

@@ -452,7 +452,7 @@ pub fn refine(
     };
     let mut u: Vec<f64> = start.concat();
     set.project(&mut u)
-        .map_err(|e| Error::Input(format!("pose refinement failed: {e:?}")))?;
+        .map_err(|e| Error::Numerical(format!("pose refinement failed: {e:?}")))?;
     set.estimate_lipschitz(&u);
     let ws = RefCell::new(objective.workspace(nconf));
     let start_value = objective.value_and_gradient(&mut ws.borrow_mut(), &start.concat(), None)?;
@@ -499,7 +499,7 @@ pub fn refine(
             .with_max_duration(remaining);
         let s = panoc
             .solve(&mut u)
-            .map_err(|e| Error::Input(format!("pose refinement failed: {e}")))?;
+            .map_err(|e| Error::Numerical(format!("pose refinement failed: {e}")))?;
         iterations += s.iterations();
         let previous = value;
         value = objective.value_and_gradient(&mut ws.borrow_mut(), &u, None)?;
@@ -563,7 +563,7 @@ pub fn refine(
     // every constraint evaluated.
     set.reset();
     set.project(&mut u)
-        .map_err(|e| Error::Input(format!("pose refinement failed: {e:?}")))?;
+        .map_err(|e| Error::Numerical(format!("pose refinement failed: {e:?}")))?;
     if u != best_u {
         value = objective.value_and_gradient(&mut ws.borrow_mut(), &u, None)?;
     }
@@ -609,7 +609,7 @@ fn projected_gradient(
             *t = x - alpha * gi;
         }
         set.project(&mut trial)
-            .map_err(|e| Error::Input(format!("pose refinement failed: {e:?}")))?;
+            .map_err(|e| Error::Numerical(format!("pose refinement failed: {e:?}")))?;
         let decrease: f64 = g
             .iter()
             .zip(u.iter())

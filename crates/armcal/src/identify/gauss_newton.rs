@@ -63,7 +63,7 @@ pub fn gauss_newton(
         let svd = js.svd(true, true);
         let step_scaled = svd
             .solve(&(-&it.r), 1e-12)
-            .map_err(|e| Error::Input(format!("Gauss–Newton step: {e}")))?;
+            .map_err(|e| Error::Numerical(format!("Gauss–Newton step: {e}")))?;
         let step = step_scaled.component_div(&scale);
         // Directional derivative ∇Fᵀδ = (Jᵀr)ᵀδ and the decrease the linear model predicts.
         let slope = it.r.dot(&(&it.j * &step));

@@ -107,9 +107,9 @@ pub fn kalman_filter(
             let innovation = -(it.r.rows(row, k) + ji * &delta);
             let pjt = &p * ji.transpose();
             let s = ji * &pjt + DMatrix::identity(k, k);
-            let s_inv = s
-                .try_inverse()
-                .ok_or_else(|| Error::Input("Kalman innovation covariance is singular".into()))?;
+            let s_inv = s.try_inverse().ok_or_else(|| {
+                Error::Numerical("Kalman innovation covariance is singular".into())
+            })?;
             let gain = &pjt * s_inv;
             delta += &gain * innovation;
             let a = &identity_n - &gain * ji;

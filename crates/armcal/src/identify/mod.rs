@@ -203,6 +203,21 @@ pub struct Estimate {
     pub fingerprint: Option<ModelFingerprint>,
 }
 
+/// Whether the caller accepts an estimate whose fit did not converge (or that records no
+/// verdicts), and how its user would say so, in the caller's own words (the CLI: its
+/// flags): [`Estimate::check_usable`] names them in the refusal and in the line every
+/// output made with an accepted estimate carries.
+#[derive(Clone, Copy, Debug)]
+pub struct Acceptance<'a> {
+    /// The user accepted the estimate as it is.
+    pub accepted: bool,
+    /// How the user accepts it (the CLI: `--accept-unconverged`).
+    pub accept: &'a str,
+    /// How the user raises the identification's iteration limit (the CLI:
+    /// `--max-iterations`).
+    pub raise_iterations: &'a str,
+}
+
 /// Whether an estimate may be used ([`Estimate::check_usable`]).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Usability {
@@ -722,12 +737,15 @@ impl Estimate {
 
     /// Whether the estimate may be used: an estimate whose fit did not converge — or that
     /// records no verdicts (written by an older armcal) — is an error naming the status,
-    /// unless `accept_unconverged`, when [`Usability::overridden`] says what every output must
-    /// carry. The χ² and identifiability verdicts worth knowing come back as notes.
-    pub fn check_usable(&self, accept_unconverged: bool) -> Result<Usability, Error> {
-        let flag = "pass --accept-unconverged to use it anyway";
+    /// unless `acceptance.accepted`, when [`Usability::overridden`] says what every output
+    /// must carry. Both say how the user accepts it, in the caller's words
+    /// ([`Acceptance`]). The χ² and identifiability verdicts worth knowing come back as
+    /// notes.
+    pub fn check_usable(&self, acceptance: &Acceptance) -> Result<Usability, Error> {
+        let accept = acceptance.accept;
+        let flag = format!("pass {accept} to use it anyway");
         let Some(v) = &self.verdicts else {
-            if !accept_unconverged {
+            if !acceptance.accepted {
                 return Err(Error::Input(format!(
                     "the estimate (cell `{}`) was written by an older armcal: it records no solver, χ² or identifiability verdict and no model fingerprint; identify again, or {flag}",
                     self.cell
@@ -735,7 +753,7 @@ impl Estimate {
             }
             return Ok(Usability {
                 overridden: Some(format!(
-                    "armcal: estimate of cell `{}` unverified (no recorded verdicts), used with --accept-unconverged",
+                    "armcal: estimate of cell `{}` unverified (no recorded verdicts), used with {accept}",
                     self.cell
                 )),
                 notes: Vec::new(),
@@ -743,14 +761,14 @@ impl Estimate {
         };
         let mut usability = Usability::default();
         if !v.solver.is_converged() {
-            if !accept_unconverged {
+            if !acceptance.accepted {
                 return Err(Error::Input(format!(
-                    "the fit of this estimate (cell `{}`) did not converge: {} after {} iterations; its parameters are not a least-squares solution. Identify again (check the nominal model, the data's units and joint columns, or raise --max-iterations), or {flag}",
-                    self.cell, v.solver, self.solver.iterations
+                    "the fit of this estimate (cell `{}`) did not converge: {} after {} iterations; its parameters are not a least-squares solution. Identify again (check the nominal model, the data's units and joint columns, or raise {}), or {flag}",
+                    self.cell, v.solver, self.solver.iterations, acceptance.raise_iterations
                 )));
             }
             usability.overridden = Some(format!(
-                "armcal: estimate of cell `{}` did not converge ({}), used with --accept-unconverged",
+                "armcal: estimate of cell `{}` did not converge ({}), used with {accept}",
                 self.cell, v.solver
             ));
         }

@@ -121,7 +121,7 @@ impl Iterate {
         };
         it.update(problem);
         if !it.cost().is_finite() {
-            return Err(crate::Error::Input(
+            return Err(crate::Error::Numerical(
                 "the residual at the starting parameters is not finite".into(),
             ));
         }

@@ -128,7 +128,7 @@ pub fn run_demo(seed: u64, observer: &mut dyn Observer) -> Result<Demo, Error> {
     ] {
         files.push((
             name.into(),
-            serde_json::to_string_pretty(record).map_err(|e| Error::Input(e.to_string()))?,
+            serde_json::to_string_pretty(record).map_err(|e| Error::Output(e.to_string()))?,
         ));
     }
 
@@ -187,7 +187,7 @@ pub fn run_demo(seed: u64, observer: &mut dyn Observer) -> Result<Demo, Error> {
         est.solver.time_ms = 0.0;
         files.push((
             format!("estimate-{name}.json"),
-            serde_json::to_string_pretty(&est).map_err(|e| Error::Input(e.to_string()))?,
+            serde_json::to_string_pretty(&est).map_err(|e| Error::Output(e.to_string()))?,
         ));
         let p = est.params_for(model)?;
         let held_out_errors = errors_of(&p, &mut fk);
@@ -270,7 +270,7 @@ pub fn run_demo(seed: u64, observer: &mut dyn Observer) -> Result<Demo, Error> {
     };
     files.push((
         "summary.json".into(),
-        serde_json::to_string_pretty(&summary).map_err(|e| Error::Input(e.to_string()))?,
+        serde_json::to_string_pretty(&summary).map_err(|e| Error::Output(e.to_string()))?,
     ));
 
     next_stage(observer, "writing the report");
