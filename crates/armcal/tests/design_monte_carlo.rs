@@ -6,7 +6,7 @@ use armcal::cell::Cell;
 use armcal::design::baselines::random_feasible;
 use armcal::design::plan::{constraint_set, plan, CellConstraints, PlanSettings};
 use armcal::design::{Criterion, DesignModel, DesignObjective};
-use armcal::identify::{solve, IdentifyOptions, Problem, Silent};
+use armcal::identify::{solve, IdentifySettings, Problem, Silent};
 use armcal::model::{forward_kinematics, observed_position, Data, Observed};
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use nalgebra::{Matrix3, Vector3};
@@ -62,7 +62,7 @@ fn kpi_design_variance_gain_holds_in_monte_carlo() {
                 let (sol, _, _) = solve(
                     &mut p,
                     &model.nominal(),
-                    &IdentifyOptions::default(),
+                    &IdentifySettings::default(),
                     &mut Silent,
                 )
                 .unwrap();

@@ -53,7 +53,7 @@ fn chi2_verdict_says_what_a_wrong_sigma_means_for_the_reported_sigmas() {
         (0.3, Chi2Outcome::SigmaTooLarge, "too large"),
     ] {
         let (cell, data) = paper_campaign(1.0, actual, 40);
-        let wrong = identify(&cell, &data, &IdentifyOptions::default(), &mut Silent).unwrap();
+        let wrong = identify(&cell, &data, &IdentifySettings::default(), &mut Silent).unwrap();
         let v = wrong.verdicts.as_ref().unwrap();
         assert_eq!(v.chi2.outcome, outcome, "{}", v.chi2.meaning);
         let k = v.chi2.sigma_ratio.unwrap();
@@ -78,7 +78,13 @@ fn chi2_verdict_says_what_a_wrong_sigma_means_for_the_reported_sigmas() {
         // Stating the true σ: consistent, and every reported σ is k times the wrong one's.
         let mut right_cell = cell.clone();
         right_cell.instrument.as_mut().unwrap().noise = constant(actual);
-        let right = identify(&right_cell, &data, &IdentifyOptions::default(), &mut Silent).unwrap();
+        let right = identify(
+            &right_cell,
+            &data,
+            &IdentifySettings::default(),
+            &mut Silent,
+        )
+        .unwrap();
         let rv = right.verdicts.as_ref().unwrap();
         assert_eq!(
             rv.chi2.outcome,
@@ -104,7 +110,7 @@ fn chi2_verdict_says_what_a_wrong_sigma_means_for_the_reported_sigmas() {
 #[test]
 fn unconverged_and_unverified_estimates_are_refused_unless_accepted() {
     let (cell, data) = paper_campaign(1.0, 1.0, 50);
-    let mut opts = IdentifyOptions::default();
+    let mut opts = IdentifySettings::default();
     opts.lm.tolerances.max_iterations = 1;
     let est = identify(&cell, &data, &opts, &mut Silent).unwrap();
     let v = est.verdicts.as_ref().unwrap();
@@ -171,7 +177,7 @@ fn cell_from(text: &str) -> Cell {
 #[test]
 fn a_cell_that_differs_from_the_estimates_is_named() {
     let (cell, data) = paper_campaign(1.0, 1.0, 60);
-    let est = identify(&cell, &data, &IdentifyOptions::default(), &mut Silent).unwrap();
+    let est = identify(&cell, &data, &IdentifySettings::default(), &mut Silent).unwrap();
     assert!(est.params_for(&cell.model).is_ok());
     let text = paper_cell_text();
     let cases = [

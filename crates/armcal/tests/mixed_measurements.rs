@@ -124,7 +124,7 @@ fn noise_free_mixed_data_recover_the_truth() {
     let (sol, _, _) = solve(
         &mut problem,
         &model.nominal(),
-        &IdentifyOptions::default(),
+        &IdentifySettings::default(),
         &mut Silent,
     )
     .unwrap();

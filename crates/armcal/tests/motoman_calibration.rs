@@ -3,7 +3,7 @@
 
 use armcal::cell::Cell;
 use armcal::evaluate::iso9283::position_repeatability;
-use armcal::identify::{identify, IdentifyOptions, Silent};
+use armcal::identify::{identify, IdentifySettings, Silent};
 use armcal::measure::{csv, MeasurementKind};
 use std::path::{Path, PathBuf};
 
@@ -20,7 +20,7 @@ fn calibrate(arm: &str) -> armcal::identify::Validation {
         Some(&cols),
     )
     .unwrap();
-    let opts = IdentifyOptions {
+    let opts = IdentifySettings {
         holdout: 1.0 / 3.0,
         seed: 1,
         ..Default::default()

@@ -8,7 +8,7 @@ use armcal::compensate::nonparametric::{
 };
 use armcal::compensate::program::filter_joint_program_corrected;
 use armcal::compensate::{IkSettings, IkStatus};
-use armcal::identify::{identify, IdentifyOptions, Silent};
+use armcal::identify::{identify, IdentifySettings, Silent};
 use armcal::measure::{Dataset, MeasurementKind, NoiseModel};
 use armcal::model::identifiability::random_configurations;
 use armcal::model::{forward_kinematics, Data};
@@ -138,7 +138,7 @@ fn sagging_calibration() -> SaggingCalibration {
             *value += to_instrument * sag(&data.configurations[m.config]);
         }
     }
-    let est = identify(&cell, &data, &IdentifyOptions::default(), &mut Silent).unwrap();
+    let est = identify(&cell, &data, &IdentifySettings::default(), &mut Silent).unwrap();
     let calibrated = est.params_for(model).unwrap();
     SaggingCalibration {
         cell,

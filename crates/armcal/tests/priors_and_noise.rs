@@ -27,7 +27,7 @@ fn a_prior_pulls_a_weak_parameter_toward_its_nominal_value() {
         let (sol, _, _) = solve(
             &mut problem,
             &model.nominal(),
-            &IdentifyOptions::default(),
+            &IdentifySettings::default(),
             &mut Silent,
         )
         .unwrap();

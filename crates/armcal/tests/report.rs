@@ -3,7 +3,7 @@
 
 mod common;
 use armcal::cell::Cell;
-use armcal::identify::{identify, Estimate, IdentifyOptions, Silent};
+use armcal::identify::{identify, Estimate, IdentifySettings, Silent};
 use armcal::model::identifiability::random_configurations;
 use armcal::model::{forward_kinematics, Data};
 use armcal::report::design_record::kind_margins;
@@ -34,7 +34,7 @@ fn fixtures() -> &'static (Cell, DesignRecord, Estimate) {
         let est = identify(
             &cell,
             &data,
-            &IdentifyOptions {
+            &IdentifySettings {
                 holdout: 0.3,
                 ..Default::default()
             },

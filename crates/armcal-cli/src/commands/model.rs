@@ -14,7 +14,7 @@
 
 use armcal::cell::Cell;
 use armcal::model::complete::{in_form, LinkForm};
-use armcal::model::identifiability::{self, IdentifiabilityOptions, Measurement};
+use armcal::model::identifiability::{self, IdentifiabilitySettings, Measurement};
 use armcal::model::rank_deficit::rank_deficit;
 use armcal::model::{Model, Segment, Status};
 
@@ -75,11 +75,11 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         .as_deref()
         .and_then(Measurement::from_name)
         .unwrap_or(cell.measurement);
-    let opts = IdentifiabilityOptions {
+    let opts = IdentifiabilitySettings {
         measurement,
         poses: a.poses,
         seed: a.seed,
-        ..cell.identifiability_options()
+        ..cell.identifiability_settings()
     };
     // The analysis runs on the parameters the cell declared free, before the automatic
     // reduction, so that every excluded parameter gets its reason.

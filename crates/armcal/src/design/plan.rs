@@ -11,7 +11,7 @@ use crate::design::objective::DesignObjective;
 use crate::design::order::order_for_travel;
 use crate::design::refine::{refine, ConfigurationConstraints, RefineSettings};
 use crate::design::Criterion;
-use crate::geometry::{ConstraintOptions, ConstraintSet, ConstraintWorkspace};
+use crate::geometry::{ConstraintSet, ConstraintSettings, ConstraintWorkspace};
 use crate::progress::{Observer, Shared};
 use crate::Error;
 use rayon::prelude::*;
@@ -72,7 +72,7 @@ pub struct DesignMargin {
 
 /// What a planner run produced.
 #[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct PlanReport {
+pub struct PlanResult {
     pub criterion: Criterion,
     pub value: f64,
     /// The design, ordered for travel (internal units).
@@ -101,7 +101,7 @@ fn infeasible_report(
     set: &ConstraintSet,
     settings: &PlanSettings,
     t0: Instant,
-) -> PlanReport {
+) -> PlanResult {
     let draws = 20_000;
     let qs = crate::model::identifiability::random_configurations(&d.model, draws, settings.seed);
     let mut ws = set.workspace();
@@ -139,7 +139,7 @@ fn infeasible_report(
         .unwrap_or(f64::NAN);
     let params = d.params.clone();
     let cons = CellConstraints::new(set, &params);
-    PlanReport {
+    PlanResult {
         criterion: settings.criterion,
         value,
         min_margin: cons.design_margin(&design),
@@ -301,7 +301,7 @@ fn constant_constraints(
 pub fn constraint_set(cell: &Cell, collisions: bool) -> Result<ConstraintSet, Error> {
     ConstraintSet::new(
         cell,
-        &ConstraintOptions {
+        &ConstraintSettings {
             incidence: cell
                 .instrument
                 .as_ref()
@@ -309,7 +309,7 @@ pub fn constraint_set(cell: &Cell, collisions: bool) -> Result<ConstraintSet, Er
                 .is_some(),
             collisions,
             line_of_sight: collisions,
-            ..ConstraintOptions::default()
+            ..ConstraintSettings::default()
         },
     )
 }
@@ -321,7 +321,7 @@ pub fn plan(
     settings: &PlanSettings,
     measured: &[Vec<f64>],
     observer: &mut dyn Observer,
-) -> Result<PlanReport, Error> {
+) -> Result<PlanResult, Error> {
     let t0 = Instant::now();
     let d = DesignModel::from_cell(cell)?;
     let set = constraint_set(cell, settings.collisions)?;
@@ -359,7 +359,7 @@ pub fn plan(
     } else {
         None
     };
-    Ok(PlanReport {
+    Ok(PlanResult {
         criterion: settings.criterion,
         value,
         design,

@@ -19,7 +19,7 @@
 //! `g = (t − p)/|t − p|` from the reflector position `p` to the tracker origin `t` (the
 //! instrument frame's origin): `cos β = zᵀg`. The paper takes `z` as the flange (TCP) z axis
 //! with the reflector on the flange. Here `p` is the reflector target (the first target of the
-//! model unless [`ConstraintOptions::reflector`] names another; the tool-frame origin if the
+//! model unless [`ConstraintSettings::reflector`] names another; the tool-frame origin if the
 //! model has no target) and `z` is that target's world z axis. A reflector given as a point
 //! (`Convention::Point`) carries the tool frame's orientation, so `z` is the tool/flange z
 //! axis as in the paper; a target given as a full frame uses its own z axis. Gradient:
@@ -52,7 +52,7 @@
 //! beam, but not against obstacles and half-spaces (the value would not depend on q).
 //!
 //! **Line of sight.** The beam from the reflector to the tracker origin is a capsule of radius
-//! [`ConstraintOptions::beam_radius`]. It is checked against every robot capsule and every
+//! [`ConstraintSettings::beam_radius`]. It is checked against every robot capsule and every
 //! obstacle capsule, except the robot capsules that carry the reflector: a capsule whose
 //! frame has at most one joint between it and the reflector is left out when the reflector
 //! point lies within its radius plus the beam radius (for a frame with one joint in between,
@@ -86,7 +86,7 @@ pub enum ConstraintKind {
 
 /// Which constraints a [`ConstraintSet`] contains.
 #[derive(Clone, Debug, PartialEq)]
-pub struct ConstraintOptions {
+pub struct ConstraintSettings {
     /// The incidence limit (paper eq. 4), if the cell has one.
     pub incidence: bool,
     /// Self collision, robot vs obstacle capsules, robot vs half-spaces.
@@ -101,9 +101,9 @@ pub struct ConstraintOptions {
     pub reflector: Option<String>,
 }
 
-impl Default for ConstraintOptions {
+impl Default for ConstraintSettings {
     fn default() -> Self {
-        ConstraintOptions {
+        ConstraintSettings {
             incidence: true,
             collisions: true,
             line_of_sight: true,
@@ -206,7 +206,7 @@ pub struct ConstraintWorkspace {
 impl ConstraintSet {
     /// Compiles the constraints of `cell` (see the module documentation for what is
     /// included).
-    pub fn new(cell: &Cell, options: &ConstraintOptions) -> Result<ConstraintSet, Error> {
+    pub fn new(cell: &Cell, options: &ConstraintSettings) -> Result<ConstraintSet, Error> {
         if !(options.beam_radius.is_finite() && options.beam_radius >= 0.0) {
             return Err(Error::Input(format!(
                 "beam radius must be a finite length ≥ 0 mm, got {}",
@@ -734,7 +734,7 @@ mod tests {
     fn jacobian_matches_central_differences() {
         use rand::SeedableRng;
         let cell = cell();
-        let set = ConstraintSet::new(&cell, &ConstraintOptions::default()).unwrap();
+        let set = ConstraintSet::new(&cell, &ConstraintSettings::default()).unwrap();
         let params = cell.model.nominal();
         let (n, dof) = (set.len(), set.dof());
         let mut ws = set.workspace();
@@ -797,7 +797,7 @@ mod tests {
         use parry3d_f64::shape::{Capsule, Segment};
         use rand::SeedableRng;
         let cell = cell();
-        let set = ConstraintSet::new(&cell, &ConstraintOptions::default()).unwrap();
+        let set = ConstraintSet::new(&cell, &ConstraintSettings::default()).unwrap();
         let params = cell.model.nominal();
         let mut ws = set.workspace();
         let mut values = vec![0.0; set.len()];
@@ -870,7 +870,7 @@ mod tests {
     #[test]
     fn row_subsets_and_early_exit_agree_with_the_full_evaluation() {
         let c = cell();
-        let set = ConstraintSet::new(&c, &ConstraintOptions::default()).unwrap();
+        let set = ConstraintSet::new(&c, &ConstraintSettings::default()).unwrap();
         let params = c.model.nominal();
         let (m, dof) = (set.len(), set.dof());
         let mut ws = set.workspace();
@@ -905,12 +905,12 @@ mod tests {
     #[test]
     fn bad_options_are_rejected() {
         let cell = cell();
-        let opts = ConstraintOptions {
+        let opts = ConstraintSettings {
             beam_radius: -1.0,
             ..Default::default()
         };
         assert!(ConstraintSet::new(&cell, &opts).is_err());
-        let opts = ConstraintOptions {
+        let opts = ConstraintSettings {
             reflector: Some("nope".into()),
             ..Default::default()
         };

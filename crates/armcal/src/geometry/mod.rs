@@ -13,6 +13,6 @@ pub mod constraints;
 pub mod segment_distance;
 
 pub use constraints::{
-    ConstraintKind, ConstraintOptions, ConstraintSet, ConstraintWorkspace, Margin,
+    ConstraintKind, ConstraintSet, ConstraintSettings, ConstraintWorkspace, Margin,
 };
 pub use segment_distance::{point_segment_distance, segment_distance, SegmentDistance};

@@ -12,7 +12,9 @@
 //! only at rounding level; otherwise the status says the iteration stalled.
 
 use super::problem::Problem;
-use super::solver::{gradient_cosine, no_decrease_status, Iterate, Solution, Status, Tolerances};
+use super::solver::{
+    gradient_cosine, no_decrease_status, Iterate, SolverResult, Status, ToleranceSettings,
+};
 use crate::progress::Observer;
 use crate::Error;
 use nalgebra::DVector;
@@ -26,9 +28,9 @@ const HALVINGS: usize = 40;
 pub fn gauss_newton(
     problem: &Problem,
     start: &[f64],
-    tol: &Tolerances,
+    tol: &ToleranceSettings,
     observer: &mut dyn Observer,
-) -> Result<Solution, Error> {
+) -> Result<SolverResult, Error> {
     let t0 = Instant::now();
     let (m, n) = (problem.rows(), problem.columns());
     let mut it = Iterate::start(problem, start)?;

@@ -20,7 +20,7 @@
 //! changed by more than 10⁻⁷ of its posterior standard deviation.
 
 use super::problem::Problem;
-use super::solver::{Iterate, Solution, Status, Tolerances};
+use super::solver::{Iterate, SolverResult, Status, ToleranceSettings};
 use crate::model::Unit;
 use crate::progress::Observer;
 use crate::Error;
@@ -30,7 +30,7 @@ use std::time::Instant;
 /// Settings of [`kalman_filter`].
 #[derive(Clone, Debug)]
 pub struct KalmanSettings {
-    pub tolerances: Tolerances,
+    pub tolerances: ToleranceSettings,
     /// Prior standard deviation of length parameters (mm) and of angles (rad).
     pub prior_length: f64,
     pub prior_angle: f64,
@@ -39,9 +39,9 @@ pub struct KalmanSettings {
 impl Default for KalmanSettings {
     fn default() -> Self {
         KalmanSettings {
-            tolerances: Tolerances {
+            tolerances: ToleranceSettings {
                 max_iterations: 50,
-                ..Tolerances::default()
+                ..ToleranceSettings::default()
             },
             prior_length: 1e3,
             prior_angle: 1.0,
@@ -54,8 +54,8 @@ const INFLATION: f64 = 1e4;
 /// Largest change of a parameter in a converged pass, in posterior standard deviations.
 const STEP_IN_SIGMA: f64 = 1e-7;
 
-pub struct KalmanSolution {
-    pub solution: Solution,
+pub struct KalmanResult {
+    pub solution: SolverResult,
     /// Covariance of the free parameters after the last pass.
     pub covariance: DMatrix<f64>,
 }
@@ -65,7 +65,7 @@ pub fn kalman_filter(
     start: &[f64],
     settings: &KalmanSettings,
     observer: &mut dyn Observer,
-) -> Result<KalmanSolution, Error> {
+) -> Result<KalmanResult, Error> {
     let t0 = Instant::now();
     let (m, n) = (problem.rows(), problem.columns());
     let mut it = Iterate::start(problem, start)?;
@@ -151,7 +151,7 @@ pub fn kalman_filter(
         }
     }
     observer.finish();
-    Ok(KalmanSolution {
+    Ok(KalmanResult {
         solution: it.into_solution(status, iterations, history, t0),
         covariance: p,
     })

@@ -7,7 +7,9 @@
 //! explicit criteria and an observer, which are a few lines here.
 
 use super::problem::Problem;
-use super::solver::{gradient_cosine, no_decrease_status, Iterate, Solution, Status, Tolerances};
+use super::solver::{
+    gradient_cosine, no_decrease_status, Iterate, SolverResult, Status, ToleranceSettings,
+};
 use crate::progress::Observer;
 use crate::Error;
 use nalgebra::DVector;
@@ -16,7 +18,7 @@ use std::time::Instant;
 /// Settings of [`levenberg_marquardt`].
 #[derive(Clone, Debug)]
 pub struct LmSettings {
-    pub tolerances: Tolerances,
+    pub tolerances: ToleranceSettings,
     /// Initial damping relative to the scaling (Marquardt's λ₀).
     pub mu0: f64,
     /// Damping increase / decrease factor.
@@ -26,7 +28,7 @@ pub struct LmSettings {
 impl Default for LmSettings {
     fn default() -> Self {
         LmSettings {
-            tolerances: Tolerances::default(),
+            tolerances: ToleranceSettings::default(),
             mu0: 0.01,
             factor: 10.0,
         }
@@ -40,7 +42,7 @@ pub fn levenberg_marquardt(
     start: &[f64],
     settings: &LmSettings,
     observer: &mut dyn Observer,
-) -> Result<Solution, Error> {
+) -> Result<SolverResult, Error> {
     let t0 = Instant::now();
     let (m, n) = (problem.rows(), problem.columns());
     let mut it = Iterate::start(problem, start)?;

@@ -19,7 +19,7 @@ pub use kalman::{kalman_filter, KalmanSettings};
 pub use lm::{levenberg_marquardt, LmSettings};
 pub use problem::Problem;
 pub use robust::{robust_fit, Loss, Outlier};
-pub use solver::{Solution, Status, Tolerances};
+pub use solver::{SolverResult, Status, ToleranceSettings};
 pub use uncertainty::{
     Chi2Outcome, ErrorStats, Observability, ParameterUncertainty, TcpCovariance,
 };
@@ -27,7 +27,7 @@ pub use verdicts::{Chi2Verdict, IdentifiabilityVerdict, Verdicts};
 
 use crate::cell::Cell;
 use crate::measure::{Dataset, MeasurementKind};
-use crate::model::identifiability::{Identifiability, IdentifiabilityOptions, Measurement};
+use crate::model::identifiability::{Identifiability, IdentifiabilitySettings, Measurement};
 use crate::model::rank_deficit::RankDeficit;
 use crate::model::{Model, ModelSpec, Segment, Status as ParamStatus};
 use crate::Error;
@@ -59,7 +59,7 @@ impl Method {
 
 /// Settings of [`identify`].
 #[derive(Clone, Debug)]
-pub struct IdentifyOptions {
+pub struct IdentifySettings {
     pub method: Method,
     pub robust: Option<Loss>,
     /// Fraction of configurations held out for validation, in [0, 1) (0: none).
@@ -71,9 +71,9 @@ pub struct IdentifyOptions {
     pub lm: LmSettings,
 }
 
-impl Default for IdentifyOptions {
+impl Default for IdentifySettings {
     fn default() -> Self {
-        IdentifyOptions {
+        IdentifySettings {
             method: Method::Lm,
             robust: None,
             holdout: 0.0,
@@ -245,7 +245,7 @@ pub fn identifiable_model(
     if !cell.auto_free {
         return Ok((cell.model.clone(), Vec::new()));
     }
-    let generic = cell.identifiability(&cell.identifiability_options())?;
+    let generic = cell.identifiability(&cell.identifiability_settings())?;
     identifiable_model_given(cell, data, at, &generic)
 }
 
@@ -273,7 +273,7 @@ fn identifiable_model_given(
         &declared,
         at,
         &data.configurations,
-        &cell.identifiability_options(),
+        &cell.identifiability_settings(),
     )?;
     report.apply(&mut declared)?;
     let generic_excluded: std::collections::HashSet<&str> =
@@ -305,7 +305,7 @@ pub fn frames_first_start(
     model: &Model,
     data: &Dataset,
     noise: &crate::measure::NoiseModel,
-    opts: &IdentifyOptions,
+    opts: &IdentifySettings,
 ) -> Result<Vec<f64>, Error> {
     let mut frames = frames_only(model);
     if frames.registry.free().is_empty() {
@@ -316,7 +316,7 @@ pub fn frames_first_start(
         &frames,
         &frames.nominal(),
         &data.configurations,
-        &IdentifiabilityOptions {
+        &IdentifiabilitySettings {
             measurement,
             ..Default::default()
         },
@@ -326,7 +326,7 @@ pub fn frames_first_start(
     if problem.free.is_empty() {
         return Ok(model.nominal());
     }
-    let stage = IdentifyOptions {
+    let stage = IdentifySettings {
         method: Method::Lm,
         robust: opts.robust,
         lm: opts.lm.clone(),
@@ -350,9 +350,9 @@ fn data_measurement(data: &Dataset) -> Measurement {
 pub fn solve(
     problem: &mut Problem,
     start: &[f64],
-    opts: &IdentifyOptions,
+    opts: &IdentifySettings,
     observer: &mut dyn Observer,
-) -> Result<(Solution, Vec<Outlier>, Option<f64>), Error> {
+) -> Result<(SolverResult, Vec<Outlier>, Option<f64>), Error> {
     problem.check_determined()?;
     if let Some(loss) = opts.robust {
         let r = robust_fit(problem, start, loss, &opts.lm, observer)?;
@@ -419,7 +419,7 @@ struct Split {
 }
 
 impl Split {
-    fn of(data: &Dataset, opts: &IdentifyOptions) -> Result<Split, Error> {
+    fn of(data: &Dataset, opts: &IdentifySettings) -> Result<Split, Error> {
         let h = opts.holdout;
         if !(0.0..1.0).contains(&h) {
             return Err(Error::Input(format!(
@@ -472,7 +472,7 @@ impl Split {
         &self,
         model: &Model,
         calibrated: &[f64],
-        opts: &IdentifyOptions,
+        opts: &IdentifySettings,
         noise: &crate::measure::NoiseModel,
     ) -> Result<Option<Validation>, Error> {
         let Some((test, source)) = &self.test else {
@@ -547,7 +547,7 @@ fn residual_report(problem: &Problem, params: &[f64], file_configs: &[usize]) ->
 pub fn identify(
     cell: &Cell,
     data: &Dataset,
-    opts: &IdentifyOptions,
+    opts: &IdentifySettings,
     observer: &mut dyn Observer,
 ) -> Result<Estimate, Error> {
     let noise = cell
@@ -667,7 +667,7 @@ struct FreeSetFit {
     reasons: Vec<(String, String)>,
     /// The problem's final row weights (a robust fit's IRLS weights).
     row_weights: Vec<f64>,
-    solution: Solution,
+    solution: SolverResult,
     outliers: Vec<Outlier>,
     robust_scale: Option<f64>,
 }
@@ -681,7 +681,7 @@ fn fit_free_set(
     cell: &Cell,
     train: &Dataset,
     noise: &crate::measure::NoiseModel,
-    opts: &IdentifyOptions,
+    opts: &IdentifySettings,
     observer: &mut dyn Observer,
 ) -> Result<FreeSetFit, Error> {
     let declared = if cell.auto_free {
@@ -690,7 +690,7 @@ fn fit_free_set(
         cell.model.clone()
     };
     let generic = if cell.auto_free {
-        Some(cell.identifiability(&cell.identifiability_options())?)
+        Some(cell.identifiability(&cell.identifiability_settings())?)
     } else {
         None
     };

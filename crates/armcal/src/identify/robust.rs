@@ -9,7 +9,7 @@
 
 use super::lm::{levenberg_marquardt, LmSettings};
 use super::problem::Problem;
-use super::solver::Solution;
+use super::solver::SolverResult;
 use crate::progress::Observer;
 use crate::Error;
 use nalgebra::{DMatrix, DVector};
@@ -65,10 +65,10 @@ pub struct Outlier {
     pub weight: f64,
 }
 
-pub struct RobustSolution {
+pub struct RobustResult {
     /// The final fit; its residual and Jacobian are those of the kept measurements with
     /// weight 1 (the rows of the outliers removed, prior rows kept).
-    pub solution: Solution,
+    pub solution: SolverResult,
     pub outliers: Vec<Outlier>,
     /// Robust scale of the whitened residuals at the end (≈ 1 if σ is right).
     pub scale: f64,
@@ -82,7 +82,7 @@ pub fn robust_fit(
     loss: Loss,
     settings: &LmSettings,
     observer: &mut dyn Observer,
-) -> Result<RobustSolution, Error> {
+) -> Result<RobustResult, Error> {
     let blocks: Vec<(usize, usize)> = problem
         .row_of
         .iter()
@@ -94,7 +94,7 @@ pub fn robust_fit(
     let mut sol = levenberg_marquardt(problem, start, settings, observer)?;
     let mut scale = 1.0;
     let mut reweightings = 0;
-    let norms = |sol: &Solution, problem: &Problem| -> Vec<f64> {
+    let norms = |sol: &SolverResult, problem: &Problem| -> Vec<f64> {
         // Undo the weights to get the plain whitened residual of each block.
         blocks
             .iter()
@@ -156,7 +156,7 @@ pub fn robust_fit(
     }
     (sol.residual, sol.jacobian) = kept_rows(problem, &sol.params, &outliers);
     observer.finish();
-    Ok(RobustSolution {
+    Ok(RobustResult {
         solution: sol,
         outliers,
         scale,

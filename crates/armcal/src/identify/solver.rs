@@ -1,4 +1,4 @@
-//! What every identification solver reports ([`Solution`], with the shared
+//! What every identification solver reports ([`SolverResult`], with the shared
 //! [`crate::solve::Status`]) and the stopping rules they share.
 
 pub use crate::solve::Status;
@@ -8,7 +8,7 @@ use std::time::Duration;
 
 /// Result of a solver run.
 #[derive(Clone, Debug)]
-pub struct Solution {
+pub struct SolverResult {
     /// Full parameter vector at the end.
     pub params: Vec<f64>,
     pub status: Status,
@@ -21,7 +21,7 @@ pub struct Solution {
     pub jacobian: DMatrix<f64>,
 }
 
-impl Solution {
+impl SolverResult {
     pub fn cost(&self) -> f64 {
         0.5 * self.residual.norm_squared()
     }
@@ -34,7 +34,7 @@ impl Solution {
         mut self,
         branch: &crate::model::branch::NearestBranch,
         free: &[usize],
-    ) -> Solution {
+    ) -> SolverResult {
         for (c, &i) in free.iter().enumerate() {
             if branch.signs[i] < 0.0 {
                 self.jacobian.column_mut(c).neg_mut();
@@ -47,7 +47,7 @@ impl Solution {
 
 /// Stopping rules shared by the iterative solvers.
 #[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct Tolerances {
+pub struct ToleranceSettings {
     pub max_iterations: usize,
     /// Relative reduction of the cost (actual and predicted) below which to stop.
     pub ftol: f64,
@@ -57,9 +57,9 @@ pub struct Tolerances {
     pub gtol: f64,
 }
 
-impl Default for Tolerances {
+impl Default for ToleranceSettings {
     fn default() -> Self {
-        Tolerances {
+        ToleranceSettings {
             max_iterations: 200,
             ftol: 1e-14,
             xtol: 1e-12,
@@ -144,8 +144,8 @@ impl Iterate {
         iterations: usize,
         history: Vec<f64>,
         t0: std::time::Instant,
-    ) -> Solution {
-        Solution {
+    ) -> SolverResult {
+        SolverResult {
             params: self.params,
             status,
             iterations,

@@ -5,7 +5,7 @@
 
 use crate::cell::Cell;
 use crate::design::assess::{assess, DesignAssessment};
-use crate::design::plan::{constraint_set, PlanReport};
+use crate::design::plan::{constraint_set, PlanResult};
 use crate::geometry::ConstraintKind;
 use crate::model::Model;
 use crate::Error;
@@ -54,7 +54,7 @@ pub struct DesignRecord {
     pub poses: Vec<Vec<f64>>,
     /// The planner's report (its `design` in internal units: rad, mm); absent for a design
     /// not planned by armcal.
-    pub plan: Option<PlanReport>,
+    pub plan: Option<PlanResult>,
     pub assessment: DesignAssessment,
     pub margins: Vec<KindMargin>,
 }
@@ -171,7 +171,7 @@ impl DesignRecord {
         cell_source: Option<&str>,
         method: &str,
         design: &[Vec<f64>],
-        plan: Option<PlanReport>,
+        plan: Option<PlanResult>,
         collisions: bool,
     ) -> Result<DesignRecord, Error> {
         let units = joint_units(&cell.model);

@@ -9,7 +9,7 @@ use crate::compensate::IkSettings;
 use crate::design::baselines::random_feasible;
 use crate::design::plan::{constraint_set, plan, CellConstraints, PlanSettings};
 use crate::design::DesignModel;
-use crate::identify::{identify, ErrorStats, Estimate, IdentifyOptions};
+use crate::identify::{identify, ErrorStats, Estimate, IdentifySettings};
 use crate::measure::csv;
 use crate::model::{forward_kinematics, observed_position, Data, Observed};
 use crate::progress::Observer;
@@ -176,7 +176,7 @@ pub fn run_demo(seed: u64, observer: &mut dyn Observer) -> Result<Demo, Error> {
         let mut est = identify(
             &cell,
             &data,
-            &IdentifyOptions {
+            &IdentifySettings {
                 seed,
                 ..Default::default()
             },

@@ -32,10 +32,10 @@
 //! **Units.** armcal works in mm and rad; the book's Chapter 6 in inches and degrees
 //! (Table 6.4 in mm and rad). The study's tables are in the book's units.
 
-use crate::identify::{solve, IdentifyOptions, Problem, Silent};
+use crate::identify::{solve, IdentifySettings, Problem, Silent};
 use crate::measure::{Dataset, MeasurementKind, NoiseModel};
 use crate::model::convert::zrp_to_dh;
-use crate::model::identifiability::{analyze_at, IdentifiabilityOptions, Measurement};
+use crate::model::identifiability::{analyze_at, IdentifiabilitySettings, Measurement};
 use crate::model::pose::rotation_log;
 use crate::model::{
     forward_kinematics, joint_jacobian, observed_pose, Convention, Data, LinkGeometry, LinkSpec,
@@ -498,7 +498,7 @@ fn rms_pair(e: &[(f64, f64)]) -> (f64, f64) {
 /// Fixes the parameters of `m` these configurations cannot identify from pose
 /// measurements; returns them with the reasons.
 fn fix_unidentifiable(m: &mut Model, qs: &[Vec<f64>]) -> Result<Vec<(String, String)>, Error> {
-    let opts = IdentifiabilityOptions {
+    let opts = IdentifiabilitySettings {
         measurement: Measurement::Pose,
         ..Default::default()
     };
@@ -525,7 +525,7 @@ fn fit(
     let (sol, _, _) = solve(
         &mut problem,
         &m.nominal(),
-        &IdentifyOptions::default(),
+        &IdentifySettings::default(),
         &mut Silent,
     )?;
     let (r, t) = rms_pair(&pose_errors(m, &sol.params, data));
