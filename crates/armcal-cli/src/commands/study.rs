@@ -187,10 +187,13 @@ fn run_puma(a: &Args) -> anyhow::Result<()> {
         .clone()
         .unwrap_or_else(|| PathBuf::from("out/study-puma"));
     let t0 = std::time::Instant::now();
-    let s = puma::run(&puma::PumaSettings {
-        seed: a.seed,
-        ..Default::default()
-    })?;
+    let s = puma::run(
+        &puma::PumaSettings {
+            seed: a.seed,
+            ..Default::default()
+        },
+        &mut Progress::new(a.quiet),
+    )?;
     let secs = t0.elapsed().as_secs_f64();
     println!(
         "PUMA 560 study (book ch. 6): truth Table 6.5, {} full poses with Table 6.4 noise \

@@ -32,7 +32,7 @@
 //! **Units.** armcal works in mm and rad; the book's Chapter 6 in inches and degrees
 //! (Table 6.4 in mm and rad). The study's tables are in the book's units.
 
-use crate::identify::{solve, IdentifySettings, Problem, Silent};
+use crate::identify::{solve, IdentifySettings, Problem};
 use crate::measure::{Dataset, MeasurementKind, NoiseModel};
 use crate::model::convert::zrp_to_dh;
 use crate::model::identifiability::{analyze_at, IdentifiabilitySettings, Measurement};
@@ -41,6 +41,7 @@ use crate::model::{
     forward_kinematics, joint_jacobian, observed_pose, Convention, Data, LinkGeometry, LinkSpec,
     Model, ModelSpec, Observed, Pose, Status,
 };
+use crate::progress::Observer;
 use crate::robots::puma560::{book_dh_spec, book_zrp_spec, MM_PER_IN};
 use crate::sim::simulate;
 use crate::Error;
@@ -520,13 +521,14 @@ fn fit(
     data: &Dataset,
     noise: &NoiseModel,
     unidentifiable: Vec<(String, String)>,
+    observer: &mut dyn Observer,
 ) -> Result<(Vec<f64>, FitSummary, ParameterSigmas), Error> {
     let mut problem = Problem::new(m, data, noise)?;
     let (sol, _, _) = solve(
         &mut problem,
         &m.nominal(),
         &IdentifySettings::default(),
-        &mut Silent,
+        observer,
     )?;
     let (r, t) = rms_pair(&pose_errors(m, &sol.params, data));
     let unc = problem.uncertainty_at(&sol.params)?;
@@ -568,8 +570,8 @@ fn book_p123(g: &LinkGeometry) -> ([String; 3], [f64; 3]) {
     (fields.map(String::from), v)
 }
 
-/// The PUMA study (module documentation).
-pub fn run(s: &PumaSettings) -> Result<PumaStudy, Error> {
+/// The PUMA study (module documentation); `observer` follows the two fits.
+pub fn run(s: &PumaSettings, observer: &mut dyn Observer) -> Result<PumaStudy, Error> {
     let noise = table_6_4_noise();
     let NoiseModel::Constant { sigma, sigma_angle } = noise else {
         unreachable!("Table 6.4 is a constant noise model")
@@ -593,8 +595,14 @@ pub fn run(s: &PumaSettings) -> Result<PumaStudy, Error> {
     // (a) Modified DH from Table 6.1.
     let mut mdh = mdh;
     let mdh_fixed = fix_unidentifiable(&mut mdh, &train)?;
-    let (mdh_params, mdh_summary, mdh_sigma) =
-        fit("modified DH (Table 6.1)", &mdh, &data, &noise, mdh_fixed)?;
+    let (mdh_params, mdh_summary, mdh_sigma) = fit(
+        "modified DH (Table 6.1)",
+        &mdh,
+        &data,
+        &noise,
+        mdh_fixed,
+        observer,
+    )?;
 
     // (b) Zero reference from Table 6.2 / eq. 6.11: u, p, offsets and T₀ free as the
     // data identify them; the base is the CMM frame (identity, fixed).
@@ -608,6 +616,7 @@ pub fn run(s: &PumaSettings) -> Result<PumaStudy, Error> {
         &data,
         &noise,
         zrp_fixed,
+        observer,
     )?;
 
     // (c) Zero reference → DH with Table 6.1's link types and sign rules.
