@@ -470,7 +470,6 @@ pub fn design_from_pool(
             }
         })
         .collect();
-    drop(shared);
     observer.finish();
     let mut best: Option<PoolDesign> = None;
     for r in runs {

@@ -194,7 +194,6 @@ pub fn run(robots: &[String], s: &StudySettings, observer: &mut dyn Observer) ->
             row
         })
         .collect();
-    drop(shared);
     observer.finish();
     rows
 }
