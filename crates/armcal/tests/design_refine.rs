@@ -38,16 +38,19 @@ fn refinement_improves_the_exchange_design_within_limits() {
     let (ex, start) = kpi_exchange_start(&d, &pool);
     let obj = DesignObjective::new(&d, Criterion::Kpi, &[]);
     let (lo, hi) = d.model.joint_limits();
-    let r = refine(
-        &obj,
-        &start,
-        &lo,
-        &hi,
-        None,
-        &RefineSettings::default(),
-        &mut Silent,
-    )
-    .unwrap();
+    let unconstrained = |start: &[Vec<f64>]| {
+        refine(
+            &obj,
+            start,
+            &lo,
+            &hi,
+            None,
+            &RefineSettings::default(),
+            &mut Silent,
+        )
+        .unwrap()
+    };
+    let r = unconstrained(&start);
     eprintln!(
         "exchange {:.5} → refined {:.5} mm² ({}, {} iterations, {:.2} s)",
         ex.value,
@@ -65,16 +68,7 @@ fn refinement_improves_the_exchange_design_within_limits() {
     }
     // From a random start the refinement alone also reaches a good design.
     let random: Vec<Vec<f64>> = pool[..60].to_vec();
-    let r2 = refine(
-        &obj,
-        &random,
-        &lo,
-        &hi,
-        None,
-        &RefineSettings::default(),
-        &mut Silent,
-    )
-    .unwrap();
+    let r2 = unconstrained(&random);
     eprintln!(
         "random {:.5} → refined {:.5} mm² ({:.2} s)",
         r2.start_value,

@@ -8,7 +8,9 @@ use std::io::IsTerminal;
 use std::time::Duration;
 
 /// A spinner line showing the innermost running task (its label, its steps or the
-/// solver's iteration and cost, and the elapsed time).
+/// solver's iteration and cost, and the elapsed time). Tasks nest as a stack; tasks of
+/// parallel workers (the planner's starts) interleave on it, so the line shows whichever
+/// reported last — a display, not a record.
 pub struct Progress {
     bar: ProgressBar,
     /// The running tasks, outermost first.
