@@ -17,10 +17,11 @@
 //! (Table 6.4 in mm and rad). Printed numbers are given in both.
 
 use armcal::cell::Cell;
-use armcal::identify::{solve, IdentifySettings, Method, Problem, Silent};
+use armcal::identify::{solve, IdentifySettings, Method, Problem};
 use armcal::measure::{Dataset, MeasurementKind, NoiseModel};
 use armcal::model::identifiability::{analyze, IdentifiabilitySettings, Measurement};
 use armcal::model::*;
+use armcal::progress::Silent;
 use armcal::robots;
 use armcal::robots::puma560::MM_PER_IN;
 use armcal::sim::simulate;

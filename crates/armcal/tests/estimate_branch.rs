@@ -9,6 +9,7 @@ use armcal::identify::*;
 use armcal::measure::{Dataset, MeasurementKind};
 use armcal::model::identifiability::random_configurations;
 use armcal::model::Model;
+use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use nalgebra::Vector3;
 

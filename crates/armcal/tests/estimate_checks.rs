@@ -8,6 +8,7 @@ use armcal::cell::Cell;
 use armcal::identify::*;
 use armcal::measure::{Dataset, NoiseModel};
 use armcal::model::identifiability::random_configurations;
+use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use common::example_cell;
 use std::path::Path;

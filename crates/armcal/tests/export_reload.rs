@@ -5,11 +5,12 @@
 //! (issue 10, item 8).
 
 use armcal::cell::{export::to_cell_toml, Cell};
-use armcal::identify::{identify, IdentifySettings, Silent};
+use armcal::identify::{identify, IdentifySettings};
 use armcal::model::complete::LinkForm;
 use armcal::model::export::{export_form, suspicious_values};
 use armcal::model::identifiability::random_configurations;
 use armcal::model::{forward_kinematics, Data, Model};
+use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use std::path::Path;
 

@@ -2,9 +2,10 @@
 //! generic count names its cause (issue 10, items 1 and 2).
 
 use armcal::cell::Cell;
-use armcal::identify::{identify, IdentifySettings, Silent};
+use armcal::identify::{identify, IdentifySettings};
 use armcal::model::identifiability::random_configurations;
 use armcal::model::Convention;
+use armcal::progress::Silent;
 use armcal::robots;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use std::path::Path;

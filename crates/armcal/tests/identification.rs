@@ -5,6 +5,7 @@ mod common;
 use armcal::cell::Cell;
 use armcal::identify::*;
 use armcal::model::identifiability::random_configurations;
+use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;

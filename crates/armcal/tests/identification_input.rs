@@ -4,6 +4,7 @@ use armcal::cell::Cell;
 use armcal::identify::*;
 use armcal::measure::{csv, MeasurementKind};
 use armcal::model::identifiability::random_configurations;
+use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use nalgebra::Vector3;
 use std::path::Path;

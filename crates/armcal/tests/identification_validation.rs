@@ -5,6 +5,7 @@ mod common;
 use armcal::identify::*;
 use armcal::measure::Dataset;
 use armcal::model::identifiability::random_configurations;
+use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 
 /// Noisy data of the paper cell at `n` random poses whose ids are not their numbers

@@ -6,6 +6,7 @@ use armcal::identify::*;
 use armcal::measure::{Dataset, Measurement, MeasurementKind, NoiseModel};
 use armcal::model::identifiability::random_configurations;
 use armcal::model::*;
+use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use nalgebra::{DMatrix, DVector, Vector3};
 

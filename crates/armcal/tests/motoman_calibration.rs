@@ -3,8 +3,9 @@
 
 use armcal::cell::Cell;
 use armcal::evaluate::iso9283::position_repeatability;
-use armcal::identify::{identify, IdentifySettings, Silent};
+use armcal::identify::{identify, IdentifySettings};
 use armcal::measure::{csv, MeasurementKind};
+use armcal::progress::Silent;
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {

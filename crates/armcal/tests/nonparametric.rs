@@ -8,10 +8,11 @@ use armcal::compensate::nonparametric::{
 };
 use armcal::compensate::program::filter_joint_program_corrected;
 use armcal::compensate::{IkSettings, IkStatus};
-use armcal::identify::{identify, IdentifySettings, Silent};
+use armcal::identify::{identify, IdentifySettings};
 use armcal::measure::{Dataset, MeasurementKind, NoiseModel};
 use armcal::model::identifiability::random_configurations;
 use armcal::model::{forward_kinematics, Data};
+use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use nalgebra::Vector3;
 use std::path::Path;

@@ -5,6 +5,7 @@ use armcal::identify::*;
 use armcal::measure::{csv, NoiseModel};
 use armcal::model::identifiability::random_configurations;
 use armcal::model::Status as ParamStatus;
+use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use std::path::Path;
 

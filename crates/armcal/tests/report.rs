@@ -3,9 +3,10 @@
 
 mod common;
 use armcal::cell::Cell;
-use armcal::identify::{identify, Estimate, IdentifySettings, Silent};
+use armcal::identify::{identify, Estimate, IdentifySettings};
 use armcal::model::identifiability::random_configurations;
 use armcal::model::{forward_kinematics, Data};
+use armcal::progress::Silent;
 use armcal::report::design_record::kind_margins;
 use armcal::report::ellipse::{confidence_scale, ellipse_axes, ellipse_points, Plane};
 use armcal::report::figures::{

@@ -12,7 +12,6 @@ pub mod solver;
 pub mod uncertainty;
 pub mod verdicts;
 
-pub use crate::progress::{Observer, Silent};
 pub use fingerprint::ModelFingerprint;
 pub use gauss_newton::gauss_newton;
 pub use kalman::{kalman_filter, KalmanSettings};
@@ -30,6 +29,7 @@ use crate::measure::{Dataset, MeasurementKind};
 use crate::model::identifiability::{Identifiability, IdentifiabilitySettings, Measurement};
 use crate::model::rank_deficit::RankDeficit;
 use crate::model::{Model, ModelSpec, Segment, Status as ParamStatus};
+use crate::progress::{Observer, Silent};
 use crate::Error;
 use nalgebra::{DVector, Matrix3};
 use rand::seq::SliceRandom;
@@ -211,10 +211,10 @@ pub struct Estimate {
 pub struct Acceptance<'a> {
     /// The user accepted the estimate as it is.
     pub accepted: bool,
-    /// How the user accepts it (the CLI: `--accept-unconverged`).
+    /// How the user accepts it (the CLI passes its flag's name).
     pub accept: &'a str,
-    /// How the user raises the identification's iteration limit (the CLI:
-    /// `--max-iterations`).
+    /// How the user raises the identification's iteration limit (the CLI passes its flag's
+    /// name).
     pub raise_iterations: &'a str,
 }
 
