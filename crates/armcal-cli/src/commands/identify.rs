@@ -42,6 +42,9 @@ pub struct Args {
     /// Overwrite an existing output file.
     #[arg(long)]
     pub force: bool,
+    /// No progress display.
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
@@ -65,7 +68,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     if a.out.exists() && !a.force {
         bail!("{} exists; pass --force to overwrite it", a.out.display());
     }
-    let est = identify(&cell, &data, &opts, &mut Progress::new(false))?;
+    let est = identify(&cell, &data, &opts, &mut Progress::new(a.quiet))?;
     print_summary(&est);
     write_new(&a.out, &serde_json::to_string_pretty(&est)?, a.force)?;
     println!("\nestimate → {}", a.out.display());

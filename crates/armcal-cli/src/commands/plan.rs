@@ -41,6 +41,9 @@ pub struct PlanArgs {
     pub report: Option<PathBuf>,
     #[arg(long)]
     pub force: bool,
+    /// No progress display.
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 #[derive(clap::Args)]
@@ -84,7 +87,7 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         seed: a.seed,
         ..PlanSettings::default()
     };
-    let rep = plan(&cell, &settings, &measured, &mut Progress::new(false))?;
+    let rep = plan(&cell, &settings, &measured, &mut Progress::new(a.quiet))?;
     write_new(
         &a.out,
         &csv::write_configurations(&cell.model, &rep.design),
