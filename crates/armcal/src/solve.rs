@@ -50,3 +50,37 @@ impl Status {
         matches!(self, Status::Converged { .. })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Status;
+
+    /// The estimate files' names and the printed words are those of the statuses before
+    /// the shared vocabulary.
+    #[test]
+    fn files_and_words_keep_their_names() {
+        let json = |s: &Status| serde_json::to_string(s).unwrap();
+        let converged = Status::Converged {
+            criterion: "gradient".into(),
+        };
+        assert_eq!(
+            json(&converged),
+            r#"{"status":"converged","criterion":"gradient"}"#
+        );
+        assert_eq!(
+            json(&Status::IterationLimit),
+            r#"{"status":"max-iterations"}"#
+        );
+        let back: Status = serde_json::from_str(r#"{"status":"max-iterations"}"#).unwrap();
+        assert_eq!(back, Status::IterationLimit);
+        assert_eq!(converged.to_string(), "converged (gradient)");
+        assert_eq!(
+            Status::IterationLimit.to_string(),
+            "stopped at the iteration limit"
+        );
+        let diverged = Status::Diverged {
+            reason: "NaN".into(),
+        };
+        assert_eq!(diverged.to_string(), "diverged: NaN");
+    }
+}
