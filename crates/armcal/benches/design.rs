@@ -8,6 +8,7 @@
 
 use armcal::cell::Cell;
 use armcal::design::plan::{plan, PlanSettings};
+use armcal::progress::Silent;
 use criterion::{criterion_group, criterion_main, Criterion};
 
 use armcal::cell::builtin::PAPER_CELL as CELL;
@@ -27,7 +28,7 @@ fn design(c: &mut Criterion) {
             collisions,
             ..PlanSettings::default()
         };
-        let r = plan(&cell, &settings, &[]).expect("plan");
+        let r = plan(&cell, &settings, &[], &mut Silent).expect("plan");
         eprintln!(
             "{name}: (1/3) tr C_s = {:.5} mm², feasible {}, efficiency {:.3}, refinement: {} ({} iterations)",
             r.value,
@@ -37,7 +38,7 @@ fn design(c: &mut Criterion) {
             r.refine_iterations
         );
         group.bench_function(name, |b| {
-            b.iter(|| plan(&cell, &settings, &[]).expect("plan"))
+            b.iter(|| plan(&cell, &settings, &[], &mut Silent).expect("plan"))
         });
     }
     group.finish();

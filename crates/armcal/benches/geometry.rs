@@ -3,7 +3,7 @@
 //! with obstacles (FK + 67 values + 67 × 6 Jacobian).
 
 use armcal::cell::Cell;
-use armcal::design::{ConstraintOptions, ConstraintSet};
+use armcal::design::{ConstraintSet, ConstraintSettings};
 use armcal::geometry::segment_distance;
 use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::Vector3;
@@ -49,7 +49,7 @@ fn geometry(c: &mut Criterion) {
 
     let cell = Cell::from_toml(CELL, "paper-cell-obstacles.toml", std::path::Path::new("."))
         .expect("paper cell");
-    let set = ConstraintSet::new(&cell, &ConstraintOptions::default()).expect("constraints");
+    let set = ConstraintSet::new(&cell, &ConstraintSettings::default()).expect("constraints");
     let params = cell.model.nominal();
     let q = [0.3, -0.4, 0.9, 0.5, -0.7, 1.1];
     let mut ws = set.workspace();

@@ -2,8 +2,9 @@
 //! Levenberg–Marquardt from the nominal model.
 
 use armcal::cell::Cell;
-use armcal::identify::{levenberg_marquardt, LmSettings, Problem, Silent};
+use armcal::identify::{levenberg_marquardt, LmSettings, Problem};
 use armcal::model::random_configurations;
+use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use criterion::{criterion_group, criterion_main, Criterion};
 

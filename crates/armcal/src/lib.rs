@@ -15,9 +15,11 @@ pub mod identify;
 pub mod json;
 pub mod measure;
 pub mod model;
+pub mod progress;
 pub mod report;
 pub mod robots;
 pub mod sim;
+pub mod solve;
 pub mod study;
 pub mod workflow;
 

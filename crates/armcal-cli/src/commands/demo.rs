@@ -1,11 +1,9 @@
 //! `armcal demo`: the whole workflow on the built-in paper cell.
 
+use super::progress::Progress;
 use anyhow::{bail, Context};
 use armcal::workflow::demo::demo;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::io::IsTerminal;
 use std::path::PathBuf;
-use std::time::Duration;
 
 /// Marks a folder as written by `armcal demo`, which may then overwrite it.
 const MARKER: &str = ".armcal-demo";
@@ -31,16 +29,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         );
     }
     let t0 = std::time::Instant::now();
-    let spinner = ProgressBar::new_spinner();
-    if a.quiet || !std::io::stdout().is_terminal() {
-        spinner.set_draw_target(ProgressDrawTarget::hidden());
-    }
-    spinner.set_style(
-        ProgressStyle::with_template("{spinner} {msg} ({elapsed})").expect("valid template"),
-    );
-    spinner.enable_steady_tick(Duration::from_millis(120));
-    let demo = demo(a.seed, &|stage| spinner.set_message(stage.to_string()))?;
-    spinner.finish_and_clear();
+    let demo = demo(a.seed, &mut Progress::new(a.quiet))?;
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     std::fs::write(a.out.join(MARKER), "written by armcal demo\n")?;
     for (name, content) in &demo.files {

@@ -1,9 +1,10 @@
 //! `armcal identify`: calibrate the cell's free parameters from a data file.
 
 use super::output::{load_cell, load_data, write_new};
+use super::progress::Progress;
 use anyhow::bail;
 use armcal::identify::{
-    identify, Estimate, IdentifyOptions, LmSettings, Loss, Method, Silent, Tolerances,
+    identify, Estimate, IdentifySettings, LmSettings, Loss, Method, ToleranceSettings,
 };
 use std::path::PathBuf;
 
@@ -30,7 +31,7 @@ pub struct Args {
     /// Iteration limit of Levenberg–Marquardt and Gauss–Newton (per run: the frames-first
     /// stage and each robust reweighting are runs of their own; the Kalman filter keeps its
     /// own limit).
-    #[arg(long, default_value_t = Tolerances::default().max_iterations)]
+    #[arg(long, default_value_t = ToleranceSettings::default().max_iterations)]
     pub max_iterations: usize,
     /// Seed of the held-out split.
     #[arg(long, default_value_t = 1)]
@@ -41,20 +42,23 @@ pub struct Args {
     /// Overwrite an existing output file.
     #[arg(long)]
     pub force: bool,
+    /// No progress display.
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let cell = load_cell(&a.cell)?;
     let data = load_data(&cell, &a.data)?;
     let test = a.test.as_deref().map(|t| load_data(&cell, t)).transpose()?;
-    let opts = IdentifyOptions {
+    let opts = IdentifySettings {
         method: Method::from_name(&a.method).expect("clap checked"),
         robust: a.robust.as_deref().and_then(Loss::from_name),
         holdout: a.holdout,
         test,
         seed: a.seed,
         lm: LmSettings {
-            tolerances: Tolerances {
+            tolerances: ToleranceSettings {
                 max_iterations: a.max_iterations,
                 ..Default::default()
             },
@@ -64,7 +68,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     if a.out.exists() && !a.force {
         bail!("{} exists; pass --force to overwrite it", a.out.display());
     }
-    let est = identify(&cell, &data, &opts, &mut Silent)?;
+    let est = identify(&cell, &data, &opts, &mut Progress::new(a.quiet))?;
     print_summary(&est);
     write_new(&a.out, &serde_json::to_string_pretty(&est)?, a.force)?;
     println!("\nestimate → {}", a.out.display());

@@ -11,6 +11,7 @@ pub mod model;
 pub mod output;
 pub mod plan;
 pub mod predict;
+pub mod progress;
 pub mod report;
 pub mod robots;
 pub mod simulate;

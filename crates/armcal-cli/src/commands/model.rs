@@ -6,7 +6,7 @@
 
 use armcal::cell::model_analysis::{analyze_model, ModelRecord};
 use armcal::model::complete::LinkForm;
-use armcal::model::identifiability::{IdentifiabilityOptions, Measurement};
+use armcal::model::identifiability::{IdentifiabilitySettings, Measurement};
 use armcal::model::Status;
 
 #[derive(clap::Args)]
@@ -38,11 +38,11 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         .as_deref()
         .and_then(Measurement::from_name)
         .unwrap_or(cell.measurement);
-    let opts = IdentifiabilityOptions {
+    let opts = IdentifiabilitySettings {
         measurement,
         poses: a.poses,
         seed: a.seed,
-        ..cell.identifiability_options()
+        ..cell.identifiability_settings()
     };
     let convention = a
         .convention

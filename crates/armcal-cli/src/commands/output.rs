@@ -49,6 +49,17 @@ pub struct AcceptUnconverged {
     pub accept_unconverged: bool,
 }
 
+impl AcceptUnconverged {
+    /// The library's acceptance, in this CLI's flags.
+    pub fn acceptance(&self) -> armcal::identify::Acceptance<'static> {
+        armcal::identify::Acceptance {
+            accepted: self.accept_unconverged,
+            accept: "--accept-unconverged",
+            raise_iterations: "--max-iterations",
+        }
+    }
+}
+
 /// Reads an estimate, refuses it if its fit did not converge (unless accepted) and, given a
 /// model, if it was identified on another model; prints its notes to stderr. Returns the
 /// estimate and the line every output made with it must carry (`None` if converged).
@@ -59,7 +70,7 @@ pub fn load_estimate(
 ) -> anyhow::Result<(armcal::identify::Estimate, Option<String>)> {
     let file = |e: armcal::Error| anyhow::anyhow!("{}: {e}", path.display());
     let est = armcal::identify::Estimate::from_file(path)?;
-    let usable = est.check_usable(accept.accept_unconverged).map_err(file)?;
+    let usable = est.check_usable(&accept.acceptance()).map_err(file)?;
     if let Some(m) = model {
         est.check_model(m).map_err(file)?;
     }

@@ -2,6 +2,7 @@
 //! (including a hand-made one) gives.
 
 use super::output::{load_cell, write_new};
+use super::progress::Progress;
 use anyhow::bail;
 use armcal::design::assess::evaluate_design;
 use armcal::design::plan::PlanSettings;
@@ -40,6 +41,9 @@ pub struct PlanArgs {
     pub report: Option<PathBuf>,
     #[arg(long)]
     pub force: bool,
+    /// No progress display.
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 #[derive(clap::Args)]
@@ -92,6 +96,7 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         ),
         &settings,
         &measured,
+        &mut Progress::new(a.quiet),
     )?;
     let rep = record.plan.as_ref().expect("a planned design");
     write_new(

@@ -30,7 +30,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     if path.exists() && !a.force {
         bail!("{} exists; pass --force to overwrite it", path.display());
     }
-    let report = files_report(&a.files, &a.title, a.accept.accept_unconverged)?;
+    let report = files_report(&a.files, &a.title, &a.accept.acceptance())?;
     for n in &report.notes {
         eprintln!("note: {n}");
     }

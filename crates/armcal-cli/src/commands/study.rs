@@ -2,10 +2,9 @@
 //! `armcal study puma`: the book's Chapter 6 PUMA case (Tables 6.9/6.10 and 6.13).
 
 use super::output::write_new;
+use super::progress::Progress;
 use armcal::study::paper::{self, RobotSelection, StudySettings, PAPER_SUMMARY, PAPER_TABLE6};
 use armcal::study::{puma, puma_record};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::io::IsTerminal;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -49,15 +48,7 @@ pub fn run_study(a: &Args) -> anyhow::Result<()> {
         seed: a.seed,
         ..StudySettings::default()
     };
-    let bar = ProgressBar::new(robots.len() as u64);
-    if a.quiet || !std::io::stderr().is_terminal() {
-        bar.set_draw_target(ProgressDrawTarget::hidden());
-    }
-    bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} robots, {elapsed} (eta {eta})")
-            .expect("valid template"),
-    );
-    let study = paper::run_study(&robots, &settings, &|| bar.inc(1));
+    let study = paper::run_study(&robots, &settings, &mut Progress::new(a.quiet));
     for r in &study.failed {
         println!(
             "{}: no result: {}",
@@ -65,7 +56,6 @@ pub fn run_study(a: &Args) -> anyhow::Result<()> {
             r.error.as_deref().unwrap_or("")
         );
     }
-    bar.finish_and_clear();
     let record = &study.record;
     let rows = &record.rows;
     let secs = record.seconds;
@@ -141,10 +131,13 @@ fn run_puma(a: &Args) -> anyhow::Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out/study-puma"));
-    let record = puma_record::run_record(&puma::PumaSettings {
-        seed: a.seed,
-        ..Default::default()
-    })?;
+    let record = puma_record::run_record(
+        &puma::PumaSettings {
+            seed: a.seed,
+            ..Default::default()
+        },
+        &mut Progress::new(a.quiet),
+    )?;
     let s = &record.result;
     let secs = record.seconds;
     println!(

@@ -10,7 +10,7 @@ mod raw;
 
 pub use crate::measure::NoiseModel;
 use crate::model::complete::{self, FormChange, Formed, LinkForm};
-use crate::model::identifiability::{self, IdentifiabilityOptions, Measurement};
+use crate::model::identifiability::{self, IdentifiabilitySettings, Measurement};
 use crate::model::rank_deficit::{rank_deficit, RankDeficit};
 use crate::model::{LinkGeometry, LinkSpec, Model, ModelSpec, Status};
 use crate::robots::{self, Capsule, Robot};
@@ -178,7 +178,7 @@ impl Cell {
     /// measurement type unless `opts` says otherwise.
     pub fn identifiability(
         &self,
-        opts: &IdentifiabilityOptions,
+        opts: &IdentifiabilitySettings,
     ) -> Result<identifiability::Identifiability, Error> {
         let declared = self.declared_model();
         identifiability::analyze(&declared, &declared.nominal(), opts)
@@ -215,8 +215,8 @@ impl Cell {
     }
 
     /// Default analysis options for this cell (its measurement type).
-    pub fn identifiability_options(&self) -> IdentifiabilityOptions {
-        IdentifiabilityOptions {
+    pub fn identifiability_settings(&self) -> IdentifiabilitySettings {
+        IdentifiabilitySettings {
             measurement: self.measurement,
             ..Default::default()
         }

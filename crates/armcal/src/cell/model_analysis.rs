@@ -14,7 +14,7 @@
 
 use super::Cell;
 use crate::model::complete::{in_form, FormChange, LinkForm};
-use crate::model::identifiability::{self, Identifiability, IdentifiabilityOptions};
+use crate::model::identifiability::{self, Identifiability, IdentifiabilitySettings};
 use crate::model::rank_deficit::{rank_deficit, RankDeficit};
 use crate::model::{Joint, Model, Segment, Status};
 use crate::Error;
@@ -64,7 +64,7 @@ pub fn converted(cell: &Cell, form: LinkForm) -> Result<Model, Error> {
 /// analysis options `opts`.
 pub fn analyze_model(
     cell: &Cell,
-    opts: &IdentifiabilityOptions,
+    opts: &IdentifiabilitySettings,
     convention: Option<LinkForm>,
 ) -> Result<ModelAnalysis, Error> {
     let (model, identifiability, rank_deficit) = match convention {

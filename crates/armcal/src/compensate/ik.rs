@@ -29,6 +29,7 @@
 use crate::compensate::closed_form::{NoClosedForm, SphericalWristIk};
 use crate::model::pose::rotation_log;
 use crate::model::{forward_kinematics, Data, JointKind, Model, Pose};
+use crate::solve::Status;
 use nalgebra::{Cholesky, SMatrix, SVector, Vector3, Vector6};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -40,10 +41,13 @@ pub enum IkTarget {
     Pose(Pose<f64>),
 }
 
-/// How an IK solve ended.
+/// How an IK solve ended: the domain status of inverse kinematics, which tells a singular
+/// configuration, a joint limit and an unreachable target apart (the compensated program's
+/// status column), and maps onto the shared solver vocabulary with [`IkStatus::status`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum IkStatus {
+    /// Within the position and orientation tolerances.
     Converged,
     /// Stopped near a singular configuration (σ_min < ε) above the tolerance.
     Singular,
@@ -53,7 +57,9 @@ pub enum IkStatus {
     /// the tool ([`CalibratedIk::solve`]), or the residual stopped decreasing away from a
     /// singularity.
     Unreachable,
-    MaxIterations,
+    /// The iteration limit was reached first.
+    #[serde(rename = "max-iterations")]
+    IterationLimit,
 }
 
 impl IkStatus {
@@ -64,7 +70,27 @@ impl IkStatus {
             IkStatus::Singular => "singular",
             IkStatus::JointLimits => "joint-limits",
             IkStatus::Unreachable => "unreachable",
-            IkStatus::MaxIterations => "max-iterations",
+            IkStatus::IterationLimit => "max-iterations",
+        }
+    }
+
+    /// The status in the shared solver vocabulary: a singular stop is a stall, joint limits
+    /// and an unreachable target make the problem infeasible.
+    pub fn status(self) -> Status {
+        match self {
+            IkStatus::Converged => Status::Converged {
+                criterion: "position and orientation within tolerance".into(),
+            },
+            IkStatus::Singular => Status::Stalled {
+                reason: "near a singular configuration (σ_min < ε) above the tolerance".into(),
+            },
+            IkStatus::JointLimits => Status::Infeasible {
+                reason: "the target needs joint values beyond the limits".into(),
+            },
+            IkStatus::Unreachable => Status::Infeasible {
+                reason: "the target is out of reach".into(),
+            },
+            IkStatus::IterationLimit => Status::IterationLimit,
         }
     }
 }
@@ -587,7 +613,7 @@ fn solve_with_diagnosis(
     } else if run.stalled {
         IkStatus::Unreachable
     } else {
-        IkStatus::MaxIterations
+        IkStatus::IterationLimit
     };
     result(ws, &run, status, None)
 }

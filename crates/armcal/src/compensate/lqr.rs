@@ -26,7 +26,7 @@ use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, SMatrix};
 
 /// Result of [`optimal_compensation`].
 #[derive(Clone, Debug)]
-pub struct LqrSolution {
+pub struct LqrResult {
     /// The optimal controls `u_1*, …, u_N*` (the joint corrections, book eq. 5.119).
     pub controls: DVector<f64>,
     /// The feedback gains: row k is `k_kᵀ` (book eq. 5.85), so that `u_k* = k_kᵀ x_k`
@@ -57,7 +57,7 @@ pub fn optimal_compensation(
     q: &DMatrix<f64>,
     gammas: &[f64],
     x_c: &DVector<f64>,
-) -> Result<LqrSolution> {
+) -> Result<LqrResult> {
     let (n, stages) = b.shape();
     if q.shape() != (n, n) {
         return Err(Error::Input(format!(
@@ -135,7 +135,7 @@ pub fn optimal_compensation(
     }
     pb.gemv(1.0, &p, x_c, 0.0);
     let cost = x_c.dot(&pb);
-    Ok(LqrSolution {
+    Ok(LqrResult {
         controls,
         gains,
         p_final: p,

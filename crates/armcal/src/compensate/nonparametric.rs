@@ -182,7 +182,7 @@ impl PolynomialCorrection {
         let tol = 1e-12 * svd.singular_values.max();
         fit.coefficients = svd
             .solve(&e, tol)
-            .map_err(|msg| Error::Input(format!("polynomial correction: {msg}")))?;
+            .map_err(|msg| Error::Numerical(format!("polynomial correction: {msg}")))?;
         let (mut ss, mut ss0) = (0.0, 0.0);
         for (x, err) in inputs.iter().zip(errors) {
             ss += (err - fit.predict(x)).norm_squared();

@@ -102,7 +102,7 @@ pub fn evaluate(
     let n = r.nrows();
     let nf = n as f64;
     let singular = || {
-        Error::Input("the design's information matrix is singular: it does not identify every free parameter".into())
+        Error::Numerical("the design's information matrix is singular: it does not identify every free parameter".into())
     };
     let rmax = r.diagonal().iter().fold(0.0f64, |a, x| a.max(x.abs()));
     if r.diagonal().iter().any(|x| x.abs() <= 1e-13 * rmax) {

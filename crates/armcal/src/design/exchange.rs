@@ -12,6 +12,8 @@ use crate::design::criteria::{evaluate, kpi_matrix, Criterion};
 use crate::design::information::{DesignModel, InformationWorkspace};
 use crate::design::objective::triangular_factor;
 use crate::design::small_cholesky;
+use crate::progress::Observer;
+use crate::solve::Status;
 use crate::Error;
 use nalgebra::DMatrix;
 use rand::seq::SliceRandom;
@@ -46,6 +48,9 @@ impl Default for ExchangeSettings {
 pub struct ExchangeResult {
     pub chosen: Vec<usize>,
     pub value: f64,
+    /// Converged when a sweep improved the criterion by less than the tolerance, else
+    /// the sweep limit ([`Status::IterationLimit`]).
+    pub status: Status,
     pub sweeps: usize,
     pub exchanges: usize,
     pub history: Vec<f64>,
@@ -91,6 +96,7 @@ pub fn exchange(
     prior: &DMatrix<f64>,
     n_points: usize,
     settings: &ExchangeSettings,
+    observer: &mut dyn Observer,
 ) -> Result<ExchangeResult, Error> {
     let t0 = Instant::now();
     if pool.len() < n_points {
@@ -137,6 +143,8 @@ pub fn exchange(
     let mut t_buf = vec![0.0; rows];
     let mut in_design = vec![false; pool.len()];
     let mut scores: Vec<(f64, usize)> = Vec::with_capacity(pool.len());
+    observer.start("exchange", Some(settings.max_sweeps));
+    let mut status = Status::IterationLimit;
     while sweeps < settings.max_sweeps {
         sweeps += 1;
         let start_value = value;
@@ -235,13 +243,22 @@ pub fn exchange(
             }
         }
         history.push(value);
+        observer.iteration(sweeps, value, 0.0);
         if start_value - value <= settings.tolerance * value.abs() {
+            status = Status::Converged {
+                criterion: format!(
+                    "a sweep improved the criterion by less than {:e}",
+                    settings.tolerance
+                ),
+            };
             break;
         }
     }
+    observer.finish();
     Ok(ExchangeResult {
         chosen,
         value,
+        status,
         sweeps,
         exchanges,
         history,

@@ -17,7 +17,7 @@ pub mod refine;
 pub mod small_cholesky;
 
 pub use cell_constraints::{
-    ConstraintKind, ConstraintOptions, ConstraintSet, ConstraintWorkspace, Margin,
+    ConstraintKind, ConstraintSet, ConstraintSettings, ConstraintWorkspace, Margin,
 };
 pub use criteria::{Criterion, CriterionValue};
 pub use information::{DesignModel, InformationWorkspace};

@@ -5,13 +5,14 @@
 use crate::cell::Cell;
 use crate::design::baselines::random_feasible;
 use crate::design::bound::{has_bound, optimality_bound, OptimalityBound};
-use crate::design::cell_constraints::{ConstraintOptions, ConstraintSet, ConstraintWorkspace};
+use crate::design::cell_constraints::{ConstraintSet, ConstraintSettings, ConstraintWorkspace};
 use crate::design::exchange::{exchange, ExchangeSettings};
 use crate::design::information::DesignModel;
 use crate::design::objective::DesignObjective;
 use crate::design::order::order_for_travel;
 use crate::design::refine::{refine, ConfigurationConstraints, RefineSettings};
 use crate::design::Criterion;
+use crate::progress::{Observer, Shared};
 use crate::Error;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -71,7 +72,7 @@ pub struct DesignMargin {
 
 /// What a planner run produced.
 #[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct PlanReport {
+pub struct PlanResult {
     pub criterion: Criterion,
     pub value: f64,
     /// The design, ordered for travel (internal units).
@@ -100,7 +101,7 @@ fn infeasible_report(
     set: &ConstraintSet,
     settings: &PlanSettings,
     t0: Instant,
-) -> PlanReport {
+) -> PlanResult {
     let draws = 20_000;
     let qs = crate::model::random_configurations(&d.model, draws, settings.seed);
     let mut ws = set.workspace();
@@ -138,7 +139,7 @@ fn infeasible_report(
         .unwrap_or(f64::NAN);
     let params = d.params.clone();
     let cons = CellConstraints::new(set, &params);
-    PlanReport {
+    PlanResult {
         criterion: settings.criterion,
         value,
         min_margin: cons.design_margin(&design),
@@ -300,7 +301,7 @@ fn constant_constraints(
 pub fn constraint_set(cell: &Cell, collisions: bool) -> Result<ConstraintSet, Error> {
     ConstraintSet::new(
         cell,
-        &ConstraintOptions {
+        &ConstraintSettings {
             incidence: cell
                 .instrument
                 .as_ref()
@@ -308,17 +309,19 @@ pub fn constraint_set(cell: &Cell, collisions: bool) -> Result<ConstraintSet, Er
                 .is_some(),
             collisions,
             line_of_sight: collisions,
-            ..ConstraintOptions::default()
+            ..ConstraintSettings::default()
         },
     )
 }
 
-/// Plans `settings.poses` measurement configurations for `cell`, augmenting `measured`.
+/// Plans `settings.poses` measurement configurations for `cell`, augmenting `measured`;
+/// `observer` follows the starts, their exchange and their refinement.
 pub fn plan(
     cell: &Cell,
     settings: &PlanSettings,
     measured: &[Vec<f64>],
-) -> Result<PlanReport, Error> {
+    observer: &mut dyn Observer,
+) -> Result<PlanResult, Error> {
     let t0 = Instant::now();
     let d = DesignModel::from_cell(cell)?;
     let set = constraint_set(cell, settings.collisions)?;
@@ -343,7 +346,7 @@ pub fn plan(
         exchange_value,
         sweeps,
         refine: refine_info,
-    } = design_from_pool(&d, &set, &pool, settings, measured)?;
+    } = design_from_pool(&d, &set, &pool, settings, measured, observer)?;
     let order = order_for_travel(&design);
     let design: Vec<Vec<f64>> = order.iter().map(|&i| design[i].clone()).collect();
     let cons = CellConstraints::new(&set, &params);
@@ -356,7 +359,7 @@ pub fn plan(
     } else {
         None
     };
-    Ok(PlanReport {
+    Ok(PlanResult {
         criterion: settings.criterion,
         value,
         design,
@@ -377,19 +380,26 @@ pub fn plan(
 /// Runs `settings.starts` exchange + refinement starts (in parallel) from the feasible
 /// candidate `pool` and returns the best design; a refined design that violates a
 /// constraint is replaced by its exchange design. The planner's core, shared with the
-/// paper's study (which reuses one pool for several criteria).
+/// paper's study (which reuses one pool for several criteria). `observer` receives the task
+/// `planning starts` with a step per finished start, and (interleaved, from the parallel
+/// starts) each start's exchange and refinement.
 pub fn design_from_pool(
     d: &DesignModel,
     set: &ConstraintSet,
     pool: &[Vec<f64>],
     settings: &PlanSettings,
     measured: &[Vec<f64>],
+    observer: &mut dyn Observer,
 ) -> Result<PoolDesign, Error> {
     let prior_rows = DesignObjective::new(d, settings.criterion, measured).prior_rows;
     let (lo, hi) = d.model.joint_limits();
-    let runs: Vec<Result<PoolDesign, Error>> = (0..settings.starts.max(1))
+    let starts = settings.starts.max(1);
+    observer.start("planning starts", Some(starts));
+    let shared = Shared::new(observer);
+    let runs: Vec<Result<PoolDesign, Error>> = (0..starts)
         .into_par_iter()
         .map(|s| {
+            let mut observer = &shared;
             let ex = exchange(
                 d,
                 settings.criterion,
@@ -407,9 +417,11 @@ pub fn design_from_pool(
                     },
                     ..ExchangeSettings::default()
                 },
+                &mut observer,
             )?;
             let start: Vec<Vec<f64>> = ex.chosen.iter().map(|&i| pool[i].clone()).collect();
             if settings.exchange_only {
+                observer.step();
                 return Ok(PoolDesign {
                     design: start,
                     value: ex.value,
@@ -427,16 +439,18 @@ pub fn design_from_pool(
                 &hi,
                 (!set.is_empty()).then_some(&cons as &dyn ConfigurationConstraints),
                 &settings.refine,
+                &mut observer,
             )?;
+            observer.step();
             // Only a design that violates nothing counts; otherwise keep the exchange design.
             let ok = r.q.iter().all(|q| cons.feasible(q));
             if ok && r.value <= ex.value {
                 Ok(PoolDesign {
+                    refine: Some((r.describe(), r.iterations)),
                     design: r.q,
                     value: r.value,
                     exchange_value: ex.value,
                     sweeps: ex.sweeps,
-                    refine: Some((r.status, r.iterations)),
                 })
             } else {
                 Ok(PoolDesign {
@@ -447,7 +461,7 @@ pub fn design_from_pool(
                     refine: Some((
                         format!(
                             "{} (refined design rejected: {})",
-                            r.status,
+                            r.describe(),
                             if ok { "no better" } else { "infeasible" }
                         ),
                         r.iterations,
@@ -456,6 +470,7 @@ pub fn design_from_pool(
             }
         })
         .collect();
+    observer.finish();
     let mut best: Option<PoolDesign> = None;
     for r in runs {
         let r = r?;

@@ -5,9 +5,10 @@
 
 use crate::cell::Cell;
 use crate::design::assess::{assess, DesignAssessment};
-use crate::design::plan::{constraint_set, plan, PlanReport, PlanSettings};
+use crate::design::plan::{constraint_set, plan, PlanResult, PlanSettings};
 use crate::design::ConstraintKind;
 use crate::model::Model;
+use crate::progress::Observer;
 use crate::Error;
 use serde::{Deserialize, Serialize};
 
@@ -61,7 +62,7 @@ pub struct DesignRecord {
     pub poses: Vec<Vec<f64>>,
     /// The planner's report (its `design` in internal units: rad, mm); absent for a design
     /// not planned by armcal.
-    pub plan: Option<PlanReport>,
+    pub plan: Option<PlanResult>,
     /// The predicted precision ([`assess`]).
     pub assessment: DesignAssessment,
     /// The smallest margin of every kind of constraint ([`kind_margins`]).
@@ -180,7 +181,7 @@ impl DesignRecord {
         cell_source: Option<&str>,
         method: &str,
         design: &[Vec<f64>],
-        plan: Option<PlanReport>,
+        plan: Option<PlanResult>,
         collisions: bool,
     ) -> Result<DesignRecord, Error> {
         let units = joint_units(&cell.model);
@@ -219,8 +220,9 @@ impl DesignRecord {
         method: &str,
         settings: &PlanSettings,
         measured: &[Vec<f64>],
+        observer: &mut dyn Observer,
     ) -> Result<DesignRecord, Error> {
-        let report = plan(cell, settings, measured)?;
+        let report = plan(cell, settings, measured, observer)?;
         let design = report.design.clone();
         DesignRecord::new(
             cell,

@@ -17,9 +17,14 @@
 //! projected-gradient steps with an Armijo test on φ use the remaining iterations
 //! (`projected_gradient`). The objective is divided by its value at the start so the
 //! tolerances are relative.
+//!
+//! The file is over 600 lines because the projection (`FeasibleSet`, with its anchors and
+//! bounds) and the two descents that use it are one algorithm sharing private buffers.
 
 use crate::design::objective::DesignObjective;
 use crate::design::small_cholesky;
+use crate::progress::Observer;
+use crate::solve::Status;
 use crate::Error;
 use optimization_engine::{
     constraints::Constraint, core::ExitStatus, panoc::*, FunctionCallResult, Problem, SolverError,
@@ -83,12 +88,35 @@ pub struct RefineResult {
     pub q: Vec<Vec<f64>>,
     pub value: f64,
     pub start_value: f64,
-    pub converged: bool,
-    pub status: String,
+    /// How the PANOC rounds ended: a convergence criterion, the iteration or time limit, or
+    /// a stall (no further descent), after which projected-gradient steps continue.
+    pub status: Status,
+    /// The projected-gradient steps after a stall (`None`: they did not run, no stall or
+    /// no iterations left).
+    pub projected_gradient_steps: Option<usize>,
     pub iterations: usize,
     /// φ at the start and after each round.
     pub history: Vec<f64>,
     pub time: Duration,
+}
+
+impl RefineResult {
+    /// The status in the design record's words: `converged`, `converged (a round of …)`,
+    /// `iteration limit`, `time limit`; a stall reads `converged (no further descent)` (the
+    /// best design so far is kept, and no step lowers φ) and is followed by
+    /// `; then N projected-gradient steps` when those ran.
+    pub fn describe(&self) -> String {
+        let status = match &self.status {
+            Status::IterationLimit => "iteration limit".to_string(),
+            Status::TimeLimit => "time limit".to_string(),
+            Status::Stalled { reason } => format!("converged ({reason})"),
+            other => other.to_string(),
+        };
+        match self.projected_gradient_steps {
+            Some(n) => format!("{status}; then {n} projected-gradient steps"),
+            None => status,
+        }
+    }
 }
 
 /// Corrections per configuration and projection.
@@ -397,6 +425,7 @@ pub fn refine(
     upper: &[f64],
     constraints: Option<&dyn ConfigurationConstraints>,
     settings: &RefineSettings,
+    observer: &mut dyn Observer,
 ) -> Result<RefineResult, Error> {
     let t0 = Instant::now();
     let k = lower.len();
@@ -426,7 +455,7 @@ pub fn refine(
     };
     let mut u: Vec<f64> = start.concat();
     set.project(&mut u)
-        .map_err(|e| Error::Input(format!("pose refinement failed: {e:?}")))?;
+        .map_err(|e| Error::Numerical(format!("pose refinement failed: {e:?}")))?;
     set.estimate_lipschitz(&u);
     let ws = RefCell::new(objective.workspace(nconf));
     let start_value = objective.value_and_gradient(&mut ws.borrow_mut(), &start.concat(), None)?;
@@ -456,14 +485,15 @@ pub fn refine(
     // end worse than it started: then the round restarts from the best design with a third
     // of its length, down to MIN_ROUND iterations.
     let mut round_length = settings.check_every.max(1);
-    let (converged, status) = loop {
+    observer.start("pose refinement", Some(settings.max_iterations));
+    let status = loop {
         let remaining = settings.max_duration.saturating_sub(t0.elapsed());
         let round = round_length.min(settings.max_iterations - iterations);
         if round == 0 {
-            break (false, "iteration limit".to_string());
+            break Status::IterationLimit;
         }
         if remaining.is_zero() {
-            break (false, "time limit".to_string());
+            break Status::TimeLimit;
         }
         cache.reset();
         let problem = Problem::new(&set, grad, cost);
@@ -472,41 +502,46 @@ pub fn refine(
             .with_max_duration(remaining);
         let s = panoc
             .solve(&mut u)
-            .map_err(|e| Error::Input(format!("pose refinement failed: {e}")))?;
+            .map_err(|e| Error::Numerical(format!("pose refinement failed: {e}")))?;
         iterations += s.iterations();
         let previous = value;
         value = objective.value_and_gradient(&mut ws.borrow_mut(), &u, None)?;
         history.push(value);
+        observer.iteration(iterations, value, 0.0);
         if value > previous {
             u.copy_from_slice(&best_u);
             value = previous;
             if round_length <= MIN_ROUND {
-                break (true, "converged (no further descent)".to_string());
+                break Status::Stalled {
+                    reason: "no further descent".into(),
+                };
             }
             round_length = (round_length / 3).max(MIN_ROUND);
             continue;
         }
         best_u.copy_from_slice(&u);
         if s.exit_status() == ExitStatus::Converged {
-            break (true, "converged".to_string());
+            // PANOC's own fixed-point tolerance: nothing more to say.
+            break Status::Converged {
+                criterion: String::new(),
+            };
         }
         let expected =
             settings.min_relative_improvement * round as f64 / settings.check_every.max(1) as f64;
         if previous - value < expected * previous.abs() {
-            break (
-                true,
-                format!(
-                    "converged (a round of {round} iterations improved by less than {:e})",
+            break Status::Converged {
+                criterion: format!(
+                    "a round of {round} iterations improved by less than {:e}",
                     expected
                 ),
-            );
+            };
         }
     };
     // Where PANOC stalls (its line search on the envelope fails when many configurations sit
     // on curved constraint boundaries), projected gradient steps with an Armijo test on φ
     // itself continue monotonically, within the remaining iteration budget.
-    let stalled = status.ends_with("(no further descent)");
-    let (converged, status) = if stalled && iterations < settings.max_iterations {
+    let stalled = matches!(status, Status::Stalled { .. });
+    let projected_gradient_steps = if stalled && iterations < settings.max_iterations {
         let budget = settings.max_iterations - iterations;
         let (v, n) = projected_gradient(
             objective,
@@ -521,15 +556,17 @@ pub fn refine(
         value = v;
         history.push(value);
         best_u.copy_from_slice(&u);
-        (true, format!("{status}; then {n} projected-gradient steps"))
+        observer.iteration(iterations, value, 0.0);
+        Some(n)
     } else {
-        (converged, status)
+        None
     };
+    observer.finish();
     // The skipped evaluations rest on estimated bounds: project the result once more with
     // every constraint evaluated.
     set.reset();
     set.project(&mut u)
-        .map_err(|e| Error::Input(format!("pose refinement failed: {e:?}")))?;
+        .map_err(|e| Error::Numerical(format!("pose refinement failed: {e:?}")))?;
     if u != best_u {
         value = objective.value_and_gradient(&mut ws.borrow_mut(), &u, None)?;
     }
@@ -537,8 +574,8 @@ pub fn refine(
         q: u.chunks(k).map(<[f64]>::to_vec).collect(),
         value,
         start_value,
-        converged,
         status,
+        projected_gradient_steps,
         iterations,
         history,
         time: t0.elapsed(),
@@ -575,7 +612,7 @@ fn projected_gradient(
             *t = x - alpha * gi;
         }
         set.project(&mut trial)
-            .map_err(|e| Error::Input(format!("pose refinement failed: {e:?}")))?;
+            .map_err(|e| Error::Numerical(format!("pose refinement failed: {e:?}")))?;
         let decrease: f64 = g
             .iter()
             .zip(u.iter())

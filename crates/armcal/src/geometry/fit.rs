@@ -314,7 +314,7 @@ pub fn fit_circle(points: &[Vector3<f64>]) -> Result<Circle, Error> {
     let sol = a
         .svd(true, true)
         .solve(&b, 1e-14)
-        .map_err(|e| Error::Input(format!("circle fit: {e}")))?;
+        .map_err(|e| Error::Numerical(format!("circle fit: {e}")))?;
     let (cx, cy) = (-sol[0] / 2.0, -sol[1] / 2.0);
     let r2 = cx * cx + cy * cy - sol[2];
     if !(r2 > 0.0 && r2.is_finite()) {

@@ -13,8 +13,9 @@
 
 use super::problem::Problem;
 use super::solver::{
-    gradient_cosine, no_decrease_status, Iterate, Observer, Solution, Status, Tolerances,
+    gradient_cosine, no_decrease_status, Iterate, SolverResult, Status, ToleranceSettings,
 };
+use crate::progress::Observer;
 use crate::Error;
 use nalgebra::DVector;
 use std::time::Instant;
@@ -27,15 +28,16 @@ const HALVINGS: usize = 40;
 pub fn gauss_newton(
     problem: &Problem,
     start: &[f64],
-    tol: &Tolerances,
+    tol: &ToleranceSettings,
     observer: &mut dyn Observer,
-) -> Result<Solution, Error> {
+) -> Result<SolverResult, Error> {
     let t0 = Instant::now();
     let (m, n) = (problem.rows(), problem.columns());
     let mut it = Iterate::start(problem, start)?;
+    observer.start("Gauss–Newton", Some(tol.max_iterations));
     let mut cost = it.cost();
     let mut history = vec![cost];
-    let mut status = Status::MaxIterations;
+    let mut status = Status::IterationLimit;
     let mut iterations = 0;
     let mut trial_params = it.params.clone();
     let mut r_trial = DVector::zeros(m);
@@ -63,7 +65,7 @@ pub fn gauss_newton(
         let svd = js.svd(true, true);
         let step_scaled = svd
             .solve(&(-&it.r), 1e-12)
-            .map_err(|e| Error::Input(format!("Gauss–Newton step: {e}")))?;
+            .map_err(|e| Error::Numerical(format!("Gauss–Newton step: {e}")))?;
         let step = step_scaled.component_div(&scale);
         // Directional derivative ∇Fᵀδ = (Jᵀr)ᵀδ and the decrease the linear model predicts.
         let slope = it.r.dot(&(&it.j * &step));
@@ -110,5 +112,6 @@ pub fn gauss_newton(
             break;
         }
     }
+    observer.finish();
     Ok(it.into_solution(status, iterations, history, t0))
 }

@@ -20,8 +20,9 @@
 //! changed by more than 10⁻⁷ of its posterior standard deviation.
 
 use super::problem::Problem;
-use super::solver::{Iterate, Observer, Solution, Status, Tolerances};
+use super::solver::{Iterate, SolverResult, Status, ToleranceSettings};
 use crate::model::Unit;
+use crate::progress::Observer;
 use crate::Error;
 use nalgebra::{DMatrix, DVector};
 use std::time::Instant;
@@ -29,7 +30,7 @@ use std::time::Instant;
 /// Settings of [`kalman_filter`].
 #[derive(Clone, Debug)]
 pub struct KalmanSettings {
-    pub tolerances: Tolerances,
+    pub tolerances: ToleranceSettings,
     /// Prior standard deviation of length parameters (mm) and of angles (rad).
     pub prior_length: f64,
     pub prior_angle: f64,
@@ -38,9 +39,9 @@ pub struct KalmanSettings {
 impl Default for KalmanSettings {
     fn default() -> Self {
         KalmanSettings {
-            tolerances: Tolerances {
+            tolerances: ToleranceSettings {
                 max_iterations: 50,
-                ..Tolerances::default()
+                ..ToleranceSettings::default()
             },
             prior_length: 1e3,
             prior_angle: 1.0,
@@ -53,8 +54,8 @@ const INFLATION: f64 = 1e4;
 /// Largest change of a parameter in a converged pass, in posterior standard deviations.
 const STEP_IN_SIGMA: f64 = 1e-7;
 
-pub struct KalmanSolution {
-    pub solution: Solution,
+pub struct KalmanResult {
+    pub solution: SolverResult,
     /// Covariance of the free parameters after the last pass.
     pub covariance: DMatrix<f64>,
 }
@@ -64,7 +65,7 @@ pub fn kalman_filter(
     start: &[f64],
     settings: &KalmanSettings,
     observer: &mut dyn Observer,
-) -> Result<KalmanSolution, Error> {
+) -> Result<KalmanResult, Error> {
     let t0 = Instant::now();
     let (m, n) = (problem.rows(), problem.columns());
     let mut it = Iterate::start(problem, start)?;
@@ -88,7 +89,8 @@ pub fn kalman_filter(
         .collect();
     blocks.extend((problem.data_rows()..m).map(|row| (row, 1)));
     let tol = &settings.tolerances;
-    let mut status = Status::MaxIterations;
+    observer.start("Kalman filter", Some(tol.max_iterations));
+    let mut status = Status::IterationLimit;
     let mut iterations = 0;
     let mut prior = p0;
     let mut p = prior.clone();
@@ -105,9 +107,9 @@ pub fn kalman_filter(
             let innovation = -(it.r.rows(row, k) + ji * &delta);
             let pjt = &p * ji.transpose();
             let s = ji * &pjt + DMatrix::identity(k, k);
-            let s_inv = s
-                .try_inverse()
-                .ok_or_else(|| Error::Input("Kalman innovation covariance is singular".into()))?;
+            let s_inv = s.try_inverse().ok_or_else(|| {
+                Error::Numerical("Kalman innovation covariance is singular".into())
+            })?;
             let gain = &pjt * s_inv;
             delta += &gain * innovation;
             let a = &identity_n - &gain * ji;
@@ -148,7 +150,8 @@ pub fn kalman_filter(
             break;
         }
     }
-    Ok(KalmanSolution {
+    observer.finish();
+    Ok(KalmanResult {
         solution: it.into_solution(status, iterations, history, t0),
         covariance: p,
     })

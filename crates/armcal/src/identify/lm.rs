@@ -8,8 +8,9 @@
 
 use super::problem::Problem;
 use super::solver::{
-    gradient_cosine, no_decrease_status, Iterate, Observer, Solution, Status, Tolerances,
+    gradient_cosine, no_decrease_status, Iterate, SolverResult, Status, ToleranceSettings,
 };
+use crate::progress::Observer;
 use crate::Error;
 use nalgebra::DVector;
 use std::time::Instant;
@@ -17,7 +18,7 @@ use std::time::Instant;
 /// Settings of [`levenberg_marquardt`].
 #[derive(Clone, Debug)]
 pub struct LmSettings {
-    pub tolerances: Tolerances,
+    pub tolerances: ToleranceSettings,
     /// Initial damping relative to the scaling (Marquardt's λ₀).
     pub mu0: f64,
     /// Damping increase / decrease factor.
@@ -27,7 +28,7 @@ pub struct LmSettings {
 impl Default for LmSettings {
     fn default() -> Self {
         LmSettings {
-            tolerances: Tolerances::default(),
+            tolerances: ToleranceSettings::default(),
             mu0: 0.01,
             factor: 10.0,
         }
@@ -41,17 +42,21 @@ pub fn levenberg_marquardt(
     start: &[f64],
     settings: &LmSettings,
     observer: &mut dyn Observer,
-) -> Result<Solution, Error> {
+) -> Result<SolverResult, Error> {
     let t0 = Instant::now();
     let (m, n) = (problem.rows(), problem.columns());
     let mut it = Iterate::start(problem, start)?;
+    observer.start(
+        "Levenberg–Marquardt",
+        Some(settings.tolerances.max_iterations),
+    );
     let mut cost = it.cost();
     let mut history = vec![cost];
     let mut mu = settings.mu0;
     let mut trial_params = it.params.clone();
     let mut r_trial = DVector::zeros(m);
     let tol = &settings.tolerances;
-    let mut status = Status::MaxIterations;
+    let mut status = Status::IterationLimit;
     let mut iterations = 0;
     while iterations < tol.max_iterations {
         iterations += 1;
@@ -135,5 +140,6 @@ pub fn levenberg_marquardt(
             break;
         }
     }
+    observer.finish();
     Ok(it.into_solution(status, iterations, history, t0))
 }

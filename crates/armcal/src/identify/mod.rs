@@ -20,16 +20,17 @@ pub use kalman::{kalman_filter, KalmanSettings};
 pub use lm::{levenberg_marquardt, LmSettings};
 pub use problem::Problem;
 pub use robust::{robust_fit, Loss, Outlier};
-pub use solver::{Observer, Silent, Solution, Status, Tolerances};
+pub use solver::{SolverResult, Status, ToleranceSettings};
 pub use uncertainty::{Chi2Outcome, Observability, ParameterUncertainty, TcpCovariance};
 pub use verdicts::{Chi2Verdict, IdentifiabilityVerdict, Verdicts};
 
 use crate::accuracy::ErrorStats;
 use crate::cell::Cell;
 use crate::measure::{Dataset, MeasurementKind};
-use crate::model::identifiability::{Identifiability, IdentifiabilityOptions, Measurement};
+use crate::model::identifiability::{Identifiability, IdentifiabilitySettings, Measurement};
 use crate::model::rank_deficit::RankDeficit;
 use crate::model::{Model, ModelSpec, Segment, Status as ParamStatus};
+use crate::progress::{Observer, Silent};
 use crate::Error;
 use nalgebra::{DVector, Matrix3};
 use rand::seq::SliceRandom;
@@ -59,7 +60,7 @@ impl Method {
 
 /// Settings of [`identify`].
 #[derive(Clone, Debug)]
-pub struct IdentifyOptions {
+pub struct IdentifySettings {
     pub method: Method,
     pub robust: Option<Loss>,
     /// Fraction of configurations held out for validation, in [0, 1) (0: none).
@@ -71,9 +72,9 @@ pub struct IdentifyOptions {
     pub lm: LmSettings,
 }
 
-impl Default for IdentifyOptions {
+impl Default for IdentifySettings {
     fn default() -> Self {
-        IdentifyOptions {
+        IdentifySettings {
             method: Method::Lm,
             robust: None,
             holdout: 0.0,
@@ -203,6 +204,21 @@ pub struct Estimate {
     pub fingerprint: Option<ModelFingerprint>,
 }
 
+/// Whether the caller accepts an estimate whose fit did not converge (or that records no
+/// verdicts), and how its user would say so, in the caller's own words (the CLI: its
+/// flags): [`Estimate::check_usable`] names them in the refusal and in the line every
+/// output made with an accepted estimate carries.
+#[derive(Clone, Copy, Debug)]
+pub struct Acceptance<'a> {
+    /// The user accepted the estimate as it is.
+    pub accepted: bool,
+    /// How the user accepts it (the CLI passes its flag's name).
+    pub accept: &'a str,
+    /// How the user raises the identification's iteration limit (the CLI passes its flag's
+    /// name).
+    pub raise_iterations: &'a str,
+}
+
 /// Whether an estimate may be used ([`Estimate::check_usable`]).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Usability {
@@ -230,7 +246,7 @@ pub fn identifiable_model(
     if !cell.auto_free {
         return Ok((cell.model.clone(), Vec::new()));
     }
-    let generic = cell.identifiability(&cell.identifiability_options())?;
+    let generic = cell.identifiability(&cell.identifiability_settings())?;
     identifiable_model_given(cell, data, at, &generic)
 }
 
@@ -258,7 +274,7 @@ fn identifiable_model_given(
         &declared,
         at,
         &data.configurations,
-        &cell.identifiability_options(),
+        &cell.identifiability_settings(),
     )?;
     report.apply(&mut declared)?;
     let generic_excluded: std::collections::HashSet<&str> =
@@ -290,7 +306,7 @@ pub fn frames_first_start(
     model: &Model,
     data: &Dataset,
     noise: &crate::measure::NoiseModel,
-    opts: &IdentifyOptions,
+    opts: &IdentifySettings,
 ) -> Result<Vec<f64>, Error> {
     let mut frames = frames_only(model);
     if frames.registry.free().is_empty() {
@@ -301,7 +317,7 @@ pub fn frames_first_start(
         &frames,
         &frames.nominal(),
         &data.configurations,
-        &IdentifiabilityOptions {
+        &IdentifiabilitySettings {
             measurement,
             ..Default::default()
         },
@@ -311,7 +327,7 @@ pub fn frames_first_start(
     if problem.free.is_empty() {
         return Ok(model.nominal());
     }
-    let stage = IdentifyOptions {
+    let stage = IdentifySettings {
         method: Method::Lm,
         robust: opts.robust,
         lm: opts.lm.clone(),
@@ -335,9 +351,9 @@ fn data_measurement(data: &Dataset) -> Measurement {
 pub fn solve(
     problem: &mut Problem,
     start: &[f64],
-    opts: &IdentifyOptions,
+    opts: &IdentifySettings,
     observer: &mut dyn Observer,
-) -> Result<(Solution, Vec<Outlier>, Option<f64>), Error> {
+) -> Result<(SolverResult, Vec<Outlier>, Option<f64>), Error> {
     problem.check_determined()?;
     if let Some(loss) = opts.robust {
         let r = robust_fit(problem, start, loss, &opts.lm, observer)?;
@@ -404,7 +420,7 @@ struct Split {
 }
 
 impl Split {
-    fn of(data: &Dataset, opts: &IdentifyOptions) -> Result<Split, Error> {
+    fn of(data: &Dataset, opts: &IdentifySettings) -> Result<Split, Error> {
         let h = opts.holdout;
         if !(0.0..1.0).contains(&h) {
             return Err(Error::Input(format!(
@@ -457,7 +473,7 @@ impl Split {
         &self,
         model: &Model,
         calibrated: &[f64],
-        opts: &IdentifyOptions,
+        opts: &IdentifySettings,
         noise: &crate::measure::NoiseModel,
     ) -> Result<Option<Validation>, Error> {
         let Some((test, source)) = &self.test else {
@@ -532,7 +548,7 @@ fn residual_report(problem: &Problem, params: &[f64], file_configs: &[usize]) ->
 pub fn identify(
     cell: &Cell,
     data: &Dataset,
-    opts: &IdentifyOptions,
+    opts: &IdentifySettings,
     observer: &mut dyn Observer,
 ) -> Result<Estimate, Error> {
     let noise = cell.noise();
@@ -648,7 +664,7 @@ struct FreeSetFit {
     reasons: Vec<(String, String)>,
     /// The problem's final row weights (a robust fit's IRLS weights).
     row_weights: Vec<f64>,
-    solution: Solution,
+    solution: SolverResult,
     outliers: Vec<Outlier>,
     robust_scale: Option<f64>,
 }
@@ -662,7 +678,7 @@ fn fit_free_set(
     cell: &Cell,
     train: &Dataset,
     noise: &crate::measure::NoiseModel,
-    opts: &IdentifyOptions,
+    opts: &IdentifySettings,
     observer: &mut dyn Observer,
 ) -> Result<FreeSetFit, Error> {
     let declared = if cell.auto_free {
@@ -671,7 +687,7 @@ fn fit_free_set(
         cell.model.clone()
     };
     let generic = if cell.auto_free {
-        Some(cell.identifiability(&cell.identifiability_options())?)
+        Some(cell.identifiability(&cell.identifiability_settings())?)
     } else {
         None
     };
@@ -718,12 +734,15 @@ impl Estimate {
 
     /// Whether the estimate may be used: an estimate whose fit did not converge — or that
     /// records no verdicts (written by an older armcal) — is an error naming the status,
-    /// unless `accept_unconverged`, when [`Usability::overridden`] says what every output must
-    /// carry. The χ² and identifiability verdicts worth knowing come back as notes.
-    pub fn check_usable(&self, accept_unconverged: bool) -> Result<Usability, Error> {
-        let flag = "pass --accept-unconverged to use it anyway";
+    /// unless `acceptance.accepted`, when [`Usability::overridden`] says what every output
+    /// must carry. Both say how the user accepts it, in the caller's words
+    /// ([`Acceptance`]). The χ² and identifiability verdicts worth knowing come back as
+    /// notes.
+    pub fn check_usable(&self, acceptance: &Acceptance) -> Result<Usability, Error> {
+        let accept = acceptance.accept;
+        let flag = format!("pass {accept} to use it anyway");
         let Some(v) = &self.verdicts else {
-            if !accept_unconverged {
+            if !acceptance.accepted {
                 return Err(Error::Input(format!(
                     "the estimate (cell `{}`) was written by an older armcal: it records no solver, χ² or identifiability verdict and no model fingerprint; identify again, or {flag}",
                     self.cell
@@ -731,7 +750,7 @@ impl Estimate {
             }
             return Ok(Usability {
                 overridden: Some(format!(
-                    "armcal: estimate of cell `{}` unverified (no recorded verdicts), used with --accept-unconverged",
+                    "armcal: estimate of cell `{}` unverified (no recorded verdicts), used with {accept}",
                     self.cell
                 )),
                 notes: Vec::new(),
@@ -739,14 +758,14 @@ impl Estimate {
         };
         let mut usability = Usability::default();
         if !v.solver.is_converged() {
-            if !accept_unconverged {
+            if !acceptance.accepted {
                 return Err(Error::Input(format!(
-                    "the fit of this estimate (cell `{}`) did not converge: {} after {} iterations; its parameters are not a least-squares solution. Identify again (check the nominal model, the data's units and joint columns, or raise --max-iterations), or {flag}",
-                    self.cell, v.solver, self.solver.iterations
+                    "the fit of this estimate (cell `{}`) did not converge: {} after {} iterations; its parameters are not a least-squares solution. Identify again (check the nominal model, the data's units and joint columns, or raise {}), or {flag}",
+                    self.cell, v.solver, self.solver.iterations, acceptance.raise_iterations
                 )));
             }
             usability.overridden = Some(format!(
-                "armcal: estimate of cell `{}` did not converge ({}), used with --accept-unconverged",
+                "armcal: estimate of cell `{}` did not converge ({}), used with {accept}",
                 self.cell, v.solver
             ));
         }

@@ -9,7 +9,8 @@
 
 use super::lm::{levenberg_marquardt, LmSettings};
 use super::problem::Problem;
-use super::solver::{Observer, Solution};
+use super::solver::SolverResult;
+use crate::progress::Observer;
 use crate::Error;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
@@ -64,10 +65,10 @@ pub struct Outlier {
     pub weight: f64,
 }
 
-pub struct RobustSolution {
+pub struct RobustResult {
     /// The final fit; its residual and Jacobian are those of the kept measurements with
     /// weight 1 (the rows of the outliers removed, prior rows kept).
-    pub solution: Solution,
+    pub solution: SolverResult,
     pub outliers: Vec<Outlier>,
     /// Robust scale of the whitened residuals at the end (≈ 1 if σ is right).
     pub scale: f64,
@@ -81,7 +82,7 @@ pub fn robust_fit(
     loss: Loss,
     settings: &LmSettings,
     observer: &mut dyn Observer,
-) -> Result<RobustSolution, Error> {
+) -> Result<RobustResult, Error> {
     let blocks: Vec<(usize, usize)> = problem
         .row_of
         .iter()
@@ -89,10 +90,11 @@ pub fn robust_fit(
         .map(|(&row, m)| (row, m.kind.rows()))
         .collect();
     problem.row_weights.fill(1.0);
+    observer.start("robust reweighting", None);
     let mut sol = levenberg_marquardt(problem, start, settings, observer)?;
     let mut scale = 1.0;
     let mut reweightings = 0;
-    let norms = |sol: &Solution, problem: &Problem| -> Vec<f64> {
+    let norms = |sol: &SolverResult, problem: &Problem| -> Vec<f64> {
         // Undo the weights to get the plain whitened residual of each block.
         blocks
             .iter()
@@ -153,7 +155,8 @@ pub fn robust_fit(
         }
     }
     (sol.residual, sol.jacobian) = kept_rows(problem, &sol.params, &outliers);
-    Ok(RobustSolution {
+    observer.finish();
+    Ok(RobustResult {
         solution: sol,
         outliers,
         scale,

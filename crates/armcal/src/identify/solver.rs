@@ -1,40 +1,14 @@
-//! What every identification solver reports, and the observer that receives progress.
+//! What every identification solver reports ([`SolverResult`], with the shared
+//! [`crate::solve::Status`]) and the stopping rules they share.
 
+pub use crate::solve::Status;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 use std::time::Duration;
 
-/// How a solver ended.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "status", rename_all = "kebab-case")]
-pub enum Status {
-    /// A convergence criterion was met; `criterion` says which.
-    Converged { criterion: String },
-    /// The iteration limit was reached before convergence.
-    MaxIterations,
-    /// The iteration failed (non-finite values, or no step reduces the cost).
-    Diverged { reason: String },
-}
-
-impl std::fmt::Display for Status {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Status::Converged { criterion } => write!(f, "converged ({criterion})"),
-            Status::MaxIterations => f.write_str("stopped at the iteration limit"),
-            Status::Diverged { reason } => write!(f, "diverged: {reason}"),
-        }
-    }
-}
-
-impl Status {
-    pub fn is_converged(&self) -> bool {
-        matches!(self, Status::Converged { .. })
-    }
-}
-
 /// Result of a solver run.
 #[derive(Clone, Debug)]
-pub struct Solution {
+pub struct SolverResult {
     /// Full parameter vector at the end.
     pub params: Vec<f64>,
     pub status: Status,
@@ -47,7 +21,7 @@ pub struct Solution {
     pub jacobian: DMatrix<f64>,
 }
 
-impl Solution {
+impl SolverResult {
     pub fn cost(&self) -> f64 {
         0.5 * self.residual.norm_squared()
     }
@@ -60,7 +34,7 @@ impl Solution {
         mut self,
         branch: &crate::model::branch::NearestBranch,
         free: &[usize],
-    ) -> Solution {
+    ) -> SolverResult {
         for (c, &i) in free.iter().enumerate() {
             if branch.signs[i] < 0.0 {
                 self.jacobian.column_mut(c).neg_mut();
@@ -71,20 +45,9 @@ impl Solution {
     }
 }
 
-/// Receives progress from solvers (argmin / clarabel style): no solver prints.
-pub trait Observer {
-    /// Called after every accepted or rejected step.
-    fn iteration(&mut self, _iteration: usize, _cost: f64, _damping: f64) {}
-}
-
-/// An observer that ignores everything.
-pub struct Silent;
-
-impl Observer for Silent {}
-
 /// Stopping rules shared by the iterative solvers.
 #[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct Tolerances {
+pub struct ToleranceSettings {
     pub max_iterations: usize,
     /// Relative reduction of the cost (actual and predicted) below which to stop.
     pub ftol: f64,
@@ -94,9 +57,9 @@ pub struct Tolerances {
     pub gtol: f64,
 }
 
-impl Default for Tolerances {
+impl Default for ToleranceSettings {
     fn default() -> Self {
-        Tolerances {
+        ToleranceSettings {
             max_iterations: 200,
             ftol: 1e-14,
             xtol: 1e-12,
@@ -158,7 +121,7 @@ impl Iterate {
         };
         it.update(problem);
         if !it.cost().is_finite() {
-            return Err(crate::Error::Input(
+            return Err(crate::Error::Numerical(
                 "the residual at the starting parameters is not finite".into(),
             ));
         }
@@ -181,8 +144,8 @@ impl Iterate {
         iterations: usize,
         history: Vec<f64>,
         t0: std::time::Instant,
-    ) -> Solution {
-        Solution {
+    ) -> SolverResult {
+        SolverResult {
             params: self.params,
             status,
             iterations,

@@ -100,7 +100,7 @@ pub fn parameter_uncertainty(
     let p_value = if dof == 0 {
         f64::NAN
     } else {
-        let d = ChiSquared::new(dof as f64).map_err(|e| Error::Input(e.to_string()))?;
+        let d = ChiSquared::new(dof as f64).map_err(|e| Error::Numerical(e.to_string()))?;
         1.0 - d.cdf(chi2)
     };
     let verdict = Chi2Outcome::of(dof, p_value).describe().to_string();
@@ -151,7 +151,7 @@ pub fn information_inverse(info: &DMatrix<f64>, names: &[String]) -> Result<DMat
     }
     let inv = scaled
         .cholesky()
-        .ok_or_else(|| Error::Input("the information matrix is not positive definite".into()))?
+        .ok_or_else(|| Error::Numerical("the information matrix is not positive definite".into()))?
         .inverse();
     Ok(DMatrix::from_fn(n, n, |a, b| inv[(a, b)] / (d[a] * d[b])))
 }
@@ -228,7 +228,7 @@ pub fn tcp_covariance_constrained(
     let inv = kkt
         .lu()
         .try_inverse()
-        .ok_or_else(|| Error::Input("the KKT matrix of paper eq. 19 is singular".into()))?;
+        .ok_or_else(|| Error::Numerical("the KKT matrix of paper eq. 19 is singular".into()))?;
     Ok(inv.view((np, np), (ns, ns)).into_owned())
 }
 

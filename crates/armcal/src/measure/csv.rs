@@ -136,7 +136,7 @@ type Table<'t> = (csv::Reader<&'t [u8]>, Vec<String>, Vec<usize>);
 
 /// A trimming CSV reader over `text`, its header, and the file line (1-based) of the header
 /// and of every record after it. Lines that start with `#` are comments (armcal writes one
-/// when an output was made with an estimate used under `--accept-unconverged`); they and
+/// when an output was made with an accepted unconverged estimate); they and
 /// empty lines are skipped but counted.
 fn reader<'t>(text: &'t str, file: &str) -> Result<Table<'t>, Error> {
     let lines = text
@@ -492,7 +492,7 @@ pub fn write_string(data: &Dataset, model: &Model) -> Result<String, Error> {
         }
     }
     w.write_record(&header)
-        .map_err(|e| Error::Input(e.to_string()))?;
+        .map_err(|e| Error::Output(e.to_string()))?;
     let f = |x: f64| format!("{x:.9}");
     for m in &data.measurements {
         let mut row = vec![data.config_ids[m.config].clone()];
@@ -544,10 +544,10 @@ pub fn write_string(data: &Dataset, model: &Model) -> Result<String, Error> {
             }
         }
         w.write_record(&row)
-            .map_err(|e| Error::Input(e.to_string()))?;
+            .map_err(|e| Error::Output(e.to_string()))?;
     }
-    let bytes = w.into_inner().map_err(|e| Error::Input(e.to_string()))?;
-    String::from_utf8(bytes).map_err(|e| Error::Input(e.to_string()))
+    let bytes = w.into_inner().map_err(|e| Error::Output(e.to_string()))?;
+    String::from_utf8(bytes).map_err(|e| Error::Output(e.to_string()))
 }
 
 /// The column name of a joint in the data files armcal writes: its name with the unit of

@@ -51,7 +51,7 @@ impl Measurement {
 
 /// Settings of the analysis.
 #[derive(Clone, Debug)]
-pub struct IdentifiabilityOptions {
+pub struct IdentifiabilitySettings {
     pub measurement: Measurement,
     /// Number of random configurations (uniform within the joint limits).
     pub poses: usize,
@@ -61,9 +61,9 @@ pub struct IdentifiabilityOptions {
     pub tolerance: f64,
 }
 
-impl Default for IdentifiabilityOptions {
+impl Default for IdentifiabilitySettings {
     fn default() -> Self {
-        IdentifiabilityOptions {
+        IdentifiabilitySettings {
             measurement: Measurement::Position,
             poses: 60,
             seed: 1,
@@ -259,7 +259,7 @@ pub fn stacked_jacobian(
 pub fn analyze(
     model: &Model,
     params: &[f64],
-    opts: &IdentifiabilityOptions,
+    opts: &IdentifiabilitySettings,
 ) -> Result<Identifiability, Error> {
     let qs = random_configurations(model, opts.poses.max(2), opts.seed);
     analyze_at(model, params, &qs, opts)
@@ -270,7 +270,7 @@ pub fn analyze_at(
     model: &Model,
     params: &[f64],
     qs: &[Vec<f64>],
-    opts: &IdentifiabilityOptions,
+    opts: &IdentifiabilitySettings,
 ) -> Result<Identifiability, Error> {
     for q in qs {
         model.check_joints(q)?;

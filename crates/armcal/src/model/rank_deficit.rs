@@ -15,7 +15,7 @@
 use crate::model::chain::Model;
 use crate::model::complete::{self, NEAR_PARALLEL_DEG};
 use crate::model::convert::axes_at_zero;
-use crate::model::identifiability::{self, expected_count, IdentifiabilityOptions, Measurement};
+use crate::model::identifiability::{self, expected_count, IdentifiabilitySettings, Measurement};
 use crate::model::kinematics::{forward_kinematics, Data};
 use crate::model::link::JointKind;
 use crate::model::registry::Status;
@@ -138,7 +138,7 @@ pub fn rank_deficit(
         }
     }
 
-    let opts = IdentifiabilityOptions {
+    let opts = IdentifiabilitySettings {
         measurement: m,
         ..Default::default()
     };

@@ -134,7 +134,7 @@ struct Scene {
 pub fn cell_view_section(cell: &Cell, designs: &[(&str, &[Vec<f64>])]) -> Result<String, Error> {
     let scene = scene(cell, designs)?;
     let json = serde_json::to_string(&scene)
-        .map_err(|e| Error::Input(format!("3D view: cannot serialise the scene: {e}")))?;
+        .map_err(|e| Error::Output(format!("3D view: cannot serialise the scene: {e}")))?;
     // JSON can only hold `<` inside strings, where `\u003c` means the same; this keeps a
     // `</script>` in a name from ending the element.
     let json = json.replace('<', "\\u003c");

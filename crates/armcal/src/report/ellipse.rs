@@ -61,7 +61,7 @@ pub fn confidence_scale(dof: usize, p: f64) -> Result<f64, Error> {
             "confidence level {p} with {dof} degrees of freedom: need 0 < p < 1 and dof ≥ 1"
         )));
     }
-    let chi2 = ChiSquared::new(dof as f64).map_err(|e| Error::Input(e.to_string()))?;
+    let chi2 = ChiSquared::new(dof as f64).map_err(|e| Error::Numerical(e.to_string()))?;
     Ok(chi2.inverse_cdf(p).sqrt())
 }
 

@@ -35,7 +35,7 @@ const WIDE: u32 = 1100;
 type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
 
 fn drawing_error<E: std::fmt::Display>(e: E) -> Error {
-    Error::Input(format!("drawing a figure: {e}"))
+    Error::Output(format!("drawing a figure: {e}"))
 }
 
 /// Draws into an SVG string of `size` px and strips what inline SVG does not need.

@@ -6,6 +6,7 @@
 use super::html::Page;
 use super::{cell_view_of, page, Document, Input, ReportContent};
 use crate::cell::Cell;
+use crate::identify::Acceptance;
 use crate::Error;
 use std::path::{Path, PathBuf};
 
@@ -35,19 +36,17 @@ fn cell_of(source: &str, design_file: &Path) -> Result<Cell, Error> {
 pub fn files_report(
     files: &[PathBuf],
     title: &str,
-    accept_unconverged: bool,
+    acceptance: &Acceptance,
 ) -> Result<FilesReport, Error> {
     let mut inputs: Vec<Input> = Vec::new();
     let mut notes = Vec::new();
     for f in files {
         let document = Document::from_file(f)?;
         if let Document::Estimate(e) = &document {
-            let usable = e
-                .check_usable(accept_unconverged)
-                .map_err(|e| Error::File {
-                    file: f.display().to_string(),
-                    message: e.to_string(),
-                })?;
+            let usable = e.check_usable(acceptance).map_err(|e| Error::File {
+                file: f.display().to_string(),
+                message: e.to_string(),
+            })?;
             notes.extend(usable.overridden.map(|o| format!("{}: {o}", f.display())));
         }
         let stem = f

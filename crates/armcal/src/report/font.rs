@@ -22,7 +22,7 @@ pub fn ensure_registered() -> Result<(), Error> {
     if ok {
         Ok(())
     } else {
-        Err(Error::Input(
+        Err(Error::Output(
             "the embedded figure font (DejaVu Sans) could not be read".into(),
         ))
     }

@@ -11,12 +11,19 @@ use crate::compensate::IkSettings;
 use crate::design::baselines::random_feasible;
 use crate::design::plan::{constraint_set, plan, CellConstraints, PlanSettings};
 use crate::design::{DesignModel, DesignRecord};
-use crate::identify::{identify, Estimate, IdentifyOptions, Silent};
+use crate::identify::{identify, Estimate, IdentifySettings};
 use crate::measure::csv;
 use crate::model::{forward_kinematics, observed_position, Data, Observed};
+use crate::progress::Observer;
 use crate::sim::{perturbed_truth, simulate, Perturbation};
 use crate::Error;
 use serde::{Deserialize, Serialize};
+
+/// Ends the demo's current stage and starts the next.
+fn next_stage(observer: &mut dyn Observer, label: &str) {
+    observer.finish();
+    observer.start(label, None);
+}
 
 use crate::cell::builtin::PAPER_CELL_OBSTACLES as CELL;
 
@@ -79,8 +86,9 @@ pub struct Demo {
     pub heuristic_estimate: Estimate,
 }
 
-/// Runs the demo; `progress` receives a short label before each stage.
-pub fn run_demo(seed: u64, progress: &dyn Fn(&str)) -> Result<Demo, Error> {
+/// Runs the demo; each stage is a task of `observer` (named by a short label), and the
+/// planner and identification report within it.
+pub fn run_demo(seed: u64, observer: &mut dyn Observer) -> Result<Demo, Error> {
     let cell =
         crate::cell::Cell::from_toml(CELL, "paper-cell-obstacles.toml", std::path::Path::new("."))?;
     let model = &cell.model;
@@ -89,7 +97,7 @@ pub fn run_demo(seed: u64, progress: &dyn Fn(&str)) -> Result<Demo, Error> {
     let mut files = vec![("cell.toml".to_string(), CELL.to_string())];
     let poses = 60;
 
-    progress("planning the KPI design (collision avoidance on)");
+    observer.start("planning the KPI design (collision avoidance on)", None);
     let mut plan_report = plan(
         &cell,
         &PlanSettings {
@@ -98,13 +106,14 @@ pub fn run_demo(seed: u64, progress: &dyn Fn(&str)) -> Result<Demo, Error> {
             ..PlanSettings::default()
         },
         &[],
+        observer,
     )?;
     // Wall-clock time differs between runs: the demo's files leave it out (zero).
     plan_report.time = std::time::Duration::ZERO;
     let d = DesignModel::from_cell(&cell)?;
     let set = constraint_set(&cell, true)?;
     let cons = CellConstraints::new(&set, &d.params);
-    progress("drawing the random heuristic design");
+    next_stage(observer, "drawing the random heuristic design");
     let (heuristic, _) = random_feasible(model, poses, seed.wrapping_add(1), 2_000_000, |q| {
         cons.feasible(q)
     })?;
@@ -138,7 +147,7 @@ pub fn run_demo(seed: u64, progress: &dyn Fn(&str)) -> Result<Demo, Error> {
     ] {
         files.push((
             name.into(),
-            serde_json::to_string_pretty(record).map_err(|e| Error::Input(e.to_string()))?,
+            serde_json::to_string_pretty(record).map_err(|e| Error::Output(e.to_string()))?,
         ));
     }
 
@@ -177,24 +186,27 @@ pub fn run_demo(seed: u64, progress: &dyn Fn(&str)) -> Result<Demo, Error> {
                         noise_seed: u64,
                         files: &mut Vec<(String, String)>|
      -> Result<(Campaign, Estimate), Error> {
-        progress(&format!("measuring and identifying ({name} design)"));
+        next_stage(
+            observer,
+            &format!("measuring and identifying ({name} design)"),
+        );
         let data = simulate(model, &truth, design, Some(&noise), noise_seed)?;
         files.push((format!("data-{name}.csv"), csv::write_string(&data, model)?));
         let mut est = identify(
             &cell,
             &data,
-            &IdentifyOptions {
+            &IdentifySettings {
                 seed,
                 ..Default::default()
             },
-            &mut Silent,
+            observer,
         )?;
         // Wall-clock time is the one thing that differs between runs: the demo's files
         // leave it out (0) so that the same seed gives identical files.
         est.solver.time_ms = 0.0;
         files.push((
             format!("estimate-{name}.json"),
-            serde_json::to_string_pretty(&est).map_err(|e| Error::Input(e.to_string()))?,
+            serde_json::to_string_pretty(&est).map_err(|e| Error::Output(e.to_string()))?,
         ));
         let p = est.params_for(model)?;
         let held_out_errors = errors_of(&p, &mut fk);
@@ -216,7 +228,7 @@ pub fn run_demo(seed: u64, progress: &dyn Fn(&str)) -> Result<Demo, Error> {
         &mut files,
     )?;
 
-    progress("compensating a working program");
+    next_stage(observer, "compensating a working program");
     let calibrated = kpi_est.params_for(model)?;
     let program: Vec<(String, Vec<f64>)> = [
         [0.0, -30.0, 60.0, 0.0, -60.0, 0.0],
@@ -277,9 +289,10 @@ pub fn run_demo(seed: u64, progress: &dyn Fn(&str)) -> Result<Demo, Error> {
     };
     files.push((
         "summary.json".into(),
-        serde_json::to_string_pretty(&summary).map_err(|e| Error::Input(e.to_string()))?,
+        serde_json::to_string_pretty(&summary).map_err(|e| Error::Output(e.to_string()))?,
     ));
 
+    observer.finish();
     Ok(Demo {
         summary,
         files,

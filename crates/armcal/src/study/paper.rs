@@ -12,6 +12,7 @@ use crate::design::baselines::random_feasible;
 use crate::design::plan::{constraint_set, design_from_pool, CellConstraints, PlanSettings};
 use crate::design::refine::RefineSettings;
 use crate::design::{Criterion, DesignModel, DesignObjective};
+use crate::progress::{Observer, Shared, Silent};
 use crate::Error;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -147,8 +148,12 @@ pub fn notional_robots() -> Vec<String> {
 /// Runs the three designs for one robot. One candidate pool serves both optimal designs,
 /// and its first `poses` draws are the heuristic design (the same seeded uniform feasible
 /// draws); the study reports criterion values only, so the planner's bound and travel
-/// ordering are left out.
-pub fn run_robot(robot: &str, s: &StudySettings) -> Result<StudyRow, Error> {
+/// ordering are left out. `observer` follows the two plans.
+pub fn run_robot(
+    robot: &str,
+    s: &StudySettings,
+    observer: &mut dyn Observer,
+) -> Result<StudyRow, Error> {
     let t0 = Instant::now();
     let cell = cell_for(robot, s.collisions)?;
     let d = DesignModel::from_cell(&cell)?;
@@ -180,6 +185,7 @@ pub fn run_robot(robot: &str, s: &StudySettings) -> Result<StudyRow, Error> {
             ..settings.clone()
         },
         &[],
+        observer,
     )?;
     let c = design_from_pool(
         &d,
@@ -190,6 +196,7 @@ pub fn run_robot(robot: &str, s: &StudySettings) -> Result<StudyRow, Error> {
             ..settings
         },
         &[],
+        observer,
     )?;
     let a_kpi = kpi.value_and_gradient(&mut ws, &a.design.concat(), None)?;
     let feasible = a.design.iter().chain(&c.design).all(|q| cons.feasible(q));
@@ -207,14 +214,17 @@ pub fn run_robot(robot: &str, s: &StudySettings) -> Result<StudyRow, Error> {
     })
 }
 
-/// Runs a list of robots in parallel; `progress` is called after each robot. A robot that
-/// fails (e.g. no feasible configuration) gets a row with its error instead of stopping
-/// the study.
-pub fn run(robots: &[String], s: &StudySettings, progress: &(dyn Fn() + Sync)) -> Vec<StudyRow> {
-    robots
+/// Runs a list of robots in parallel; `observer` receives the task `study robots` and a
+/// step after each robot (the robots' own plans run silently: they interleave). A robot
+/// that fails (e.g. no feasible configuration) gets a row with its error instead of
+/// stopping the study.
+pub fn run(robots: &[String], s: &StudySettings, observer: &mut dyn Observer) -> Vec<StudyRow> {
+    observer.start("study robots", Some(robots.len()));
+    let shared = Shared::new(observer);
+    let rows = robots
         .par_iter()
         .map(|r| {
-            let row = run_robot(r, s).unwrap_or_else(|e| StudyRow {
+            let row = run_robot(r, s, &mut Silent).unwrap_or_else(|e| StudyRow {
                 robot: r.clone(),
                 collisions: s.collisions,
                 heuristic: f64::NAN,
@@ -226,10 +236,12 @@ pub fn run(robots: &[String], s: &StudySettings, progress: &(dyn Fn() + Sync)) -
                 seconds: 0.0,
                 error: Some(e.to_string()),
             });
-            progress();
+            (&shared).step();
             row
         })
-        .collect()
+        .collect();
+    observer.finish();
+    rows
 }
 
 /// The result file of `armcal study paper` (`study-collisions.json` or
@@ -371,11 +383,11 @@ pub struct PaperStudy {
     pub failed: Vec<StudyRow>,
 }
 
-/// The study over `robots` ([`run`]), timed, as its record; `progress` is called after
-/// each robot.
-pub fn run_study(robots: &[String], s: &StudySettings, progress: &(dyn Fn() + Sync)) -> PaperStudy {
+/// The study over `robots` ([`run`]), timed, as its record; `observer` sees one step per
+/// robot.
+pub fn run_study(robots: &[String], s: &StudySettings, observer: &mut dyn Observer) -> PaperStudy {
     let t0 = Instant::now();
-    let (failed, rows): (Vec<StudyRow>, Vec<StudyRow>) = run(robots, s, progress)
+    let (failed, rows): (Vec<StudyRow>, Vec<StudyRow>) = run(robots, s, observer)
         .into_iter()
         .partition(|r| r.error.is_some());
     PaperStudy {

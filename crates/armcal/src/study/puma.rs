@@ -32,15 +32,16 @@
 //! **Units.** armcal works in mm and rad; the book's Chapter 6 in inches and degrees
 //! (Table 6.4 in mm and rad). The study's tables are in the book's units.
 
-use crate::identify::{solve, IdentifyOptions, Problem, Silent};
+use crate::identify::{solve, IdentifySettings, Problem};
 use crate::measure::{Dataset, MeasurementKind, NoiseModel};
 use crate::model::convert::zrp_to_dh;
-use crate::model::identifiability::{analyze_at, IdentifiabilityOptions, Measurement};
+use crate::model::identifiability::{analyze_at, IdentifiabilitySettings, Measurement};
 use crate::model::pose::rotation_log;
 use crate::model::{
     forward_kinematics, joint_jacobian, observed_pose, Convention, Data, LinkGeometry, LinkSpec,
     Model, ModelSpec, Observed, Pose, Status,
 };
+use crate::progress::Observer;
 use crate::robots::puma560::{book_dh_spec, book_zrp_spec, MM_PER_IN};
 use crate::sim::simulate;
 use crate::Error;
@@ -506,7 +507,7 @@ fn rms_pair(e: &[(f64, f64)]) -> (f64, f64) {
 /// Fixes the parameters of `m` these configurations cannot identify from pose
 /// measurements; returns them with the reasons.
 fn fix_unidentifiable(m: &mut Model, qs: &[Vec<f64>]) -> Result<Vec<(String, String)>, Error> {
-    let opts = IdentifiabilityOptions {
+    let opts = IdentifiabilitySettings {
         measurement: Measurement::Pose,
         ..Default::default()
     };
@@ -528,13 +529,14 @@ fn fit(
     data: &Dataset,
     noise: &NoiseModel,
     unidentifiable: Vec<(String, String)>,
+    observer: &mut dyn Observer,
 ) -> Result<(Vec<f64>, FitSummary, ParameterSigmas), Error> {
     let mut problem = Problem::new(m, data, noise)?;
     let (sol, _, _) = solve(
         &mut problem,
         &m.nominal(),
-        &IdentifyOptions::default(),
-        &mut Silent,
+        &IdentifySettings::default(),
+        observer,
     )?;
     let (r, t) = rms_pair(&pose_errors(m, &sol.params, data));
     let unc = problem.uncertainty_at(&sol.params)?;
@@ -576,8 +578,8 @@ fn book_p123(g: &LinkGeometry) -> ([String; 3], [f64; 3]) {
     (fields.map(String::from), v)
 }
 
-/// The PUMA study (module documentation).
-pub fn run(s: &PumaSettings) -> Result<PumaStudy, Error> {
+/// The PUMA study (module documentation); `observer` follows the two fits.
+pub fn run(s: &PumaSettings, observer: &mut dyn Observer) -> Result<PumaStudy, Error> {
     let noise = table_6_4_noise();
     let NoiseModel::Constant { sigma, sigma_angle } = noise else {
         unreachable!("Table 6.4 is a constant noise model")
@@ -601,8 +603,14 @@ pub fn run(s: &PumaSettings) -> Result<PumaStudy, Error> {
     // (a) Modified DH from Table 6.1.
     let mut mdh = mdh;
     let mdh_fixed = fix_unidentifiable(&mut mdh, &train)?;
-    let (mdh_params, mdh_summary, mdh_sigma) =
-        fit("modified DH (Table 6.1)", &mdh, &data, &noise, mdh_fixed)?;
+    let (mdh_params, mdh_summary, mdh_sigma) = fit(
+        "modified DH (Table 6.1)",
+        &mdh,
+        &data,
+        &noise,
+        mdh_fixed,
+        observer,
+    )?;
 
     // (b) Zero reference from Table 6.2 / eq. 6.11: u, p, offsets and T₀ free as the
     // data identify them; the base is the CMM frame (identity, fixed).
@@ -616,6 +624,7 @@ pub fn run(s: &PumaSettings) -> Result<PumaStudy, Error> {
         &data,
         &noise,
         zrp_fixed,
+        observer,
     )?;
 
     // (c) Zero reference → DH with Table 6.1's link types and sign rules.

@@ -3,6 +3,7 @@
 //! 6.9/6.10, `puma-accuracy.csv` for Table 6.13).
 
 use super::puma::{run, PumaSettings, PumaStudy};
+use crate::progress::Observer;
 use crate::Error;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
@@ -25,10 +26,10 @@ impl PumaRecord {
     }
 }
 
-/// Runs the study ([`run`]), timed.
-pub fn run_record(s: &PumaSettings) -> Result<PumaRecord, Error> {
+/// Runs the study ([`run`]), timed; `observer` sees its fits.
+pub fn run_record(s: &PumaSettings, observer: &mut dyn Observer) -> Result<PumaRecord, Error> {
     let t0 = Instant::now();
-    let result = run(s)?;
+    let result = run(s, observer)?;
     Ok(PumaRecord {
         study: "puma".into(),
         seconds: t0.elapsed().as_secs_f64(),

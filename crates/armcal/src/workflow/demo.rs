@@ -1,5 +1,6 @@
 //! `armcal demo` in one call: the demo's run ([`crate::study::demo`]) and its HTML report.
 
+use crate::progress::Observer;
 use crate::report::{self, Document, Input, ReportContent};
 use crate::study::demo::{run_demo, DemoSummary};
 use crate::Error;
@@ -12,13 +13,13 @@ pub struct DemoFiles {
     pub files: Vec<(String, String)>,
 }
 
-/// Runs the demo and renders its report (`report.html`, the last file); `progress` receives
-/// a short label before each stage.
-pub fn demo(seed: u64, progress: &dyn Fn(&str)) -> Result<DemoFiles, Error> {
-    let run = run_demo(seed, progress)?;
+/// Runs the demo and renders its report (`report.html`, the last file); `observer` sees
+/// each stage as a task.
+pub fn demo(seed: u64, observer: &mut dyn Observer) -> Result<DemoFiles, Error> {
+    let run = run_demo(seed, observer)?;
     let mut files = run.files;
     let summary = run.summary;
-    progress("writing the report");
+    observer.start("writing the report", None);
     let inputs = [
         (
             "KPI design",
@@ -57,6 +58,7 @@ pub fn demo(seed: u64, progress: &dyn Fn(&str)) -> Result<DemoFiles, Error> {
         cell_view: report::cell_view_of(&run.cell, &inputs)?,
         notes: &[],
     })?;
+    observer.finish();
     files.push(("report.html".into(), html));
     Ok(DemoFiles { summary, files })
 }

@@ -183,7 +183,7 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
     };
     cell.declared_free = cell.model.registry.free();
     if cell.auto_free {
-        let report = cell.identifiability(&cell.identifiability_options())?;
+        let report = cell.identifiability(&cell.identifiability_settings())?;
         report.apply(&mut cell.model)?;
     }
     Ok(cell)

@@ -19,7 +19,7 @@
 //! `g = (t − p)/|t − p|` from the reflector position `p` to the tracker origin `t` (the
 //! instrument frame's origin): `cos β = zᵀg`. The paper takes `z` as the flange (TCP) z axis
 //! with the reflector on the flange. Here `p` is the reflector target (the first target of the
-//! model unless [`ConstraintOptions::reflector`] names another; the tool-frame origin if the
+//! model unless [`ConstraintSettings::reflector`] names another; the tool-frame origin if the
 //! model has no target) and `z` is that target's world z axis. A reflector given as a point
 //! (`Convention::Point`) carries the tool frame's orientation, so `z` is the tool/flange z
 //! axis as in the paper; a target given as a full frame uses its own z axis. Gradient:
@@ -53,7 +53,7 @@
 //! beam, but not against obstacles and half-spaces (the value would not depend on q).
 //!
 //! **Line of sight.** The beam from the reflector to the tracker origin is a capsule of radius
-//! [`ConstraintOptions::beam_radius`]. It is checked against every robot capsule and every
+//! [`ConstraintSettings::beam_radius`]. It is checked against every robot capsule and every
 //! obstacle capsule, except the robot capsules that carry the reflector: a capsule whose
 //! frame has at most one joint between it and the reflector is left out when the reflector
 //! point lies within its radius plus the beam radius (for a frame with one joint in between,
@@ -90,7 +90,7 @@ pub enum ConstraintKind {
 
 /// Which constraints a [`ConstraintSet`] contains.
 #[derive(Clone, Debug, PartialEq)]
-pub struct ConstraintOptions {
+pub struct ConstraintSettings {
     /// The incidence limit (paper eq. 4), if the cell has one.
     pub incidence: bool,
     /// Self collision, robot vs obstacle capsules, robot vs half-spaces.
@@ -105,9 +105,9 @@ pub struct ConstraintOptions {
     pub reflector: Option<String>,
 }
 
-impl Default for ConstraintOptions {
+impl Default for ConstraintSettings {
     fn default() -> Self {
-        ConstraintOptions {
+        ConstraintSettings {
             incidence: true,
             collisions: true,
             line_of_sight: true,
@@ -261,7 +261,7 @@ pub struct ConstraintWorkspace {
 impl ConstraintSet {
     /// Compiles the constraints of `cell` (see the module documentation for what is
     /// included).
-    pub fn new(cell: &Cell, options: &ConstraintOptions) -> Result<ConstraintSet, Error> {
+    pub fn new(cell: &Cell, options: &ConstraintSettings) -> Result<ConstraintSet, Error> {
         if !(options.beam_radius.is_finite() && options.beam_radius >= 0.0) {
             return Err(Error::Input(format!(
                 "beam radius must be a finite length ≥ 0 mm, got {}",

@@ -24,7 +24,7 @@ fn random_q(set: &ConstraintSet, r: &mut rand_chacha::ChaCha8Rng) -> Vec<f64> {
 fn jacobian_matches_central_differences() {
     use rand::SeedableRng;
     let cell = cell();
-    let set = ConstraintSet::new(&cell, &ConstraintOptions::default()).unwrap();
+    let set = ConstraintSet::new(&cell, &ConstraintSettings::default()).unwrap();
     let params = cell.model.nominal();
     let (n, dof) = (set.len(), set.dof());
     let mut ws = set.workspace();
@@ -87,7 +87,7 @@ fn capsule_distances_agree_with_parry() {
     use parry3d_f64::shape::{Capsule, Segment};
     use rand::SeedableRng;
     let cell = cell();
-    let set = ConstraintSet::new(&cell, &ConstraintOptions::default()).unwrap();
+    let set = ConstraintSet::new(&cell, &ConstraintSettings::default()).unwrap();
     let params = cell.model.nominal();
     let mut ws = set.workspace();
     let mut values = vec![0.0; set.len()];
@@ -160,7 +160,7 @@ fn capsule_distances_agree_with_parry() {
 #[test]
 fn row_subsets_and_early_exit_agree_with_the_full_evaluation() {
     let c = cell();
-    let set = ConstraintSet::new(&c, &ConstraintOptions::default()).unwrap();
+    let set = ConstraintSet::new(&c, &ConstraintSettings::default()).unwrap();
     let params = c.model.nominal();
     let (m, dof) = (set.len(), set.dof());
     let mut ws = set.workspace();
@@ -195,12 +195,12 @@ fn row_subsets_and_early_exit_agree_with_the_full_evaluation() {
 #[test]
 fn bad_options_are_rejected() {
     let cell = cell();
-    let opts = ConstraintOptions {
+    let opts = ConstraintSettings {
         beam_radius: -1.0,
         ..Default::default()
     };
     assert!(ConstraintSet::new(&cell, &opts).is_err());
-    let opts = ConstraintOptions {
+    let opts = ConstraintSettings {
         reflector: Some("nope".into()),
         ..Default::default()
     };

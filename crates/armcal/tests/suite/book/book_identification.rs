@@ -17,10 +17,11 @@
 //! (Table 6.4 in mm and rad). Printed numbers are given in both.
 
 use armcal::cell::Cell;
-use armcal::identify::{solve, IdentifyOptions, Method, Problem, Silent};
+use armcal::identify::{solve, IdentifySettings, Method, Problem};
 use armcal::measure::{Dataset, MeasurementKind, NoiseModel};
-use armcal::model::identifiability::{analyze, IdentifiabilityOptions, Measurement};
+use armcal::model::identifiability::{analyze, IdentifiabilitySettings, Measurement};
 use armcal::model::*;
+use armcal::progress::Silent;
 use armcal::robots;
 use armcal::robots::puma560::MM_PER_IN;
 use armcal::sim::simulate;
@@ -54,7 +55,7 @@ fn analysis(
     m: &Model,
     measurement: Measurement,
 ) -> armcal::model::identifiability::Identifiability {
-    let opts = IdentifiabilityOptions {
+    let opts = IdentifiabilitySettings {
         measurement,
         poses: 60,
         seed: 3,
@@ -241,12 +242,12 @@ fn max_book_error(m: &Model, est: &[f64], truth: &[f64]) -> (f64, String) {
         .fold((0.0, String::new()), |a, b| if b.0 > a.0 { b } else { a })
 }
 
-fn lm() -> IdentifyOptions {
-    IdentifyOptions::default()
+fn lm() -> IdentifySettings {
+    IdentifySettings::default()
 }
 
-fn gn() -> IdentifyOptions {
-    IdentifyOptions {
+fn gn() -> IdentifySettings {
+    IdentifySettings {
         method: Method::GaussNewton,
         ..Default::default()
     }
@@ -523,7 +524,7 @@ fn puma560_cell_example_has_the_books_30_parameters() {
         .iter()
         .all(|n| n.starts_with("base.") || n.starts_with('j')));
     let report = cell
-        .identifiability(&cell.identifiability_options())
+        .identifiability(&cell.identifiability_settings())
         .unwrap();
     assert_eq!(report.candidates.len(), 30);
     assert_eq!(report.rank_svd, 30);

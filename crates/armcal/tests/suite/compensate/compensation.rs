@@ -6,10 +6,11 @@ use armcal::cell::Cell;
 use armcal::compensate::closed_form::SphericalWristIk;
 use armcal::compensate::program::{corrected_cartesian_targets, filter_joint_program};
 use armcal::compensate::{CalibratedIk, IkSettings, IkStatus, IkTarget};
-use armcal::identify::{identify, IdentifyOptions, Silent};
+use armcal::identify::{identify, IdentifySettings};
 use armcal::model::pose::rotation_log;
 use armcal::model::random_configurations;
 use armcal::model::{forward_kinematics, Data, Model, Pose};
+use armcal::progress::Silent;
 use armcal::robots;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use rand::{Rng, SeedableRng};
@@ -236,7 +237,7 @@ fn closed_loop_filtered_program_hits_targets_within_predicted_uncertainty() {
     let truth = perturbed_truth(model, &Perturbation::default(), 12);
     let qs = random_configurations(model, 120, 13);
     let data = simulate(model, &truth, &qs, Some(&noise), 14).unwrap();
-    let est = identify(&cell, &data, &IdentifyOptions::default(), &mut Silent).unwrap();
+    let est = identify(&cell, &data, &IdentifySettings::default(), &mut Silent).unwrap();
     let calibrated = est.params_for(model).unwrap();
     // A small working program: 20 configurations within ±15° of a reach-forward-and-down
     // pose (away from the stretched-elbow singularity, where no solution exists).

@@ -8,10 +8,11 @@ use armcal::compensate::nonparametric::{
 };
 use armcal::compensate::program::filter_joint_program_corrected;
 use armcal::compensate::{IkSettings, IkStatus};
-use armcal::identify::{identify, IdentifyOptions, Silent};
+use armcal::identify::{identify, IdentifySettings};
 use armcal::measure::{Dataset, MeasurementKind, NoiseModel};
 use armcal::model::random_configurations;
 use armcal::model::{forward_kinematics, Data};
+use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use nalgebra::Vector3;
 use std::path::Path;
@@ -138,7 +139,7 @@ fn sagging_calibration() -> SaggingCalibration {
             *value += to_instrument * sag(&data.configurations[m.config]);
         }
     }
-    let est = identify(&cell, &data, &IdentifyOptions::default(), &mut Silent).unwrap();
+    let est = identify(&cell, &data, &IdentifySettings::default(), &mut Silent).unwrap();
     let calibrated = est.params_for(model).unwrap();
     SaggingCalibration {
         cell,

@@ -7,6 +7,7 @@ use armcal::design::exchange::{exchange, ExchangeSettings};
 use armcal::design::refine::{refine, RefineSettings};
 use armcal::design::{Criterion, DesignModel, DesignObjective};
 use armcal::model::random_configurations;
+use armcal::progress::Silent;
 use nalgebra::DMatrix;
 use std::path::Path;
 
@@ -28,6 +29,7 @@ fn bound_is_below_every_design_and_efficiency_is_high_for_optimised_designs() {
             &DMatrix::zeros(0, d.n()),
             30,
             &ExchangeSettings::default(),
+            &mut Silent,
         )
         .unwrap();
         let start: Vec<Vec<f64>> = ex.chosen.iter().map(|&i| pool[i].clone()).collect();
@@ -41,6 +43,7 @@ fn bound_is_below_every_design_and_efficiency_is_high_for_optimised_designs() {
                 max_iterations: 800,
                 ..Default::default()
             },
+            &mut Silent,
         )
         .unwrap();
         let b = optimality_bound(&obj, &refined.q, &pool, 20, |_| true).unwrap();

@@ -5,6 +5,7 @@ use armcal::cell::Cell;
 use armcal::design::exchange::{exchange, ExchangeSettings};
 use armcal::design::{Criterion, DesignModel, DesignObjective};
 use armcal::model::random_configurations;
+use armcal::progress::Silent;
 use nalgebra::DMatrix;
 use std::path::Path;
 
@@ -25,8 +26,8 @@ fn kpi_exchange_beats_random_and_parameter_variance_designs() {
     let random: Vec<Vec<f64>> = pool[..60].to_vec();
     let kpi_random = kpi_of(&random);
     let s = ExchangeSettings::default();
-    let a = exchange(&d, Criterion::A, &pool, &none, 60, &s).unwrap();
-    let kpi = exchange(&d, Criterion::Kpi, &pool, &none, 60, &s).unwrap();
+    let a = exchange(&d, Criterion::A, &pool, &none, 60, &s, &mut Silent).unwrap();
+    let kpi = exchange(&d, Criterion::Kpi, &pool, &none, 60, &s, &mut Silent).unwrap();
     let pick = |r: &[usize]| r.iter().map(|&i| pool[i].clone()).collect::<Vec<_>>();
     let kpi_a = kpi_of(&pick(&a.chosen));
     let kpi_k = kpi_of(&pick(&kpi.chosen));
@@ -57,6 +58,7 @@ fn kpi_exchange_beats_random_and_parameter_variance_designs() {
                 max_sweeps: 3,
                 ..s.clone()
             },
+            &mut Silent,
         )
         .unwrap();
         assert!(

@@ -6,8 +6,9 @@ use armcal::cell::Cell;
 use armcal::design::baselines::random_feasible;
 use armcal::design::plan::{constraint_set, plan, CellConstraints, PlanSettings};
 use armcal::design::{Criterion, DesignModel, DesignObjective};
-use armcal::identify::{solve, IdentifyOptions, Problem, Silent};
+use armcal::identify::{solve, IdentifySettings, Problem};
 use armcal::model::{forward_kinematics, observed_position, Data, Observed};
+use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
@@ -34,6 +35,7 @@ fn kpi_design_variance_gain_holds_in_monte_carlo() {
             ..Default::default()
         },
         &[],
+        &mut Silent,
     )
     .unwrap();
     let obj = DesignObjective::new(&d, Criterion::Kpi, &[]);
@@ -61,7 +63,7 @@ fn kpi_design_variance_gain_holds_in_monte_carlo() {
                 let (sol, _, _) = solve(
                     &mut p,
                     &model.nominal(),
-                    &IdentifyOptions::default(),
+                    &IdentifySettings::default(),
                     &mut Silent,
                 )
                 .unwrap();

@@ -5,6 +5,7 @@ use armcal::cell::Cell;
 use armcal::design::baselines::random_feasible;
 use armcal::design::plan::{constraint_set, plan, CellConstraints, PlanSettings};
 use armcal::design::{Criterion, DesignModel, DesignObjective};
+use armcal::progress::Silent;
 use std::path::Path;
 
 fn cell(name: &str) -> Cell {
@@ -38,7 +39,7 @@ fn planner_beats_the_heuristic_with_and_without_collisions() {
             collisions,
             ..PlanSettings::default()
         };
-        let kpi = plan(&c, &settings, &[]).unwrap();
+        let kpi = plan(&c, &settings, &[], &mut Silent).unwrap();
         let a = plan(
             &c,
             &PlanSettings {
@@ -46,6 +47,7 @@ fn planner_beats_the_heuristic_with_and_without_collisions() {
                 ..settings.clone()
             },
             &[],
+            &mut Silent,
         )
         .unwrap();
         let a_kpi = kpi_of(&a.design, &mut ws);
@@ -88,6 +90,7 @@ fn an_obstacle_over_the_tracker_gives_a_clear_report_and_the_best_design() {
             ..PlanSettings::default()
         },
         &[],
+        &mut Silent,
     )
     .unwrap();
     assert!(!rep.feasible);

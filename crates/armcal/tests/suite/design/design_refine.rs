@@ -6,6 +6,7 @@ use armcal::design::exchange::{exchange, ExchangeResult, ExchangeSettings};
 use armcal::design::refine::{refine, RefineSettings};
 use armcal::design::{Criterion, DesignModel, DesignObjective};
 use armcal::model::random_configurations;
+use armcal::progress::Silent;
 use nalgebra::DMatrix;
 use std::path::Path;
 
@@ -19,6 +20,7 @@ fn kpi_exchange_start(d: &DesignModel, pool: &[Vec<f64>]) -> (ExchangeResult, Ve
         &DMatrix::zeros(0, d.n()),
         60,
         &ExchangeSettings::default(),
+        &mut Silent,
     )
     .unwrap();
     let start = ex.chosen.iter().map(|&i| pool[i].clone()).collect();
@@ -36,7 +38,19 @@ fn refinement_improves_the_exchange_design_within_limits() {
     let (ex, start) = kpi_exchange_start(&d, &pool);
     let obj = DesignObjective::new(&d, Criterion::Kpi, &[]);
     let (lo, hi) = d.model.joint_limits();
-    let r = refine(&obj, &start, &lo, &hi, None, &RefineSettings::default()).unwrap();
+    let unconstrained = |start: &[Vec<f64>]| {
+        refine(
+            &obj,
+            start,
+            &lo,
+            &hi,
+            None,
+            &RefineSettings::default(),
+            &mut Silent,
+        )
+        .unwrap()
+    };
+    let r = unconstrained(&start);
     eprintln!(
         "exchange {:.5} → refined {:.5} mm² ({}, {} iterations, {:.2} s)",
         ex.value,
@@ -54,7 +68,7 @@ fn refinement_improves_the_exchange_design_within_limits() {
     }
     // From a random start the refinement alone also reaches a good design.
     let random: Vec<Vec<f64>> = pool[..60].to_vec();
-    let r2 = refine(&obj, &random, &lo, &hi, None, &RefineSettings::default()).unwrap();
+    let r2 = unconstrained(&random);
     eprintln!(
         "random {:.5} → refined {:.5} mm² ({:.2} s)",
         r2.start_value,
@@ -92,6 +106,7 @@ fn constrained_refinement_descends_and_stays_feasible() {
         &hi,
         Some(&cons as &dyn ConfigurationConstraints),
         &RefineSettings::default(),
+        &mut Silent,
     )
     .unwrap();
     eprintln!(

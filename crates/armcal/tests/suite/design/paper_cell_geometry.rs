@@ -6,7 +6,7 @@
 //! the reading of the setup and the ≈ 6 % incidence-feasible share of uniform draws.
 
 use armcal::cell::Cell;
-use armcal::design::{ConstraintKind, ConstraintOptions, ConstraintSet};
+use armcal::design::{ConstraintKind, ConstraintSet, ConstraintSettings};
 use armcal::model::{forward_kinematics, Data};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -28,12 +28,12 @@ fn q_work() -> Vec<f64> {
     deg([0.0, -30.0, 30.0, 0.0, -90.0, 0.0])
 }
 
-fn options(incidence: bool, collisions: bool, line_of_sight: bool) -> ConstraintOptions {
-    ConstraintOptions {
+fn options(incidence: bool, collisions: bool, line_of_sight: bool) -> ConstraintSettings {
+    ConstraintSettings {
         incidence,
         collisions,
         line_of_sight,
-        ..ConstraintOptions::default()
+        ..ConstraintSettings::default()
     }
 }
 
@@ -96,7 +96,7 @@ fn frame_zero_orientation_evidence() {
 #[test]
 fn constraint_counts() {
     let cell = cell();
-    let set = ConstraintSet::new(&cell, &ConstraintOptions::default()).unwrap();
+    let set = ConstraintSet::new(&cell, &ConstraintSettings::default()).unwrap();
     let count = |k| set.count(k);
     // 7 robot capsules (pedestal on base, j1, j2, j3, j4, j5, reflector holder on tool),
     // 6 of them moving; 3 obstacle capsules (mount beam, car body, car roof); 2 half-spaces.

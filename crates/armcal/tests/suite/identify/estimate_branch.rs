@@ -9,6 +9,7 @@ use armcal::identify::*;
 use armcal::measure::{Dataset, MeasurementKind};
 use armcal::model::random_configurations;
 use armcal::model::Model;
+use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use nalgebra::Vector3;
 
@@ -34,7 +35,7 @@ fn robust_variance_factor_uses_the_kept_measurements() {
             *value += Vector3::new((i as f64).sin(), (i as f64).cos(), 0.3).normalize() * 50.0;
         }
     }
-    let opts = IdentifyOptions {
+    let opts = IdentifySettings {
         robust: Some(Loss::Huber),
         ..Default::default()
     };
@@ -57,7 +58,11 @@ fn robust_variance_factor_uses_the_kept_measurements() {
 }
 
 /// The fit `identify` ran before mapping: the same steps without the branch choice.
-fn unmapped(cell: &Cell, data: &Dataset, opts: &IdentifyOptions) -> (Model, Solution, Vec<f64>) {
+fn unmapped(
+    cell: &Cell,
+    data: &Dataset,
+    opts: &IdentifySettings,
+) -> (Model, SolverResult, Vec<f64>) {
     let noise = cell.instrument.as_ref().unwrap().noise.clone();
     let start = frames_first_start(&cell.declared_model(), data, &noise, opts).unwrap();
     let (model, _) = identifiable_model(cell, data, &start).unwrap();
@@ -85,7 +90,7 @@ fn an_outlier_no_longer_gives_full_turns_or_flipped_links() {
         }
     }
     for loss in [Loss::Huber, Loss::Cauchy] {
-        let opts = IdentifyOptions {
+        let opts = IdentifySettings {
             robust: Some(loss),
             ..Default::default()
         };
@@ -182,6 +187,6 @@ fn an_outlier_no_longer_gives_full_turns_or_flipped_links() {
     }
 }
 
-fn parameter_uncertainty_of(sol: &Solution, names: &[String]) -> ParameterUncertainty {
+fn parameter_uncertainty_of(sol: &SolverResult, names: &[String]) -> ParameterUncertainty {
     uncertainty::parameter_uncertainty(&sol.jacobian, &sol.residual, names).unwrap()
 }

@@ -8,9 +8,19 @@ use armcal::cell::Cell;
 use armcal::identify::*;
 use armcal::measure::{Dataset, NoiseModel};
 use armcal::model::random_configurations;
+use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use common::example_cell;
 use std::path::Path;
+
+/// Acceptance in the CLI's words, as the CLI passes it.
+fn cli(accepted: bool) -> Acceptance<'static> {
+    Acceptance {
+        accepted,
+        accept: "--accept-unconverged",
+        raise_iterations: "--max-iterations",
+    }
+}
 
 fn constant(sigma: f64) -> NoiseModel {
     NoiseModel::Constant {
@@ -44,7 +54,7 @@ fn chi2_verdict_says_what_a_wrong_sigma_means_for_the_reported_sigmas() {
         (0.3, Chi2Outcome::SigmaTooLarge, "too large"),
     ] {
         let (cell, data) = paper_campaign(1.0, actual, 40);
-        let wrong = identify(&cell, &data, &IdentifyOptions::default(), &mut Silent).unwrap();
+        let wrong = identify(&cell, &data, &IdentifySettings::default(), &mut Silent).unwrap();
         let v = wrong.verdicts.as_ref().unwrap();
         assert_eq!(v.chi2.outcome, outcome, "{}", v.chi2.meaning);
         let k = v.chi2.sigma_ratio.unwrap();
@@ -60,7 +70,7 @@ fn chi2_verdict_says_what_a_wrong_sigma_means_for_the_reported_sigmas() {
             "{}",
             v.chi2.meaning
         );
-        let usable = wrong.check_usable(false).unwrap();
+        let usable = wrong.check_usable(&cli(false)).unwrap();
         assert!(
             usable.overridden.is_none() && usable.notes.iter().any(|n| n.contains(words)),
             "{usable:?}"
@@ -69,7 +79,13 @@ fn chi2_verdict_says_what_a_wrong_sigma_means_for_the_reported_sigmas() {
         // Stating the true σ: consistent, and every reported σ is k times the wrong one's.
         let mut right_cell = cell.clone();
         right_cell.instrument.as_mut().unwrap().noise = constant(actual);
-        let right = identify(&right_cell, &data, &IdentifyOptions::default(), &mut Silent).unwrap();
+        let right = identify(
+            &right_cell,
+            &data,
+            &IdentifySettings::default(),
+            &mut Silent,
+        )
+        .unwrap();
         let rv = right.verdicts.as_ref().unwrap();
         assert_eq!(
             rv.chi2.outcome,
@@ -77,7 +93,7 @@ fn chi2_verdict_says_what_a_wrong_sigma_means_for_the_reported_sigmas() {
             "{}",
             rv.chi2.meaning
         );
-        assert!(right.check_usable(false).unwrap().notes.is_empty());
+        assert!(right.check_usable(&cli(false)).unwrap().notes.is_empty());
         for (s_wrong, s_right) in sigmas(&wrong).iter().zip(sigmas(&right)) {
             let ratio = s_right / (k * s_wrong);
             assert!(
@@ -95,19 +111,19 @@ fn chi2_verdict_says_what_a_wrong_sigma_means_for_the_reported_sigmas() {
 #[test]
 fn unconverged_and_unverified_estimates_are_refused_unless_accepted() {
     let (cell, data) = paper_campaign(1.0, 1.0, 50);
-    let mut opts = IdentifyOptions::default();
+    let mut opts = IdentifySettings::default();
     opts.lm.tolerances.max_iterations = 1;
     let est = identify(&cell, &data, &opts, &mut Silent).unwrap();
     let v = est.verdicts.as_ref().unwrap();
-    assert_eq!(v.solver, Status::MaxIterations);
-    let e = est.check_usable(false).unwrap_err().to_string();
+    assert_eq!(v.solver, Status::IterationLimit);
+    let e = est.check_usable(&cli(false)).unwrap_err().to_string();
     assert!(
         e.contains("did not converge")
             && e.contains("stopped at the iteration limit")
             && e.contains("--accept-unconverged"),
         "{e}"
     );
-    let accepted = est.check_usable(true).unwrap();
+    let accepted = est.check_usable(&cli(true)).unwrap();
     let line = accepted.overridden.unwrap();
     assert!(
         line.contains("did not converge (stopped at the iteration limit)")
@@ -124,13 +140,13 @@ fn unconverged_and_unverified_estimates_are_refused_unless_accepted() {
     std::fs::write(&path, serde_json::to_string(&json).unwrap()).unwrap();
     let old = Estimate::from_file(&path).unwrap();
     assert!(old.verdicts.is_none() && old.fingerprint.is_none());
-    let e = old.check_usable(false).unwrap_err().to_string();
+    let e = old.check_usable(&cli(false)).unwrap_err().to_string();
     assert!(
         e.contains("older armcal") && e.contains("--accept-unconverged"),
         "{e}"
     );
     assert!(old
-        .check_usable(true)
+        .check_usable(&cli(true))
         .unwrap()
         .overridden
         .unwrap()
@@ -162,7 +178,7 @@ fn cell_from(text: &str) -> Cell {
 #[test]
 fn a_cell_that_differs_from_the_estimates_is_named() {
     let (cell, data) = paper_campaign(1.0, 1.0, 60);
-    let est = identify(&cell, &data, &IdentifyOptions::default(), &mut Silent).unwrap();
+    let est = identify(&cell, &data, &IdentifySettings::default(), &mut Silent).unwrap();
     assert!(est.params_for(&cell.model).is_ok());
     let text = paper_cell_text();
     let cases = [

@@ -2,9 +2,10 @@
 //! generic count names its cause (issue 10, items 1 and 2).
 
 use armcal::cell::Cell;
-use armcal::identify::{identify, IdentifyOptions, Silent};
+use armcal::identify::{identify, IdentifySettings};
 use armcal::model::random_configurations;
 use armcal::model::Convention;
+use armcal::progress::Silent;
 use armcal::robots;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use std::path::Path;
@@ -76,7 +77,7 @@ fn an_unknown_marker_at_zero_loses_no_parameter() {
         let qs = random_configurations(model, 1000, 3);
         let noise = known.instrument.as_ref().unwrap().noise.clone();
         let data = simulate(model, &truth, &qs, Some(&noise), 5).unwrap();
-        let opts = IdentifyOptions {
+        let opts = IdentifySettings {
             holdout: 0.3,
             ..Default::default()
         };
@@ -137,7 +138,7 @@ fn every_builtin_6r_robot_is_complete_under_auto() {
         for (m, expected) in [("position", 27), ("pose", 30)] {
             let cell = load(&with_target(&format!("builtin = \"{name}\""), m));
             let report = cell
-                .identifiability(&cell.identifiability_options())
+                .identifiability(&cell.identifiability_settings())
                 .unwrap();
             assert_eq!(
                 report.identifiable.len(),
@@ -155,7 +156,7 @@ fn every_builtin_6r_robot_is_complete_under_auto() {
     let text = with_target("builtin = \"ur10\"\nconvention = \"dh\"", "position");
     let cell = load(&text);
     let report = cell
-        .identifiability(&cell.identifiability_options())
+        .identifiability(&cell.identifiability_settings())
         .unwrap();
     assert!(
         report.identifiable.len() < 27,
@@ -180,7 +181,7 @@ fn a_target_on_the_last_axis_is_named() {
         with_target("builtin = \"paper\"", "position").replace("[10, 20, 100]", "[0, 0, 50]");
     let cell = load(&text);
     let report = cell
-        .identifiability(&cell.identifiability_options())
+        .identifiability(&cell.identifiability_settings())
         .unwrap();
     assert_eq!(report.identifiable.len(), 25);
     let d = cell
@@ -257,7 +258,7 @@ fn an_inline_mdh_table_with_parallel_axes_is_completed() {
     let j3 = &auto.model.links[auto.model.link_index("j3").unwrap()];
     assert_eq!(j3.spec.geometry.convention, Convention::MdhBeta);
     let report = auto
-        .identifiability(&auto.identifiability_options())
+        .identifiability(&auto.identifiability_settings())
         .unwrap();
     assert_eq!(report.identifiable.len(), 27, "{:?}", report.excluded);
 
@@ -266,7 +267,7 @@ fn an_inline_mdh_table_with_parallel_axes_is_completed() {
         cell_text(MDH_PARALLEL)
     ));
     let report = given
-        .identifiability(&given.identifiability_options())
+        .identifiability(&given.identifiability_settings())
         .unwrap();
     assert_eq!(report.identifiable.len(), 26);
     let d = given

@@ -5,6 +5,7 @@ use crate::common;
 use armcal::cell::Cell;
 use armcal::identify::*;
 use armcal::model::random_configurations;
+use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
@@ -25,7 +26,7 @@ fn noise_free_identification_recovers_the_truth() {
     let noise = cell.instrument.as_ref().unwrap().noise.clone();
     for method in [Method::Lm, Method::GaussNewton, Method::Kalman] {
         let mut problem = Problem::new(model, &data, &noise).unwrap();
-        let opts = IdentifyOptions {
+        let opts = IdentifySettings {
             method,
             ..Default::default()
         };
@@ -52,7 +53,7 @@ fn gauss_newton_kalman_and_lm_agree_on_noisy_data() {
     let data = simulate(model, &truth, &qs, Some(&noise), 21).unwrap();
     let run = |method| {
         let mut problem = Problem::new(model, &data, &noise).unwrap();
-        let opts = IdentifyOptions {
+        let opts = IdentifySettings {
             method,
             ..Default::default()
         };
@@ -130,7 +131,7 @@ fn predicted_tcp_covariance_matches_monte_carlo() {
             let (sol, _, _) = solve(
                 &mut problem,
                 &model.nominal(),
-                &IdentifyOptions::default(),
+                &IdentifySettings::default(),
                 &mut Silent,
             )
             .unwrap();
@@ -168,7 +169,7 @@ fn every_method(cell: &Cell, data: &armcal::measure::Dataset) -> Vec<Estimate> {
     [Method::Lm, Method::GaussNewton, Method::Kalman]
         .into_iter()
         .map(|method| {
-            let opts = IdentifyOptions {
+            let opts = IdentifySettings {
                 method,
                 ..Default::default()
             };
@@ -200,7 +201,7 @@ fn every_method_from_an_unplaced_tracker_reaches_lms_estimate_on_precise_data() 
         // Gauss–Newton without the frames-first start: converged only at LM's cost.
         let (model, _) = identifiable_model(&cell, &data, &cell.model.nominal()).unwrap();
         let mut problem = Problem::new(&model, &data, &noise).unwrap();
-        let opts = IdentifyOptions {
+        let opts = IdentifySettings {
             method: Method::GaussNewton,
             ..Default::default()
         };

@@ -5,6 +5,7 @@ use armcal::cell::Cell;
 use armcal::identify::*;
 use armcal::measure::{csv, MeasurementKind};
 use armcal::model::random_configurations;
+use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use nalgebra::Vector3;
 use std::path::Path;
@@ -34,7 +35,7 @@ fn robust_fit_rejects_gross_errors_and_lists_them() {
         }
     }
     let holdout = |data: &armcal::measure::Dataset, robust: Option<Loss>| {
-        let opts = IdentifyOptions {
+        let opts = IdentifySettings {
             robust,
             holdout: 0.3,
             seed: 2,
@@ -178,7 +179,7 @@ fn too_few_or_degenerate_measurements_are_refused_with_reasons() {
     let model = &cell.model;
     let qs = random_configurations(model, 5, 1);
     let data = simulate(model, &model.nominal(), &qs, None, 0).unwrap();
-    let e = identify(&cell, &data, &IdentifyOptions::default(), &mut Silent)
+    let e = identify(&cell, &data, &IdentifySettings::default(), &mut Silent)
         .err()
         .unwrap()
         .to_string();
@@ -191,7 +192,7 @@ fn too_few_or_degenerate_measurements_are_refused_with_reasons() {
     let same = vec![qs[0].clone(); 20];
     let noise = cell.instrument.as_ref().unwrap().noise.clone();
     let data = simulate(model, &model.nominal(), &same, Some(&noise), 0).unwrap();
-    let est = identify(&cell, &data, &IdentifyOptions::default(), &mut Silent).unwrap();
+    let est = identify(&cell, &data, &IdentifySettings::default(), &mut Silent).unwrap();
     assert_eq!(est.free.len(), 3);
     let from_data: Vec<&str> = est
         .fixed_reasons
@@ -204,10 +205,15 @@ fn too_few_or_degenerate_measurements_are_refused_with_reasons() {
     // With an explicit free list the rank deficiency is an error naming the parameters.
     let mut fixed_list = cell.clone();
     fixed_list.auto_free = false;
-    let e = identify(&fixed_list, &data, &IdentifyOptions::default(), &mut Silent)
-        .err()
-        .unwrap()
-        .to_string();
+    let e = identify(
+        &fixed_list,
+        &data,
+        &IdentifySettings::default(),
+        &mut Silent,
+    )
+    .err()
+    .unwrap()
+    .to_string();
     assert!(
         e.contains("not all identifiable") && e.contains("`j"),
         "{e}"
@@ -236,10 +242,10 @@ fn a_fit_that_cannot_converge_reports_its_status() {
         0,
     )
     .unwrap();
-    let mut opts = IdentifyOptions::default();
+    let mut opts = IdentifySettings::default();
     opts.lm.tolerances.max_iterations = 2;
     let est = identify(&cell, &data, &opts, &mut Silent).unwrap();
-    assert_eq!(est.solver.status, Status::MaxIterations);
+    assert_eq!(est.solver.status, Status::IterationLimit);
     // Undamped Gauss–Newton from a start far away: diverges or stops, with a reason.
     let far = perturbed_truth(
         model,
@@ -251,7 +257,7 @@ fn a_fit_that_cannot_converge_reports_its_status() {
         3,
     );
     let data = simulate(model, &far, &qs, None, 0).unwrap();
-    let opts = IdentifyOptions {
+    let opts = IdentifySettings {
         method: Method::GaussNewton,
         ..Default::default()
     };

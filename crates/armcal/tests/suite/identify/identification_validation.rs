@@ -6,6 +6,7 @@ use armcal::accuracy::ErrorStats;
 use armcal::identify::*;
 use armcal::measure::Dataset;
 use armcal::model::random_configurations;
+use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 
 /// Noisy data of the paper cell at `n` random poses whose ids are not their numbers
@@ -25,7 +26,7 @@ fn paper_data(n: usize, seed: u64) -> (armcal::cell::Cell, Dataset) {
 #[test]
 fn the_holdout_split_is_recorded_by_the_files_pose_ids() {
     let (cell, data) = paper_data(60, 4);
-    let opts = IdentifyOptions {
+    let opts = IdentifySettings {
         holdout: 0.3,
         seed: 5,
         ..Default::default()
@@ -59,7 +60,7 @@ fn a_test_file_validates_the_fit_of_the_whole_data_file() {
     for id in &mut test.config_ids {
         *id = format!("T-{id}");
     }
-    let opts = IdentifyOptions {
+    let opts = IdentifySettings {
         test: Some(test.clone()),
         ..Default::default()
     };
@@ -86,7 +87,7 @@ fn a_test_file_validates_the_fit_of_the_whole_data_file() {
     );
     assert!(v.calibrated.rms < v.nominal.rms);
     // A fraction and a test file together are refused.
-    let both = IdentifyOptions {
+    let both = IdentifySettings {
         holdout: 0.2,
         ..opts
     };
@@ -103,7 +104,7 @@ fn frames_fitted_row_of_a_frames_only_cell_is_the_calibration() {
     let qs = random_configurations(&cell.model, 60, 11);
     let noise = cell.instrument.as_ref().unwrap().noise.clone();
     let data = simulate(&cell.model, &truth, &qs, Some(&noise), 6).unwrap();
-    let opts = IdentifyOptions {
+    let opts = IdentifySettings {
         holdout: 0.3,
         ..Default::default()
     };
@@ -123,7 +124,7 @@ fn frames_fitted_row_of_a_frames_only_cell_is_the_calibration() {
 fn a_holdout_fraction_outside_0_1_is_an_error() {
     let (cell, data) = paper_data(30, 4);
     for h in [f64::NAN, -0.1, 1.0, 1.5] {
-        let opts = IdentifyOptions {
+        let opts = IdentifySettings {
             holdout: h,
             ..Default::default()
         };

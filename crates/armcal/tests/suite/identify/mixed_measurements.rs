@@ -6,6 +6,7 @@ use armcal::identify::*;
 use armcal::measure::{Dataset, Measurement, MeasurementKind, NoiseModel};
 use armcal::model::random_configurations;
 use armcal::model::*;
+use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use nalgebra::{DMatrix, DVector, Vector3};
 
@@ -124,7 +125,7 @@ fn noise_free_mixed_data_recover_the_truth() {
     let (sol, _, _) = solve(
         &mut problem,
         &model.nominal(),
-        &IdentifyOptions::default(),
+        &IdentifySettings::default(),
         &mut Silent,
     )
     .unwrap();

@@ -5,6 +5,7 @@ use armcal::identify::*;
 use armcal::measure::{csv, NoiseModel};
 use armcal::model::random_configurations;
 use armcal::model::Status as ParamStatus;
+use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use std::path::Path;
 
@@ -27,7 +28,7 @@ fn a_prior_pulls_a_weak_parameter_toward_its_nominal_value() {
         let (sol, _, _) = solve(
             &mut problem,
             &model.nominal(),
-            &IdentifyOptions::default(),
+            &IdentifySettings::default(),
             &mut Silent,
         )
         .unwrap();

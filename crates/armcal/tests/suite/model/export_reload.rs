@@ -5,11 +5,12 @@
 //! (issue 10, item 8).
 
 use armcal::cell::{export::to_cell_toml, Cell};
-use armcal::identify::{identify, IdentifyOptions, Silent};
+use armcal::identify::{identify, IdentifySettings};
 use armcal::model::complete::LinkForm;
 use armcal::model::export::{export_form, suspicious_values};
 use armcal::model::random_configurations;
 use armcal::model::{forward_kinematics, Data, Model};
+use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use std::path::Path;
 
@@ -21,7 +22,7 @@ fn every_cell_export_identifies_again_to_the_same_fit() {
     let qs = random_configurations(&cell.model, 80, 6);
     let noise = cell.instrument.as_ref().unwrap().noise.clone();
     let data = simulate(&cell.model, &truth, &qs, Some(&noise), 8).unwrap();
-    let opts = IdentifyOptions::default();
+    let opts = IdentifySettings::default();
     let est = identify(&cell, &data, &opts, &mut Silent).unwrap();
     let identified = Model::from_spec(&est.model).unwrap();
     for form in [

@@ -2,7 +2,7 @@
 
 use crate::common;
 use armcal::cell::Cell;
-use armcal::model::identifiability::{analyze, IdentifiabilityOptions, Measurement};
+use armcal::model::identifiability::{analyze, IdentifiabilitySettings, Measurement};
 use armcal::model::*;
 use common::*;
 use std::path::Path;
@@ -34,7 +34,7 @@ fn paper_cell_identifies_the_papers_27_parameters() {
         assert!(free.contains(&name), "{name} should be free");
     }
     let report = cell
-        .identifiability(&cell.identifiability_options())
+        .identifiability(&cell.identifiability_settings())
         .unwrap();
     assert_eq!(report.rank_svd, 27);
     assert_eq!(report.rank_qr, 27);
@@ -99,7 +99,7 @@ fn book_completeness_counts_hold_numerically() {
         ("P", 8),
     ] {
         let model = random_chain(kinds, 7);
-        let opts = IdentifiabilityOptions {
+        let opts = IdentifiabilitySettings {
             measurement: Measurement::Pose,
             ..Default::default()
         };
@@ -126,7 +126,7 @@ fn position_and_distance_lose_orientation_and_placement() {
         let report = analyze(
             &model,
             &model.nominal(),
-            &IdentifiabilityOptions {
+            &IdentifiabilitySettings {
                 measurement: m,
                 ..Default::default()
             },
@@ -146,7 +146,7 @@ fn identical_poses_are_rank_deficient() {
         &cell.model,
         &cell.model.nominal(),
         &vec![q; 20],
-        &cell.identifiability_options(),
+        &cell.identifiability_settings(),
     )
     .unwrap();
     assert_eq!(report.rank_svd, 3, "one position seen 20 times has rank 3");

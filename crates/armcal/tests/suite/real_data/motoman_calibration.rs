@@ -3,8 +3,9 @@
 
 use armcal::accuracy::iso9283::position_repeatability;
 use armcal::cell::Cell;
-use armcal::identify::{identify, IdentifyOptions, Silent};
+use armcal::identify::{identify, IdentifySettings};
 use armcal::measure::{csv, MeasurementKind};
+use armcal::progress::Silent;
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {
@@ -20,7 +21,7 @@ fn calibrate(arm: &str) -> armcal::identify::Validation {
         Some(&cols),
     )
     .unwrap();
-    let opts = IdentifyOptions {
+    let opts = IdentifySettings {
         holdout: 1.0 / 3.0,
         seed: 1,
         ..Default::default()

@@ -5,9 +5,10 @@ use crate::common;
 use armcal::cell::Cell;
 use armcal::design::record::kind_margins;
 use armcal::design::DesignRecord;
-use armcal::identify::{identify, Estimate, IdentifyOptions, Silent};
+use armcal::identify::{identify, Estimate, IdentifySettings};
 use armcal::model::random_configurations;
 use armcal::model::{forward_kinematics, Data};
+use armcal::progress::Silent;
 use armcal::report::ellipse::{confidence_scale, ellipse_axes, ellipse_points, Plane};
 use armcal::report::figures::{
     bar_figure, cdf_figure, colour, ellipse_figure, histogram_figure, joint_figure, series_figure,
@@ -35,7 +36,7 @@ fn fixtures() -> &'static (Cell, DesignRecord, Estimate) {
         let est = identify(
             &cell,
             &data,
-            &IdentifyOptions {
+            &IdentifySettings {
                 holdout: 0.3,
                 ..Default::default()
             },
