@@ -4,6 +4,44 @@
 //! The two sources are Mooring, Roth & Driels, *Fundamentals of Manipulator Calibration*
 //! (1991) ("book") and Jost, Kudruss, Körkel & Walter (2017), optimum experimental design of
 //! laser-tracker measurement poses ("paper").
+//!
+//! # The pipeline in one page
+//!
+//! A cell ([`Cell`]: robot, instrument, targets, working poses, obstacles) gives the
+//! [`Model`]; [`plan`] chooses measurement poses and [`assess`] predicts what any design
+//! gives; [`simulate`] measures a virtual robot (or a [`Dataset`] is read from a file with
+//! [`measure::csv::read`]); [`identify`] fits the parameters with their uncertainty into an
+//! [`Estimate`]; [`calibrated_ik`] and [`compensate::program`] use it; [`accuracy`] proves
+//! it. Every solver reports a [`Status`] and its progress to an [`Observer`]; every file
+//! armcal writes is a typed record of the module that produces it ([`Estimate`],
+//! [`DesignRecord`], …), read by [`report`].
+//!
+//! ```
+//! use armcal::{calibrated_ik, identify, simulate, Cell, IdentifySettings, IkSettings, IkTarget};
+//! use armcal::compensate::ik::IkWorkspace;
+//! use armcal::model::{random_configurations, tool_pose};
+//! use armcal::progress::Silent;
+//! use armcal::sim::{perturbed_truth, Perturbation};
+//!
+//! # fn main() -> armcal::Result<()> {
+//! let cell = Cell::from_toml(armcal::cell::builtin::PAPER_CELL, "paper-cell.toml", ".".as_ref())?;
+//! let model = &cell.model;
+//! // A virtual robot that differs from its nominal model, measured at 40 random poses.
+//! let truth = perturbed_truth(model, &Perturbation::default(), 7);
+//! let poses = random_configurations(model, 40, 1);
+//! let data = simulate(model, &truth, &poses, Some(&cell.noise()), 2)?;
+//! let estimate = identify(&cell, &data, &IdentifySettings::default(), &mut Silent)?;
+//! assert!(estimate.solver.status.is_converged());
+//! // The calibrated model drives the tool to where the nominal one says it is.
+//! let params = estimate.params_for(model)?;
+//! let q = &poses[0];
+//! let target = tool_pose(model, &model.nominal(), q);
+//! let ik = calibrated_ik(model, &params, &IkTarget::Pose(target), q, &IkSettings::default(),
+//!     &mut IkWorkspace::new(model));
+//! assert!(ik.position_error < 1e-6);
+//! # Ok(())
+//! # }
+//! ```
 
 pub mod accuracy;
 pub mod cell;
@@ -24,5 +62,18 @@ pub mod study;
 pub mod workflow;
 
 pub use error::{Error, Result};
+
+// The handful of names a program needs; everything else by its module path.
+pub use cell::Cell;
+pub use compensate::{calibrated_ik, IkSettings, IkStatus, IkTarget};
+pub use design::assess::assess;
+pub use design::plan::{plan, PlanResult, PlanSettings};
+pub use design::{Criterion, DesignRecord};
+pub use identify::{identify, Estimate, IdentifySettings};
+pub use measure::Dataset;
+pub use model::Model;
 /// The linear-algebra crate of the public API.
 pub use nalgebra;
+pub use progress::{Observer, Silent};
+pub use sim::simulate;
+pub use solve::Status;
