@@ -9,6 +9,19 @@ use std::path::{Path, PathBuf};
 /// Modules allowed to import `report`: the ones above it.
 const ABOVE_REPORT: &[&str] = &["workflow"];
 
+/// The layers of docs/DESIGN.md, bottom first: a module imports only from lower layers.
+const LAYERS: &[&[&str]] = &[
+    &["solve", "progress", "error", "json"],
+    &["model", "geometry"],
+    &["robots", "measure"],
+    &["cell", "sim", "accuracy"],
+    &["identify", "compensate"],
+    &["design"],
+    &["study"],
+    &["report"],
+    &["workflow"],
+];
+
 fn sources(dir: &Path, out: &mut Vec<PathBuf>) {
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
@@ -161,6 +174,35 @@ fn no_import_cycle_between_top_level_modules() {
             );
         }
     }
+}
+
+#[test]
+fn every_import_goes_down_the_layers() {
+    let layer = |m: &str| LAYERS.iter().position(|l| l.contains(&m));
+    let graph = module_graph();
+    let mut wrong = Vec::new();
+    for (from, edges) in &graph {
+        let Some(lf) = layer(from) else {
+            wrong.push(format!(
+                "`{from}` is in no layer of docs/DESIGN.md: add it to LAYERS"
+            ));
+            continue;
+        };
+        for (to, files) in edges {
+            match layer(to) {
+                Some(lt) if lt < lf => {}
+                _ => wrong.push(format!(
+                    "{from} → {to} goes up or sideways ({})",
+                    files.join(", ")
+                )),
+            }
+        }
+    }
+    assert!(
+        wrong.is_empty(),
+        "imports against the layers:\n  {}",
+        wrong.join("\n  ")
+    );
 }
 
 #[test]
