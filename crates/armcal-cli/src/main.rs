@@ -51,6 +51,14 @@ enum Command {
 }
 
 fn main() {
+    // Rust ignores SIGPIPE, so a write to a closed pipe makes `println!` panic (exit 101).
+    // With the default action restored, `armcal … | head -1` ends quietly when `head` exits,
+    // like any Unix tool. Outputs are written to files before anything is printed about them.
+    #[cfg(unix)]
+    // SAFETY: called first in `main`, before any thread exists; SIG_DFL is a valid handler.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Robots => commands::robots::run(),

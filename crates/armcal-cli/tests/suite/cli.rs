@@ -145,3 +145,43 @@ fn model_converts_to_another_convention_before_the_analysis() {
     assert!(!ok);
     assert!(err.contains("dh") && err.contains("zrp"), "{err}");
 }
+
+/// `armcal … | head -1`: a closed stdout ends the command quietly (no panic, no exit 101).
+/// The read end is closed before armcal has started, so its first write meets a closed pipe.
+#[cfg(unix)]
+#[test]
+fn a_closed_stdout_is_not_a_crash() {
+    use std::io::Read;
+    use std::os::unix::process::ExitStatusExt;
+    use std::process::{Command, Stdio};
+    for args in [
+        vec!["robots"],
+        vec!["fk", "paper", "--joints", "0,10,20,0,30,0"],
+        vec!["model", "examples/paper-cell.toml"],
+    ] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_armcal"))
+            .args(&args)
+            .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("run armcal");
+        drop(child.stdout.take());
+        let mut err = String::new();
+        child
+            .stderr
+            .take()
+            .unwrap()
+            .read_to_string(&mut err)
+            .unwrap();
+        let status = child.wait().unwrap();
+        assert!(
+            !err.contains("panicked") && status.code() != Some(101),
+            "armcal {args:?} with a closed stdout: {status:?}, stderr: {err}"
+        );
+        assert!(
+            status.success() || status.signal() == Some(libc::SIGPIPE),
+            "armcal {args:?} ended with {status:?}: {err}"
+        );
+    }
+}
