@@ -53,7 +53,9 @@ enum Command {
 fn main() {
     // Rust ignores SIGPIPE, so a write to a closed pipe makes `println!` panic (exit 101).
     // With the default action restored, `armcal … | head -1` ends quietly when `head` exits,
-    // like any Unix tool. Outputs are written to files before anything is printed about them.
+    // like any Unix tool. (A command that prints before it writes its files — axes, compensate,
+    // export, identify, report, study — is then stopped before writing them; issue 12 item 2,
+    // all-or-nothing writes, is where that ordering gets fixed.)
     #[cfg(unix)]
     // SAFETY: called first in `main`, before any thread exists; SIG_DFL is a valid handler.
     unsafe {
