@@ -5,6 +5,8 @@
 //! (1991) ("book") and Jost, Kudruss, Körkel & Walter (2017), optimum experimental design of
 //! laser-tracker measurement poses ("paper").
 
+#![warn(missing_docs)]
+
 pub mod accuracy;
 pub mod cell;
 pub mod compensate;
