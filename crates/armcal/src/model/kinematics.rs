@@ -30,6 +30,7 @@ pub struct Data<T: RealField + Copy> {
 }
 
 impl<T: RealField + Copy> Data<T> {
+    /// Buffers sized for `model`, every pose the identity and every twist zero.
     pub fn new(model: &Model) -> Self {
         Data {
             instrument: Pose::identity(),
