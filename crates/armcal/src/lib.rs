@@ -43,6 +43,8 @@
 //! # }
 //! ```
 
+#![warn(missing_docs)]
+
 pub mod accuracy;
 pub mod cell;
 pub mod compensate;

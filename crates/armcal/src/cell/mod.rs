@@ -21,7 +21,9 @@ use std::path::{Path, PathBuf};
 /// The measuring instrument.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Instrument {
+    /// Free-text instrument type from `[instrument] kind` (default `laser-tracker`).
     pub kind: String,
+    /// Measurement noise of the instrument (`[instrument.noise]`).
     pub noise: NoiseModel,
     /// Largest angle between the target's z axis and the beam to the instrument (rad;
     /// paper eq. 4), if the targets are reflectors with a limited acceptance angle.
@@ -31,9 +33,11 @@ pub struct Instrument {
 /// A configuration at which the robot works; the pose-design KPI is the TCP there.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct WorkingPose {
+    /// Name from `[[working]] name`, used in reports.
     pub name: String,
     /// Joint values, internal units (rad, mm).
     pub q: Vec<f64>,
+    /// Relative weight (> 0) of this configuration's TCP error in the pose-design KPI.
     pub weight: f64,
 }
 
@@ -41,16 +45,24 @@ pub struct WorkingPose {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
 pub enum Obstacle {
+    /// The points within `radius` of the segment `a`–`b`.
     Capsule {
+        /// Obstacle name, used in messages.
         name: String,
+        /// First end of the axis segment (mm, world frame).
         a: [f64; 3],
+        /// Second end of the axis segment (mm, world frame).
         b: [f64; 3],
+        /// Radius around the segment (mm).
         radius: f64,
     },
     /// The free side is `normal · x ≥ offset` (normal of unit length).
     HalfSpace {
+        /// Obstacle name, used in messages.
         name: String,
+        /// Normal pointing to the free side, as given (see [`half_space_unit_normal`]).
         normal: [f64; 3],
+        /// Distance of the boundary plane from the world origin along the normal (mm).
         offset: f64,
     },
 }
@@ -81,22 +93,30 @@ pub struct DataColumns {
 /// A loaded cell.
 #[derive(Clone, Debug)]
 pub struct Cell {
+    /// Cell name (`name` at the top of the file, or the robot's name for a built-in cell).
     pub name: String,
     /// Where the cell came from (file path or `builtin:<robot>`).
     pub origin: String,
+    /// The library robot or the robot the file describes, before instrument and targets.
     pub robot: Robot,
     /// The model: robot + instrument + targets, with parameter statuses applied.
     pub model: Model,
+    /// `[instrument]`, if the cell has one.
     pub instrument: Option<Instrument>,
+    /// `[[working]]` configurations, in file order.
     pub working: Vec<WorkingPose>,
+    /// `[[obstacles]]` the pose design keeps clear of, in the world frame.
     pub obstacles: Vec<Obstacle>,
     /// Capsules of the robot and of the tool (in chain frames).
     pub capsules: Vec<Capsule>,
+    /// What the instrument measures (`[parameters] measurement`; default pose if every
+    /// target is a frame, else position).
     pub measurement: Measurement,
     /// `true`: the free set is reduced to the minimal identifiable set on load.
     pub auto_free: bool,
     /// Parameters the cell declared free (or with a prior) before any automatic reduction.
     pub declared_free: Vec<usize>,
+    /// `[data] joints`: the data-file columns of the joints, if the cell names them.
     pub data_columns: Option<DataColumns>,
     /// Things the user should know that do not stop the cell from loading.
     pub warnings: Vec<String>,

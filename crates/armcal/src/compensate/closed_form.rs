@@ -50,6 +50,7 @@ const BOUNDARY_BEND: f64 = 0.0175;
 /// Why a model has no closed-form solution of this kind.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct NoClosedForm {
+    /// Which structural condition failed (e.g. wrist axes not meeting in one point).
     pub reason: String,
 }
 
@@ -150,6 +151,7 @@ impl Branches {
         }
     }
 
+    /// The branches found (at most 8: shoulder × elbow × wrist flip), in solve order.
     pub fn as_slice(&self) -> &[Branch] {
         &self.list[..self.len]
     }

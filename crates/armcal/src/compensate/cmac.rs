@@ -31,9 +31,9 @@ pub fn book_memory_words(resolution: usize, levels: usize, dims: usize) -> usize
 /// Layout of a CMAC.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CmacSettings {
-    /// Lower and upper input value per axis: the centres of the first and last resolution
-    /// unit.
+    /// Lower input value per axis: the centre of the first resolution unit.
     pub lower: Vec<f64>,
+    /// Upper input value per axis: the centre of the last resolution unit.
     pub upper: Vec<f64>,
     /// Resolution units R per axis (the book's example: 120).
     pub resolution: usize,

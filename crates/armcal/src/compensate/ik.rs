@@ -37,7 +37,9 @@ use std::f64::consts::PI;
 /// What the tool frame must reach (world frame, mm).
 #[derive(Clone, Copy, Debug)]
 pub enum IkTarget {
+    /// Tool-frame origin only (mm); 3 task rows.
     Position(Vector3<f64>),
+    /// Full tool-frame pose; 6 task rows, orientation weighted by L.
     Pose(Pose<f64>),
 }
 
@@ -98,6 +100,7 @@ impl IkStatus {
 /// Settings of [`calibrated_ik`].
 #[derive(Clone, Debug)]
 pub struct IkSettings {
+    /// Damped least-squares iterations before [`IkStatus::IterationLimit`].
     pub max_iterations: usize,
     /// Position tolerance (mm).
     pub position_tolerance: f64,
@@ -105,8 +108,10 @@ pub struct IkSettings {
     pub orientation_tolerance: f64,
     /// Characteristic length L (mm) weighting orientation against position.
     pub length: f64,
-    /// Singular-value threshold ε and largest damping γ_max (of the weighted Jacobian).
+    /// Singular-value threshold ε of the weighted Jacobian `J_w` (mm per rad) below which
+    /// damping starts.
     pub epsilon: f64,
+    /// Largest damping γ_max (mm), reached at σ_min = 0; capped by ‖e_w‖.
     pub gamma_max: f64,
 }
 
@@ -131,18 +136,24 @@ impl Default for IkSettings {
 pub struct LimitViolation {
     /// Joint index (0-based).
     pub joint: usize,
+    /// Value the target needs (rad or mm).
     pub value: f64,
+    /// The lower or upper limit it crosses (rad or mm).
     pub limit: f64,
 }
 
 /// Result of one solve.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct IkResult {
+    /// Final joint values (rad or mm), within the limits.
     pub q: Vec<f64>,
+    /// How the solve ended.
     pub status: IkStatus,
+    /// Damped least-squares iterations, including those of a singularity restart.
     pub iterations: usize,
-    /// Remaining position error (mm) and orientation error (rad; 0 for position targets).
+    /// Remaining position error (mm).
     pub position_error: f64,
+    /// Remaining orientation error (rad; 0 for position targets).
     pub orientation_error: f64,
     /// Smallest singular value of the weighted Jacobian at the end, for a solve that did
     /// not converge (it tells a singular configuration from an unreachable target); `None`
@@ -200,6 +211,7 @@ pub struct IkWorkspace {
 }
 
 impl IkWorkspace {
+    /// Buffers sized for `model`'s joints, with its joint limits.
     pub fn new(model: &Model) -> Self {
         let (lower, upper) = model.joint_limits();
         let n = model.dof();

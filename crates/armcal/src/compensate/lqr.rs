@@ -147,7 +147,9 @@ pub fn optimal_compensation(
 /// Multiplications and additions of one compensation (book §5.3.4).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct OperationCount {
+    /// Number of multiplications M.
     pub multiplications: usize,
+    /// Number of additions A.
     pub additions: usize,
 }
 

@@ -36,13 +36,17 @@ pub fn chebyshev_nodes(a: f64, b: f64, n: usize) -> Vec<f64> {
 /// exponent of the first variable decreasing (the book's β ordering, 0-based).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct PolynomialBasis {
+    /// Number of input variables k.
     pub vars: usize,
+    /// Largest total degree d of a term.
     pub degree: usize,
     /// Exponents of every term, `terms[j][i]` = power of variable i in β_j.
     pub terms: Vec<Vec<u32>>,
 }
 
 impl PolynomialBasis {
+    /// Every monomial of total degree ≤ `degree` in `vars` variables, in the book's β order
+    /// (Eq. 5.188).
     pub fn new(vars: usize, degree: usize) -> Self {
         let mut terms = Vec::new();
         for g in 0..=degree {
@@ -61,6 +65,7 @@ impl PolynomialBasis {
         self.terms.len()
     }
 
+    /// True if the basis has no terms (never for a basis built by [`PolynomialBasis::new`]).
     pub fn is_empty(&self) -> bool {
         self.terms.is_empty()
     }
@@ -105,10 +110,12 @@ fn push_degree(terms: &mut Vec<Vec<u32>>, e: &mut [u32], i: usize, left: u32) {
 /// A fitted polynomial correction: inputs (k variables) → 3-vector error.
 #[derive(Clone, Debug)]
 pub struct PolynomialCorrection {
+    /// The monomials the correction is a combination of.
     pub basis: PolynomialBasis,
-    /// Lower and upper bound of every input over the training data; inputs are mapped
-    /// linearly from [lower, upper] to [−1, 1].
+    /// Lower bound of every input over the training data; inputs are mapped linearly from
+    /// [lower, upper] to [−1, 1].
     pub lower: Vec<f64>,
+    /// Upper bound of every input over the training data.
     pub upper: Vec<f64>,
     /// Coefficients, one column per output component (basis.len() × 3).
     pub coefficients: DMatrix<f64>,
@@ -255,7 +262,9 @@ impl CorrectionInputs {
 /// error, approximate by (rotation error × their distance) otherwise.
 #[derive(Clone, Debug)]
 pub struct ResidualCorrection {
+    /// What the polynomial is a function of (arm joints, all joints or TCP position).
     pub inputs: CorrectionInputs,
+    /// The fitted polynomial: inputs → world-frame position error `e` (mm).
     pub polynomial: PolynomialCorrection,
 }
 

@@ -240,9 +240,14 @@ fn cheapest(model: &Model, links: &[Link], params: &[f64], respect_status: bool)
 /// An angle still more than 90° from its nominal value after the mapping.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FarAngle {
+    /// Registry name of the angle (`j4.theta`).
     pub name: String,
+    /// Mapped estimate (deg).
     pub estimate_deg: f64,
+    /// Nominal value (deg).
     pub nominal_deg: f64,
+    /// Sentence saying whether an equivalent within 90° exists and which fixed parameters
+    /// it would change.
     pub reason: String,
 }
 

@@ -12,8 +12,11 @@ use serde::{Deserialize, Serialize};
 /// and the joint that drives it (none for fixed links and frames).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LinkSpec {
+    /// Link name; parameters are named `<name>.<field>` (e.g. `l2.alpha`).
     pub name: String,
+    /// Convention and nominal parameter values (mm, rad).
     pub geometry: LinkGeometry,
+    /// Joint driving the link; `None` for fixed links, frames and targets.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub joint: Option<Joint>,
 }
@@ -21,6 +24,7 @@ pub struct LinkSpec {
 /// Everything needed to build a [`Model`]; also what exports and estimate files store.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ModelSpec {
+    /// Robot name (cell file `[robot] name`, URDF `<robot name>`).
     pub name: String,
     /// Frame of the measuring instrument in the world (e.g. a laser tracker). Measurements
     /// are expressed in it (paper eq. 3). `None`: measurements are in the world frame.
@@ -37,6 +41,7 @@ pub struct ModelSpec {
 /// A compiled link: its spec plus where its parameters live in the registry.
 #[derive(Clone, Debug)]
 pub struct Link {
+    /// The link as described, with its nominal values.
     pub spec: LinkSpec,
     /// Index of the joint variable in `q`, if the link has a joint.
     pub joint: Option<usize>,
@@ -83,12 +88,17 @@ pub(crate) enum Step {
 /// Immutable kinematic model with its parameter registry.
 #[derive(Clone, Debug)]
 pub struct Model {
+    /// Robot name, from [`ModelSpec::name`].
     pub name: String,
+    /// Every link parameter with its nominal value, unit and status, in link order.
     pub registry: Registry,
+    /// Joints in chain order; `q[i]` drives `joints[i]` (rad or mm).
     pub joints: Vec<Joint>,
+    /// Instrument frame in the world (paper eq. 3); `None`: measurements in the world frame.
     pub instrument: Option<Link>,
     /// Base frame, links, tool frame, in chain order.
     pub links: Vec<Link>,
+    /// Points or frames attached to the tool, measured by the instrument.
     pub targets: Vec<Link>,
     pub(crate) instrument_steps: Vec<Step>,
     pub(crate) chain_steps: Vec<Step>,
@@ -287,14 +297,17 @@ impl Model {
         self.spec_at(&self.registry.nominal())
     }
 
+    /// Number of joint variables (length of `q`).
     pub fn dof(&self) -> usize {
         self.joints.len()
     }
 
+    /// Number of link parameters in the registry (length of a parameter vector).
     pub fn param_count(&self) -> usize {
         self.registry.len()
     }
 
+    /// Nominal parameter vector in registry order (mm, rad).
     pub fn nominal(&self) -> Vec<f64> {
         self.registry.nominal()
     }

@@ -59,6 +59,7 @@ pub enum LinkForm {
 }
 
 impl LinkForm {
+    /// Every form, in declaration order (lists valid names in cell-file errors).
     pub const ALL: [LinkForm; 5] = [
         LinkForm::Auto,
         LinkForm::AsGiven,
@@ -67,6 +68,7 @@ impl LinkForm {
         LinkForm::Zrp,
     ];
 
+    /// Kebab-case name used in cell files (`[robot] convention`) and on the command line.
     pub fn name(self) -> &'static str {
         match self {
             LinkForm::Auto => "auto",
@@ -77,6 +79,7 @@ impl LinkForm {
         }
     }
 
+    /// Inverse of [`LinkForm::name`]; `None` for an unknown name.
     pub fn from_name(s: &str) -> Option<LinkForm> {
         LinkForm::ALL.into_iter().find(|f| f.name() == s)
     }
@@ -85,11 +88,15 @@ impl LinkForm {
 /// One link whose form [`complete_minimal`] changed, and why.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FormChange {
+    /// Name of the changed link.
     pub link: String,
+    /// Its convention before the change (DH or MDH).
     pub from: Convention,
+    /// Its convention after (Hayati or MDH with β).
     pub to: Convention,
-    /// The joints whose axes are nearly parallel, and the angle between them (deg).
+    /// The joints whose axes are nearly parallel.
     pub joints: [String; 2],
+    /// Angle between those two axes at q = 0 (deg).
     pub angle_deg: f64,
 }
 
@@ -106,7 +113,9 @@ impl std::fmt::Display for FormChange {
 /// A chain in the form a cell asked for.
 #[derive(Clone, Debug)]
 pub struct Formed {
+    /// The chain in the requested form, with the same forward kinematics as the input.
     pub spec: ModelSpec,
+    /// Links whose convention changed, in chain order.
     pub changes: Vec<FormChange>,
     /// Nearly parallel axes left in an incomplete form, each as a sentence with its fix.
     pub incomplete: Vec<String>,

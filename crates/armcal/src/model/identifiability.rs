@@ -39,6 +39,7 @@ pub enum Measurement {
 }
 
 impl Measurement {
+    /// Parses `pose` (or `full-pose`), `position` or `distance`; `None` otherwise.
     pub fn from_name(s: &str) -> Option<Measurement> {
         match s {
             "pose" | "full-pose" => Some(Measurement::Pose),
@@ -52,9 +53,11 @@ impl Measurement {
 /// Settings of the analysis.
 #[derive(Clone, Debug)]
 pub struct IdentifiabilitySettings {
+    /// What the instrument measures: decides which Jacobian rows are stacked.
     pub measurement: Measurement,
     /// Number of random configurations (uniform within the joint limits).
     pub poses: usize,
+    /// Seed of the random configurations (same seed, same result).
     pub seed: u64,
     /// A scaled column whose component orthogonal to the kept columns is below this is
     /// dependent; also the relative singular-value threshold of the rank.
@@ -75,7 +78,10 @@ impl Default for IdentifiabilitySettings {
 /// Why a parameter is not in the identifiable set.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Exclusion {
+    /// Registry name of the excluded parameter.
     pub name: String,
+    /// Sentence: no effect on the measurement, or which kept parameters it cannot be
+    /// separated from.
     pub reason: String,
     /// Kept parameters whose combination reproduces this one's effect, with the
     /// coefficient in column-normalised units, largest first.
@@ -85,7 +91,9 @@ pub struct Exclusion {
 /// The book's completeness count for the model's joints.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Completeness {
+    /// Number of revolute joints `R`.
     pub revolute: usize,
+    /// Number of prismatic joints `P`.
     pub prismatic: usize,
     /// `4R + 2P + 6` (book eq. 2.49): parameters of a complete, minimal model of the
     /// pose of the tool relative to the world.
@@ -97,14 +105,19 @@ pub struct Completeness {
 /// Result of the analysis.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Identifiability {
+    /// Measurement type analysed.
     pub measurement: Measurement,
+    /// Number of random configurations stacked.
     pub poses: usize,
+    /// The book's parameter counts for this joint set (book eq. 2.49).
     pub completeness: Completeness,
     /// Parameters analysed (free or with prior).
     pub candidates: Vec<String>,
     /// Parameters the user or cell fixed; not analysed.
     pub fixed: Vec<String>,
+    /// Rank of the column-normalised Jacobian: singular values above `tolerance · σmax`.
     pub rank_svd: usize,
+    /// Rank by QR with column pivoting: `|R_ii|` above `tolerance · |R_00|`.
     pub rank_qr: usize,
     /// Singular values of the column-normalised Jacobian of all candidates, descending.
     pub singular_values: Vec<f64>,
@@ -112,6 +125,7 @@ pub struct Identifiability {
     pub identifiable: Vec<String>,
     /// Condition number σmax/σmin of the column-normalised Jacobian of the identifiable set.
     pub condition_number: f64,
+    /// Candidates left out of the identifiable set, each with the reason.
     pub excluded: Vec<Exclusion>,
 }
 

@@ -37,6 +37,7 @@ pub enum Rows {
 }
 
 impl Rows {
+    /// Rows per observation: 3 for position, 6 for pose.
     pub fn count(self) -> usize {
         match self {
             Rows::Position => 3,
@@ -141,6 +142,7 @@ pub struct MixedWorkspace {
 }
 
 impl MixedWorkspace {
+    /// Buffers sized for `model`, with every parameter's and joint's chain position.
     pub fn new(model: &Model) -> Self {
         let mut param_order = vec![0; model.param_count()];
         let mut joint_order = vec![0; model.dof()];

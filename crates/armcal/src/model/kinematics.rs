@@ -24,12 +24,13 @@ pub struct Data<T: RealField + Copy> {
     pub joint_twists: Vec<Twist<T>>,
     /// For every parameter, the derivative of its world twist w.r.t. the angle (or
     /// displacement) φ of its own factor. Only zero-reference screws have one (their
-    /// axis-direction and axis-point twists turn with φ, see [`apply_screw`]); every other
+    /// axis-direction and axis-point twists turn with φ, see `apply_screw`); every other
     /// parameter's twist is taken before its factor acts and its entry stays zero.
     pub param_twist_rates: Vec<Twist<T>>,
 }
 
 impl<T: RealField + Copy> Data<T> {
+    /// Buffers sized for `model`, every pose the identity and every twist zero.
     pub fn new(model: &Model) -> Self {
         Data {
             instrument: Pose::identity(),

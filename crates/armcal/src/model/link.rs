@@ -12,7 +12,9 @@ use std::fmt;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum JointKind {
+    /// Rotates by the joint variable q (rad) about the joint axis.
     Revolute,
+    /// Translates by the joint variable q (mm) along the joint axis.
     Prismatic,
 }
 
@@ -29,9 +31,13 @@ impl JointKind {
 /// A joint variable with its limits, in internal units (rad or mm).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Joint {
+    /// Joint name, as in the cell file or URDF.
     pub name: String,
+    /// Whether q is an angle (rad) or a length (mm).
     pub kind: JointKind,
+    /// Lower limit of q (rad or mm).
     pub lower: f64,
+    /// Upper limit of q (rad or mm).
     pub upper: f64,
 }
 
@@ -77,11 +83,17 @@ pub enum Convention {
 /// One elementary motion of a link.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Motion {
+    /// Rotation about the current x axis by the parameter (rad).
     Rx,
+    /// Rotation about the current y axis by the parameter (rad).
     Ry,
+    /// Rotation about the current z axis by the parameter (rad).
     Rz,
+    /// Translation along the current x axis by the parameter (mm).
     Tx,
+    /// Translation along the current y axis by the parameter (mm).
     Ty,
+    /// Translation along the current z axis by the parameter (mm).
     Tz,
     /// Rotation about the link's fixed unit axis (URDF).
     RotAxis,
@@ -90,6 +102,7 @@ pub enum Motion {
 }
 
 impl Convention {
+    /// Every convention, in declaration order (lists valid names in cell-file errors).
     pub const ALL: [Convention; 10] = [
         Convention::Dh,
         Convention::Hayati,
@@ -103,6 +116,7 @@ impl Convention {
         Convention::Point,
     ];
 
+    /// Snake-case name used in cell files and serialised models (`"dh"`, `"mdh_beta"`, …).
     pub fn name(self) -> &'static str {
         match self {
             Convention::Dh => "dh",
@@ -118,6 +132,7 @@ impl Convention {
         }
     }
 
+    /// Inverse of [`Convention::name`]; `None` for an unknown name.
     pub fn from_name(s: &str) -> Option<Convention> {
         Convention::ALL.iter().copied().find(|c| c.name() == s)
     }
@@ -271,7 +286,10 @@ impl fmt::Display for Convention {
 /// A link's geometry: a convention and its parameter values in internal units (mm, rad).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LinkGeometry {
+    /// How `values` parameterise the link transform.
     pub convention: Convention,
+    /// Parameter values (mm, rad, or unitless axis components), in the order of
+    /// [`Convention::fields`].
     pub values: Vec<f64>,
     /// The fixed joint axis of a URDF link (unit vector in the link's origin frame).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -320,6 +338,7 @@ impl LinkGeometry {
         Self::new(Convention::Point, xyz.to_vec())
     }
 
+    /// Geometry from raw values in [`Convention::fields`] order (mm, rad); no URDF axis.
     pub fn new(convention: Convention, values: Vec<f64>) -> Self {
         LinkGeometry {
             convention,

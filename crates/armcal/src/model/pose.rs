@@ -11,11 +11,14 @@ use nalgebra::{Matrix3, RealField, Vector3};
     deserialize = "T: serde::de::DeserializeOwned"
 ))]
 pub struct Pose<T: RealField + Copy> {
+    /// Rotation `R` (orthonormal, det 1) from this frame to the parent frame.
     pub rot: Matrix3<T>,
+    /// Translation `t` (mm): this frame's origin in the parent frame.
     pub trans: Vector3<T>,
 }
 
 impl<T: RealField + Copy> Pose<T> {
+    /// `R = I`, `t = 0`.
     pub fn identity() -> Self {
         Pose {
             rot: Matrix3::identity(),
@@ -31,6 +34,7 @@ impl<T: RealField + Copy> Pose<T> {
         }
     }
 
+    /// `x ↦ Rᵀ x − Rᵀ t`.
     pub fn inverse(&self) -> Pose<T> {
         let rt = self.rot.transpose();
         Pose {
@@ -39,6 +43,7 @@ impl<T: RealField + Copy> Pose<T> {
         }
     }
 
+    /// `R p + t`: the point `p` given in this frame, expressed in the parent frame (mm).
     pub fn transform_point(&self, p: &Vector3<T>) -> Vector3<T> {
         self.rot * p + self.trans
     }
@@ -104,11 +109,14 @@ impl Pose<f64> {
 /// moves with velocity `w × p + v` (book §2.4 differential transformation `δ`, `d`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Twist<T: RealField + Copy> {
+    /// Angular part `δ` (rad per unit of the differentiated variable).
     pub w: Vector3<T>,
+    /// Linear part `d`: velocity of the frame origin (mm per unit of the variable).
     pub v: Vector3<T>,
 }
 
 impl<T: RealField + Copy> Twist<T> {
+    /// `w = 0`, `v = 0`.
     pub fn zero() -> Self {
         Twist {
             w: Vector3::zeros(),
@@ -122,18 +130,21 @@ impl<T: RealField + Copy> Twist<T> {
     }
 }
 
+/// Elementary rotation by `a` (rad) about the x axis.
 pub fn rot_x<T: RealField + Copy>(a: T) -> Matrix3<T> {
     let (s, c) = a.sin_cos();
     let (o, z) = (T::one(), T::zero());
     Matrix3::new(o, z, z, z, c, -s, z, s, c)
 }
 
+/// Elementary rotation by `a` (rad) about the y axis.
 pub fn rot_y<T: RealField + Copy>(a: T) -> Matrix3<T> {
     let (s, c) = a.sin_cos();
     let (o, z) = (T::one(), T::zero());
     Matrix3::new(c, z, s, z, o, z, -s, z, c)
 }
 
+/// Elementary rotation by `a` (rad) about the z axis.
 pub fn rot_z<T: RealField + Copy>(a: T) -> Matrix3<T> {
     let (s, c) = a.sin_cos();
     let (o, z) = (T::one(), T::zero());

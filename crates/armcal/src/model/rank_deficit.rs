@@ -28,9 +28,11 @@ const ON_AXIS_MM: f64 = 1e-3;
 /// A rank below the generic count, and why.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RankDeficit {
+    /// Measurement type the rank was computed for.
     pub measurement: Measurement,
     /// The generic count for the measurement type.
     pub expected: usize,
+    /// Size of the identifiable set found numerically (below `expected`).
     pub identifiable: usize,
     /// One sentence per cause found, each with its fix.
     pub causes: Vec<String>,

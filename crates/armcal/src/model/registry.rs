@@ -47,10 +47,14 @@ pub enum Status {
     /// Held at its nominal value.
     Fixed,
     /// Estimated, with a Gaussian prior centred on the nominal value (σ in internal units).
-    Prior { sigma: f64 },
+    Prior {
+        /// Standard deviation of the prior (mm or rad, the parameter's internal unit).
+        sigma: f64,
+    },
 }
 
 impl Status {
+    /// True unless [`Status::Fixed`]: free and prior parameters are both estimated.
     pub fn is_free(&self) -> bool {
         !matches!(self, Status::Fixed)
     }
@@ -69,14 +73,18 @@ pub enum Segment {
     Target(usize),
 }
 
+/// One named scalar of a model: a link, frame or target field.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Parameter {
     /// Stable name, `<frame>.<field>`.
     pub name: String,
+    /// Unit of `nominal` (mm, rad or unitless).
     pub unit: Unit,
     /// Nominal value in internal units (mm, rad).
     pub nominal: f64,
+    /// Whether the identification estimates it, holds it, or estimates it with a prior.
     pub status: Status,
+    /// Instrument, chain or target: which targets it moves.
     pub segment: Segment,
 }
 
@@ -96,6 +104,7 @@ pub struct Registry {
 }
 
 impl Registry {
+    /// Registry with no parameters.
     pub fn new() -> Self {
         Self::default()
     }
@@ -125,22 +134,27 @@ impl Registry {
         Ok(i)
     }
 
+    /// Number of parameters (length of a parameter vector).
     pub fn len(&self) -> usize {
         self.params.len()
     }
 
+    /// True if the registry has no parameters.
     pub fn is_empty(&self) -> bool {
         self.params.is_empty()
     }
 
+    /// Parameter at index `i`; panics if out of range.
     pub fn get(&self, i: usize) -> &Parameter {
         &self.params[i]
     }
 
+    /// Parameters in index order.
     pub fn iter(&self) -> impl Iterator<Item = &Parameter> {
         self.params.iter()
     }
 
+    /// Index of the parameter with this exact name, if any.
     pub fn index_of(&self, name: &str) -> Option<usize> {
         self.index.get(name).copied()
     }
@@ -200,6 +214,7 @@ impl Registry {
         Ok(out)
     }
 
+    /// Sets whether parameter `i` is free, fixed or has a prior.
     pub fn set_status(&mut self, i: usize, status: Status) {
         self.params[i].status = status;
     }
