@@ -44,7 +44,7 @@ use serde::{Deserialize, Serialize};
 pub enum Method {
     /// Levenberg–Marquardt ([`levenberg_marquardt`], book §4.3).
     Lm,
-    /// Damped Gauss–Newton ([`gauss_newton`], book eqs. 4.22–4.27).
+    /// Damped Gauss–Newton ([`gauss_newton()`], book eqs. 4.22–4.27).
     GaussNewton,
     /// Iterated Kalman filter ([`kalman_filter`], book §4.3.3, §4.5.4).
     Kalman,
