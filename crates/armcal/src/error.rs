@@ -20,7 +20,12 @@ pub enum Error {
     Output(String),
     /// A file could not be read or parsed; the message gives file, line and field.
     #[error("{file}: {message}")]
-    File { file: String, message: String },
+    File {
+        /// Path of the file.
+        file: String,
+        /// What is wrong, with line and field where known.
+        message: String,
+    },
     /// A conversion between conventions that cannot be done exactly.
     #[error("conversion: {0}")]
     Conversion(String),
@@ -29,4 +34,5 @@ pub enum Error {
     Io(#[from] std::io::Error),
 }
 
+/// `std::result::Result` with armcal's [`Error`] as default error type.
 pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -15,7 +15,10 @@ use serde::{Deserialize, Serialize};
 pub enum Status {
     /// A convergence criterion was met; `criterion` says which (empty: the solver's own
     /// tolerance, nothing more to say).
-    Converged { criterion: String },
+    Converged {
+        /// Which criterion was met (e.g. step or gradient tolerance); may be empty.
+        criterion: String,
+    },
     /// The iteration limit was reached before convergence.
     #[serde(rename = "max-iterations")]
     IterationLimit,
@@ -23,11 +26,20 @@ pub enum Status {
     TimeLimit,
     /// No step makes progress any more, away from a proven optimum (a failed line search, a
     /// singular configuration).
-    Stalled { reason: String },
+    Stalled {
+        /// Why no step progresses.
+        reason: String,
+    },
     /// The constraints (joint limits, reach) admit no solution.
-    Infeasible { reason: String },
+    Infeasible {
+        /// Which constraint cannot be met.
+        reason: String,
+    },
     /// The iteration failed (non-finite values, or no step reduces the cost).
-    Diverged { reason: String },
+    Diverged {
+        /// What failed.
+        reason: String,
+    },
 }
 
 impl std::fmt::Display for Status {

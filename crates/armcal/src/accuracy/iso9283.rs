@@ -9,9 +9,13 @@ use serde::{Deserialize, Serialize};
 /// `S_l = √(Σ(l_j − l̄)²/(n − 1))`, and `RP = l̄ + 3 S_l`.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Repeatability {
+    /// Number of attained positions `n`.
     pub n: usize,
+    /// Barycentre x̄ of the attained positions (mm, measurement frame).
     pub barycentre: Vector3<f64>,
+    /// Mean distance l̄ of the positions from the barycentre (mm).
     pub mean_distance: f64,
+    /// Sample standard deviation S_l of those distances, with `n − 1` (mm).
     pub std_distance: f64,
     /// RP = l̄ + 3 S_l (mm).
     pub rp: f64,
@@ -40,9 +44,13 @@ pub fn position_repeatability(points: &[Vector3<f64>]) -> Option<Repeatability> 
 /// attained positions and the commanded position.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Accuracy {
+    /// AP = |x̄ − x_c| (mm).
     pub ap: f64,
+    /// x component of x̄ − x_c (mm).
     pub apx: f64,
+    /// y component of x̄ − x_c (mm).
     pub apy: f64,
+    /// z component of x̄ − x_c (mm).
     pub apz: f64,
 }
 

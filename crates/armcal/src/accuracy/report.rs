@@ -11,7 +11,9 @@ use serde::{Deserialize, Serialize};
 /// ISO 9283 figures of one commanded pose (a configuration measured several times).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct PoseFigures {
+    /// Configuration id (from the dataset) of the first measurement of the pose.
     pub pose_id: String,
+    /// RP of the positions attained at this pose; `None` if measured only once.
     pub repeatability: Option<Repeatability>,
     /// AP against the model's prediction (the commanded position).
     pub accuracy: Accuracy,
@@ -22,8 +24,9 @@ pub struct PoseFigures {
 pub struct AccuracyReport {
     /// |measured − predicted| of every position measurement (mm).
     pub errors: ErrorStats,
+    /// ISO 9283 figures per commanded pose and observed point.
     pub poses: Vec<PoseFigures>,
-    /// Largest RP over poses measured at least twice.
+    /// Largest RP over poses measured at least twice (mm).
     pub worst_rp: Option<f64>,
 }
 

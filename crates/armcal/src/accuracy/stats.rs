@@ -6,14 +6,20 @@ use serde::{Deserialize, Serialize};
 /// Summary statistics of absolute errors (mm).
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct ErrorStats {
+    /// Number of values.
     pub count: usize,
+    /// Mean of |e| (mm).
     pub mean: f64,
+    /// Root mean square √(Σe²/n) (mm).
     pub rms: f64,
+    /// Largest |e| (mm).
     pub max: f64,
+    /// 95th percentile of |e|, linear interpolation between order statistics (mm).
     pub p95: f64,
 }
 
 impl ErrorStats {
+    /// Statistics of the absolute values of `values`; all zero for an empty slice.
     pub fn of(values: &[f64]) -> ErrorStats {
         if values.is_empty() {
             return ErrorStats::default();

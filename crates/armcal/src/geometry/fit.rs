@@ -89,10 +89,12 @@ impl AxisCovariance {
 /// A circle in space.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Circle {
+    /// Centre (mm, in the points' frame).
     pub centre: Vector3<f64>,
     /// Unit normal, oriented so that the points, in the order given, turn positively
     /// (right-handed) about it.
     pub normal: Vector3<f64>,
+    /// Radius (mm).
     pub radius: f64,
     /// RMS distance of the points from the circle (in-plane and out-of-plane parts), mm.
     pub rms: f64,

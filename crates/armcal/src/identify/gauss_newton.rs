@@ -25,6 +25,8 @@ const ARMIJO: f64 = 1e-4;
 /// Step halvings before the direction counts as giving no decrease (α ≥ 2⁻⁴⁰).
 const HALVINGS: usize = 40;
 
+/// Minimises ½‖r(p)‖² over the problem's free parameters by damped Gauss–Newton from
+/// `start` (full parameter vector), stopping by `tol`.
 pub fn gauss_newton(
     problem: &Problem,
     start: &[f64],

@@ -30,9 +30,11 @@ use std::time::Instant;
 /// Settings of [`kalman_filter`].
 #[derive(Clone, Debug)]
 pub struct KalmanSettings {
+    /// Stopping rules; `max_iterations` counts filter passes.
     pub tolerances: ToleranceSettings,
-    /// Prior standard deviation of length parameters (mm) and of angles (rad).
+    /// Prior standard deviation of length parameters in the first pass (mm).
     pub prior_length: f64,
+    /// Prior standard deviation of angle parameters in the first pass (rad).
     pub prior_angle: f64,
 }
 
@@ -54,12 +56,16 @@ const INFLATION: f64 = 1e4;
 /// Largest change of a parameter in a converged pass, in posterior standard deviations.
 const STEP_IN_SIGMA: f64 = 1e-7;
 
+/// Result of [`kalman_filter`].
 pub struct KalmanResult {
+    /// The estimate, with the whitened residual and Jacobian at it.
     pub solution: SolverResult,
     /// Covariance of the free parameters after the last pass.
     pub covariance: DMatrix<f64>,
 }
 
+/// Minimises ½‖r(p)‖² over the problem's free parameters by iterated Kalman filter passes
+/// from `start` (full parameter vector); see the module documentation.
 pub fn kalman_filter(
     problem: &Problem,
     start: &[f64],

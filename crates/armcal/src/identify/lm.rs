@@ -18,6 +18,7 @@ use std::time::Instant;
 /// Settings of [`levenberg_marquardt`].
 #[derive(Clone, Debug)]
 pub struct LmSettings {
+    /// Stopping rules.
     pub tolerances: ToleranceSettings,
     /// Initial damping relative to the scaling (Marquardt's λ₀).
     pub mu0: f64,

@@ -42,12 +42,16 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
+    /// Levenberg–Marquardt ([`levenberg_marquardt`], book §4.3).
     Lm,
+    /// Damped Gauss–Newton ([`gauss_newton()`], book eqs. 4.22–4.27).
     GaussNewton,
+    /// Iterated Kalman filter ([`kalman_filter`], book §4.3.3, §4.5.4).
     Kalman,
 }
 
 impl Method {
+    /// The method named `lm`, `gn` / `gauss-newton` or `kalman`; `None` for another name.
     pub fn from_name(s: &str) -> Option<Method> {
         match s {
             "lm" => Some(Method::Lm),
@@ -61,14 +65,20 @@ impl Method {
 /// Settings of [`identify`].
 #[derive(Clone, Debug)]
 pub struct IdentifySettings {
+    /// Solver of the fit.
     pub method: Method,
+    /// Robust loss for an IRLS fit ([`robust_fit`], always with Levenberg–Marquardt);
+    /// `None`: plain least squares.
     pub robust: Option<Loss>,
     /// Fraction of configurations held out for validation, in [0, 1) (0: none).
     pub holdout: f64,
     /// Validation data of the same cell (the user's own held-out file): the whole `data`
     /// is fitted and validated on these configurations. Excludes `holdout`.
     pub test: Option<Dataset>,
+    /// Seed of the random choice of held-out configurations.
     pub seed: u64,
+    /// Settings of Levenberg–Marquardt (also inside a robust fit); Gauss–Newton stops by
+    /// its tolerances.
     pub lm: LmSettings,
 }
 
@@ -88,31 +98,45 @@ impl Default for IdentifySettings {
 /// One parameter in the estimate report (display units: mm, deg).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ParameterEstimate {
+    /// Parameter name in the model's registry.
     pub name: String,
+    /// Display unit: `mm` or `deg`.
     pub unit: String,
+    /// Nominal value (display unit).
     pub nominal: f64,
+    /// Value at the solution (display unit).
     pub estimate: f64,
     /// Standard deviation (display unit); `None` for fixed parameters.
     pub sigma: Option<f64>,
+    /// Whether the parameter was estimated.
     pub free: bool,
 }
 
 /// Solver statistics.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SolverReport {
+    /// Solver used.
     pub method: Method,
+    /// Robust loss of an IRLS fit; `None` for plain least squares.
     pub robust: Option<Loss>,
+    /// How the (last) solver run ended.
     pub status: Status,
+    /// Iterations of the last solver run.
     pub iterations: usize,
+    /// Wall-clock time of the last solver run (ms).
     pub time_ms: f64,
+    /// Cost ½‖r‖² of the whitened residual after each iteration (index 0: the start).
     pub history: Vec<f64>,
 }
 
 /// Residual statistics per axis (mm) of the position-bearing measurements.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ResidualReport {
+    /// x components of the position residuals (instrument frame, mm).
     pub x: ErrorStats,
+    /// y components of the position residuals (instrument frame, mm).
     pub y: ErrorStats,
+    /// z components of the position residuals (instrument frame, mm).
     pub z: ErrorStats,
     /// Euclidean position error per measurement (scalar error for distances and planes).
     pub norm: ErrorStats,
@@ -126,8 +150,9 @@ pub struct ResidualReport {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct MeasurementResidual {
     /// The configuration's number in the data file (1-based, in the file's order, also
-    /// when part of the file was held out) and its `pose_id` in the file.
+    /// when part of the file was held out).
     pub pose: usize,
+    /// The configuration's `pose_id` in the data file.
     pub pose_id: String,
     /// Position residual x, y, z (mm); `None` for distance and plane measurements.
     pub xyz: Option<[f64; 3]>,
@@ -142,12 +167,15 @@ pub struct Validation {
     /// test data file.
     #[serde(default)]
     pub test_data: String,
+    /// Number of configurations fitted.
     pub train_configurations: usize,
+    /// Number of configurations validated on.
     pub test_configurations: usize,
-    /// The `pose_id`s of the fitted configurations (data file) and of the validation
-    /// configurations (data file, or the test file), in file order.
+    /// The `pose_id`s of the fitted configurations (data file), in file order.
     #[serde(default)]
     pub train_ids: Vec<String>,
+    /// The `pose_id`s of the validation configurations (data file, or the test file), in
+    /// file order.
     #[serde(default)]
     pub test_ids: Vec<String>,
     /// Nominal model, nothing fitted.
@@ -162,10 +190,13 @@ pub struct Validation {
 /// Everything an identification produced: what `estimate.json` holds.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Estimate {
+    /// Name of the cell.
     pub cell: String,
+    /// Where the fitted data came from ([`Dataset::source`]).
     pub data: String,
     /// The identified model (internal units: mm, rad), for predict / compensate / export.
     pub model: ModelSpec,
+    /// Every model parameter, free or fixed, in registry order (display units).
     pub parameters: Vec<ParameterEstimate>,
     /// Why each parameter not estimated was left out (identifiability analysis).
     pub fixed_reasons: Vec<(String, String)>,
@@ -173,16 +204,22 @@ pub struct Estimate {
     /// data), if so.
     #[serde(default)]
     pub rank_deficit: Option<RankDeficit>,
+    /// Solver statistics of the fit.
     pub solver: SolverReport,
+    /// C_p, σ's, correlations and the χ² test of the free parameters (internal units).
     pub uncertainty: ParameterUncertainty,
     /// Names of the free parameters, the order of C_p.
     pub free: Vec<String>,
+    /// Pairs of free parameters with correlation |ρ| > 0.95, and ρ.
     pub strong_correlations: Vec<(String, String, f64)>,
     /// C_s = G C_p Gᵀ at each working configuration.
     pub tcp: Vec<TcpCovariance>,
     /// C_s by the constrained formulation (paper eq. 19), same order.
     pub tcp_constrained: Vec<Matrix3<f64>>,
+    /// Observability indices of the data rows of the whitened Jacobian at the solution
+    /// (book §4.5.3, paper eqs. 8–10).
     pub observability: Observability,
+    /// Residuals of the fitted data, `model − measured` (mm).
     pub residuals: ResidualReport,
     /// Measurements a robust fit left out (of the χ² test and C_p too).
     pub outliers: Vec<Outlier>,
@@ -190,9 +227,14 @@ pub struct Estimate {
     /// closer (the estimate is reported in the equivalent set nearest the nominal).
     #[serde(default)]
     pub far_from_nominal: Vec<crate::model::branch::FarAngle>,
+    /// Robust scale of the whitened residuals at the end of an IRLS fit (≈ 1 if σ is
+    /// right); `None` for plain least squares.
     pub robust_scale: Option<f64>,
+    /// Held-out validation; `None` without held-out or test data.
     pub validation: Option<Validation>,
+    /// Number of measurements fitted (the training part).
     pub measurements: usize,
+    /// Number of configurations fitted (the training part).
     pub configurations: usize,
     /// Solver, χ² and identifiability verdicts; `None` in files of an older armcal, which
     /// consumers treat as unverified ([`Estimate::check_usable`]).

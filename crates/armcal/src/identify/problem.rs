@@ -15,17 +15,22 @@ use nalgebra::{DMatrix, DVector};
 pub struct Prior {
     /// Column (index into the free set).
     pub column: usize,
+    /// Prior mean: the parameter's nominal value (internal units: mm, rad).
     pub mean: f64,
+    /// Prior standard deviation (internal units: mm, rad).
     pub sigma: f64,
 }
 
 /// Data of an identification problem; immutable, shareable.
 #[derive(Clone, Debug)]
 pub struct Problem<'a> {
+    /// The model whose parameters are identified.
     pub model: &'a Model,
+    /// The measurements.
     pub data: &'a Dataset,
     /// Parameter index of each estimated column.
     pub free: Vec<usize>,
+    /// Prior rows, appended after the data rows in this order.
     pub priors: Vec<Prior>,
     /// σ of every data row, in row order.
     pub sigmas: Vec<f64>,
@@ -183,10 +188,12 @@ impl<'a> Problem<'a> {
         self.sigmas.len()
     }
 
+    /// Columns of the Jacobian: the number of free parameters.
     pub fn columns(&self) -> usize {
         self.free.len()
     }
 
+    /// Buffers for evaluating this problem.
     pub fn workspace(&self) -> Workspace {
         Workspace {
             data: Data::new(self.model),

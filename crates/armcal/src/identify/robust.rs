@@ -20,11 +20,14 @@ use statrs::distribution::{ChiSquared, ContinuousCDF};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Loss {
+    /// Huber: `w = min(1, k/e)`, k = 1.345.
     Huber,
+    /// Cauchy: `w = 1/(1 + (e/c)²)`, c = 2.385.
     Cauchy,
 }
 
 impl Loss {
+    /// The loss named `huber` or `cauchy`; `None` for another name.
     pub fn from_name(s: &str) -> Option<Loss> {
         match s {
             "huber" => Some(Loss::Huber),
@@ -58,6 +61,7 @@ pub struct Outlier {
     pub measurement: usize,
     /// Data-file line (0 for synthetic data).
     pub line: usize,
+    /// `pose_id` of the measurement's configuration.
     pub configuration: String,
     /// ‖r_i‖ / s: the whitened residual norm in robust-scale units.
     pub standardized: f64,
@@ -65,13 +69,16 @@ pub struct Outlier {
     pub weight: f64,
 }
 
+/// Result of [`robust_fit`].
 pub struct RobustResult {
     /// The final fit; its residual and Jacobian are those of the kept measurements with
     /// weight 1 (the rows of the outliers removed, prior rows kept).
     pub solution: SolverResult,
+    /// Measurements whose `‖r_i‖²/s²` exceeds the χ²(rows) 99.9 % quantile.
     pub outliers: Vec<Outlier>,
     /// Robust scale of the whitened residuals at the end (≈ 1 if σ is right).
     pub scale: f64,
+    /// Number of reweightings done (at most 30).
     pub reweightings: usize,
 }
 

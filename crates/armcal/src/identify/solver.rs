@@ -11,17 +11,22 @@ use std::time::Duration;
 pub struct SolverResult {
     /// Full parameter vector at the end.
     pub params: Vec<f64>,
+    /// How the solver ended.
     pub status: Status,
+    /// Iterations done.
     pub iterations: usize,
     /// Cost ½‖r‖² after each iteration (index 0: the start).
     pub history: Vec<f64>,
+    /// Wall-clock time of the run.
     pub time: Duration,
-    /// Whitened residual and Jacobian at the solution.
+    /// Whitened residual at the solution (data rows, then prior rows).
     pub residual: DVector<f64>,
+    /// Whitened Jacobian at the solution, one column per free parameter.
     pub jacobian: DMatrix<f64>,
 }
 
 impl SolverResult {
+    /// Cost ½‖r‖² of the whitened residual at the solution.
     pub fn cost(&self) -> f64 {
         0.5 * self.residual.norm_squared()
     }
@@ -48,6 +53,7 @@ impl SolverResult {
 /// Stopping rules shared by the iterative solvers.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ToleranceSettings {
+    /// Largest number of iterations.
     pub max_iterations: usize,
     /// Relative reduction of the cost (actual and predicted) below which to stop.
     pub ftol: f64,

@@ -16,6 +16,7 @@ pub struct ParameterUncertainty {
     pub covariance: DMatrix<f64>,
     /// √diag(C_p).
     pub sigma: Vec<f64>,
+    /// Correlation matrix `ρ_ab = C_p[a,b] / (σ_a σ_b)`.
     pub correlation: DMatrix<f64>,
     /// Pairs of free-parameter columns with |ρ| > 0.95, and ρ.
     pub strong_correlations: Vec<(usize, usize, f64)>,
@@ -38,6 +39,7 @@ pub struct ParameterUncertainty {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Chi2Outcome {
+    /// `0.025 ≤ P(χ² ≥ rᵀr) ≤ 0.975`: the residuals agree with the stated σ.
     Consistent,
     /// Residuals too large: the stated σ is too small (or model error, or outliers).
     SigmaTooSmall,
@@ -61,6 +63,7 @@ impl Chi2Outcome {
         }
     }
 
+    /// One phrase for the outcome (the text of [`ParameterUncertainty::verdict`]).
     pub fn describe(self) -> &'static str {
         match self {
             Chi2Outcome::Consistent => "consistent with the stated σ",
@@ -160,6 +163,7 @@ pub fn information_inverse(info: &DMatrix<f64>, names: &[String]) -> Result<DMat
 /// configuration.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct TcpCovariance {
+    /// Name of the working configuration.
     pub name: String,
     /// `C_s = G C_p Gᵀ` (mm²), G = ∂TCP/∂p.
     pub covariance: Matrix3<f64>,
@@ -240,15 +244,23 @@ pub fn tcp_covariance_constrained(
 /// column-normalised Jacobian (unit-free; book eq. 4.174 corrected: κ of J, not of JᵀJ).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Observability {
+    /// O1 = (σ₁⋯σₙ)^{1/n}/√m (Borm & Menq).
     pub o1: f64,
+    /// O2 = σₙ/σ₁, the inverse condition number.
     pub o2: f64,
+    /// O3 = σₙ, the minimum singular value.
     pub o3: f64,
+    /// O4 = σₙ²/σ₁, the noise amplification index.
     pub o4: f64,
+    /// O5 = 1/Σ(1/σᵢ).
     pub o5: f64,
+    /// σ₁/σₙ of the column-normalised Jacobian (unit-free; book eq. 4.174 corrected).
     pub condition_number: f64,
+    /// Singular values σ₁ ≥ … ≥ σₙ of the Jacobian as given (not column-normalised).
     pub singular_values: Vec<f64>,
 }
 
+/// The observability indices of the whitened identification Jacobian `j` ([`Observability`]).
 pub fn observability(j: &DMatrix<f64>) -> Observability {
     let m = j.nrows() as f64;
     let mut s: Vec<f64> = j

@@ -16,7 +16,9 @@ use serde::{Deserialize, Serialize};
 pub struct Verdicts {
     /// How the solver ended.
     pub solver: Status,
+    /// Whether the residuals agree with the stated σ.
     pub chi2: Chi2Verdict,
+    /// How many parameters were identified of the generic count.
     pub identifiability: IdentifiabilityVerdict,
 }
 
@@ -29,6 +31,7 @@ pub struct Verdicts {
 /// reported σ's are off by k ≈ √σ̂₀².
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Chi2Verdict {
+    /// Result of the two-sided test at 5 %.
     pub outcome: Chi2Outcome,
     /// P(χ² ≥ rᵀr); `None` without redundancy.
     pub p_value: Option<f64>,
@@ -36,12 +39,14 @@ pub struct Chi2Verdict {
     pub variance_factor: Option<f64>,
     /// √σ̂₀²: how many times larger the residuals are than the stated σ predicts.
     pub sigma_ratio: Option<f64>,
+    /// Degrees of freedom m − n (rows minus free parameters).
     pub dof: usize,
     /// One sentence: what the verdict means for the reported σ's.
     pub meaning: String,
 }
 
 impl Chi2Verdict {
+    /// The verdict of the χ² test recorded in `u`.
     pub fn of(u: &ParameterUncertainty) -> Chi2Verdict {
         let outcome = Chi2Outcome::of(u.dof, u.p_value);
         let finite = |x: f64| Some(x).filter(|x| x.is_finite());
@@ -85,6 +90,7 @@ impl Chi2Verdict {
 /// in generic geometry ([`expected_count`]).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct IdentifiabilityVerdict {
+    /// The cell's measurement type (position, pose, distance).
     pub measurement: Measurement,
     /// Number of parameters estimated.
     pub identified: usize,
@@ -92,10 +98,13 @@ pub struct IdentifiabilityVerdict {
     pub expected: Option<usize>,
     /// Parameters left out with a reason (see the estimate's `fixed_reasons`).
     pub fixed: Vec<String>,
+    /// One sentence: identified against expected, and why fewer if so.
     pub meaning: String,
 }
 
 impl IdentifiabilityVerdict {
+    /// The verdict for `identified` parameters estimated from `measurement` data, with the
+    /// parameters fixed for a reason and the rank deficit that explains a shortfall.
     pub fn of(
         model: &Model,
         measurement: Measurement,

@@ -23,6 +23,7 @@ use std::path::Path;
 /// What the reader found besides the data.
 #[derive(Clone, Debug, Default)]
 pub struct ReadReport {
+    /// Header names of the columns the reader did not use.
     pub ignored: Vec<String>,
 }
 

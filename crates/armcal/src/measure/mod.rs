@@ -24,6 +24,7 @@ use serde::{Deserialize, Serialize};
 pub enum MeasurementKind {
     /// Position of the observed point in the instrument frame (mm).
     Position {
+        /// Measured position (mm, instrument frame).
         value: Vector3<f64>,
         /// σ per axis (mm) from the data file, if it gives one.
         sigma: Option<Vector3<f64>>,
@@ -31,6 +32,7 @@ pub enum MeasurementKind {
     /// Full pose of the observed frame in the instrument frame: position (mm) and rotation.
     /// Residual rows: position error, then the rotation vector of `R_model R_measᵀ` (rad).
     Pose {
+        /// Measured pose of the observed frame (instrument frame; translation in mm).
         value: Pose<f64>,
         /// σ of the 3 position rows (mm) and the 3 rotation rows (rad).
         sigma: Option<[f64; 6]>,
@@ -38,21 +40,31 @@ pub enum MeasurementKind {
     /// Distance between the observed point at this configuration and at configuration
     /// `other` (mm): a ball bar or a two-socket tool between two poses.
     Distance {
+        /// Index of the other configuration in [`Dataset::configurations`].
         other: usize,
+        /// Measured distance (mm).
         value: f64,
+        /// σ of the distance (mm) from the data file, if it gives one.
         sigma: Option<f64>,
     },
     /// Distance from the observed point to a fixed point given in the instrument frame (mm):
     /// a ball bar on a fixed pivot.
     DistanceToPoint {
+        /// The fixed point (mm, instrument frame).
         point: Vector3<f64>,
+        /// Measured distance (mm).
         value: f64,
+        /// σ of the distance (mm) from the data file, if it gives one.
         sigma: Option<f64>,
     },
     /// The observed point lies on the plane `normal · x = offset` (instrument frame, mm).
     OnPlane {
+        /// Plane normal (instrument frame; normalised before use).
         normal: Vector3<f64>,
+        /// Signed distance of the plane from the instrument origin along the unit normal
+        /// (mm); the residual is `n̂ · x − offset`.
         offset: f64,
+        /// σ of the distance to the plane (mm) from the data file, if it gives one.
         sigma: Option<f64>,
     },
 }
@@ -67,6 +79,7 @@ impl MeasurementKind {
         }
     }
 
+    /// The kind's name, as in the serialised `kind` tag (`position`, `distance-to-point`, …).
     pub fn name(&self) -> &'static str {
         match self {
             MeasurementKind::Position { .. } => "position",
@@ -84,7 +97,9 @@ impl MeasurementKind {
 pub struct Measurement {
     /// Index into [`Dataset::configurations`].
     pub config: usize,
+    /// The target or tool frame that was measured.
     pub observed: Observed,
+    /// What was measured, with value and optional σ.
     pub kind: MeasurementKind,
     /// Line in the data file (1-based, header = 1), 0 for synthetic data.
     pub line: usize,
@@ -97,6 +112,7 @@ pub struct Dataset {
     pub configurations: Vec<Vec<f64>>,
     /// A user-facing id per configuration (the data file's `pose_id`).
     pub config_ids: Vec<String>,
+    /// Every measurement, each referring to a configuration by index.
     pub measurements: Vec<Measurement>,
     /// Where the data came from.
     pub source: String,

@@ -11,13 +11,26 @@ use serde::{Deserialize, Serialize};
 pub enum NoiseModel {
     /// Independent N(0, σ²) per position axis (mm); `sigma_angle` (rad) for the rotation
     /// rows of pose measurements. One-row blocks (distances, planes) use σ of the x axis.
-    Constant { sigma: [f64; 3], sigma_angle: f64 },
+    Constant {
+        /// σ of the x, y, z position rows (mm).
+        sigma: [f64; 3],
+        /// σ of each rotation row of a pose measurement (rad).
+        sigma_angle: f64,
+    },
     /// Laser-tracker style σ = a + b · range per axis: `a` in mm, `b_per_m` in mm per metre
     /// of distance from the instrument (e.g. 0.015 mm + 0.006 mm/m).
-    Range { a: f64, b_per_m: f64 },
+    Range {
+        /// Constant part of σ (mm).
+        a: f64,
+        /// Growth of σ with the range (mm per m).
+        b_per_m: f64,
+    },
     /// σ per measurement, read from the data file; values below `floor` (mm) are raised to
     /// it (a stated uncertainty of 0 would give an infinite weight).
-    PerMeasurement { floor: f64 },
+    PerMeasurement {
+        /// Smallest σ of any row (mm; the same number in rad for rotation rows).
+        floor: f64,
+    },
 }
 
 impl Default for NoiseModel {

@@ -13,11 +13,15 @@ use nalgebra::{DMatrix, Vector3};
 /// frame and the 6 × n identification Jacobian (position rows, then rotation rows).
 #[derive(Clone, Debug)]
 pub struct Prediction {
+    /// Pose of the observed frame in the instrument frame (translation in mm).
     pub pose: Pose<f64>,
+    /// 6 × n Jacobian of that pose with respect to the n free parameters: position rows
+    /// (mm per parameter unit), then rotation rows (rad per parameter unit).
     pub jac: DMatrix<f64>,
 }
 
 impl Prediction {
+    /// Identity pose and a zero 6 × `columns` Jacobian, to be filled by the model.
     pub fn new(columns: usize) -> Self {
         Prediction {
             pose: Pose::identity(),

@@ -22,8 +22,11 @@ use serde::{Deserialize, Serialize};
 pub struct Capsule {
     /// Name of the chain frame (`base`, `j1`, …, `tool`) the capsule moves with.
     pub frame: String,
+    /// First end of the axis segment (mm, in `frame`).
     pub a: [f64; 3],
+    /// Second end of the axis segment (mm, in `frame`).
     pub b: [f64; 3],
+    /// Radius of the swept sphere (mm).
     pub radius: f64,
 }
 

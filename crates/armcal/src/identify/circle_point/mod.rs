@@ -53,7 +53,9 @@ pub fn span_for_limits(r: f64, n: usize, sigma: f64) -> Option<f64> {
 pub struct JointSweep {
     /// Index of the swept joint (0-based).
     pub joint: usize,
+    /// Full joint vector of each measurement (rad, mm).
     pub q: Vec<Vec<f64>>,
+    /// Measured target position at each joint vector (instrument frame, mm).
     pub points: Vec<Vector3<f64>>,
 }
 
@@ -63,6 +65,7 @@ pub struct JointSweep {
 pub struct JointAxis {
     /// Name of the joint's link in the model (e.g. `j3`).
     pub link: String,
+    /// The model's joint: name, kind and limits.
     pub joint: Joint,
     /// Unit direction: a positive joint motion turns positively about it (revolute) or
     /// moves along it (prismatic).
@@ -96,7 +99,9 @@ pub struct JointAxis {
 /// The axes of all joints, in joint order.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AxesResult {
+    /// Name of the model the axes were identified for.
     pub model: String,
+    /// One axis per joint, in joint order.
     pub axes: Vec<JointAxis>,
 }
 
