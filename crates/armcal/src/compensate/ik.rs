@@ -27,6 +27,8 @@
 //! inside the iterations.
 
 use crate::compensate::closed_form::{NoClosedForm, SphericalWristIk};
+pub use crate::compensate::damped_step::{damped_step, task_jacobian_columns};
+use crate::compensate::damped_step::{normal_matrix, smallest_eigenvalue, step_from};
 use crate::model::pose::rotation_log;
 use crate::model::{forward_kinematics, Data, JointKind, Model, Pose};
 use crate::solve::Status;
@@ -251,98 +253,6 @@ fn weighted_error<const R: usize>(
     };
     let e = Vector6::new(d.x, d.y, d.z, w.x * length, w.y * length, w.z * length);
     (e.fixed_rows::<R>(0).into_owned(), d.norm(), w.norm())
-}
-
-/// Columns of the weighted task Jacobian `Q^{1/2} J` of the tool frame, one per joint, from
-/// evaluated kinematics: joint j's world twist (ω, v) moves the tool origin p with
-/// `ω × p + v` (rows 0–2) and turns it with ω, scaled by L (rows 3–5).
-pub fn task_jacobian_columns(data: &Data<f64>, length: f64, columns: &mut [Vector6<f64>]) {
-    let p = data.tool().trans;
-    for (col, tw) in columns.iter_mut().zip(&data.joint_twists) {
-        let v = tw.point_velocity(&p);
-        *col = Vector6::new(
-            v.x,
-            v.y,
-            v.z,
-            tw.w.x * length,
-            tw.w.y * length,
-            tw.w.z * length,
-        );
-    }
-}
-
-/// `J_w J_wᵀ` over the first R rows.
-fn normal_matrix<const R: usize>(columns: &[Vector6<f64>]) -> SMatrix<f64, R, R> {
-    let mut a = SMatrix::<f64, R, R>::zeros();
-    for c in columns {
-        let j = c.fixed_rows::<R>(0);
-        a += j * j.transpose();
-    }
-    a
-}
-
-/// `Δq = J_wᵀ (A + γ² I)⁻¹ e` with `A = J_w J_wᵀ` into `step`; `false` if `A + γ² I` is
-/// not positive definite.
-fn step_from<const R: usize>(
-    a: &SMatrix<f64, R, R>,
-    columns: &[Vector6<f64>],
-    e: &SVector<f64, R>,
-    gamma2: f64,
-    step: &mut [f64],
-) -> bool {
-    let Some(ch) = Cholesky::new(a + SMatrix::<f64, R, R>::identity() * gamma2) else {
-        return false;
-    };
-    let y = ch.solve(e);
-    for (s, c) in step.iter_mut().zip(columns) {
-        *s = c.fixed_rows::<R>(0).dot(&y);
-    }
-    true
-}
-
-/// The one-step optimal compensator (book eqs. 5.85–5.87 with one stage), in task-space
-/// form: `Δq = J_wᵀ (J_w J_wᵀ + γ² I)⁻¹ e_w = (J_wᵀJ_w + γ² I)⁻¹ J_wᵀ e_w`, from the columns
-/// of the weighted Jacobian (first R rows) and the weighted error. Writes `step` (one
-/// value per column); `false` if the damped matrix is not positive definite (γ = 0 at an
-/// exact singularity).
-pub fn damped_step<const R: usize>(
-    columns: &[Vector6<f64>],
-    e: &SVector<f64, R>,
-    gamma2: f64,
-    step: &mut [f64],
-) -> bool {
-    step_from(&normal_matrix::<R>(columns), columns, e, gamma2, step)
-}
-
-/// Smallest eigenvalue of the symmetric positive semi-definite `a` (σ_min² of J_w) by
-/// inverse iteration from the warm start `v` (updated), to 1e-3 relative (the Rayleigh
-/// quotient, whose error is quadratic in that of the vector; enough for the damping and
-/// the report).
-fn smallest_eigenvalue<const R: usize>(a: &SMatrix<f64, R, R>, v: &mut Vector6<f64>) -> f64 {
-    // A shift of rounding size keeps the factorisation defined at an exact singularity.
-    let shift = 1e-13 * a.trace().max(f64::MIN_POSITIVE);
-    let Some(ch) = Cholesky::new(a + SMatrix::<f64, R, R>::identity() * shift) else {
-        return 0.0;
-    };
-    let mut x: SVector<f64, R> = v.fixed_rows::<R>(0).into_owned();
-    if !x.iter().all(|c| c.is_finite()) || x.norm() <= 1e-3 {
-        x = SVector::repeat(1.0);
-    }
-    x.normalize_mut();
-    let mut mu = 0.0;
-    for _ in 0..30 {
-        let y = ch.solve(&x);
-        let next = x.dot(&y);
-        let n = y.norm();
-        x = y / n;
-        let done = (next - mu).abs() <= 1e-3 * next;
-        mu = next;
-        if done {
-            break;
-        }
-    }
-    v.fixed_rows_mut::<R>(0).copy_from(&x);
-    (1.0 / mu - shift).max(0.0)
 }
 
 /// How one damped-least-squares run ended (`ws.q` holds its joints, `ws.data` its

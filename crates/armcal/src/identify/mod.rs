@@ -4,6 +4,7 @@
 //! axes by circle point analysis.
 
 pub mod circle_point;
+pub mod estimate;
 pub mod fingerprint;
 pub mod gauss_newton;
 pub mod kalman;
@@ -14,6 +15,10 @@ pub mod solver;
 pub mod uncertainty;
 pub mod verdicts;
 
+pub use estimate::{
+    Acceptance, Estimate, MeasurementResidual, ParameterEstimate, ResidualReport, SolverReport,
+    Usability, Validation,
+};
 pub use fingerprint::ModelFingerprint;
 pub use gauss_newton::gauss_newton;
 pub use kalman::{kalman_filter, KalmanSettings};
@@ -28,11 +33,10 @@ use crate::accuracy::ErrorStats;
 use crate::cell::Cell;
 use crate::measure::{Dataset, MeasurementKind};
 use crate::model::identifiability::{Identifiability, IdentifiabilitySettings, Measurement};
-use crate::model::rank_deficit::RankDeficit;
-use crate::model::{Model, ModelSpec, Segment, Status as ParamStatus};
+use crate::model::{Model, Segment, Status as ParamStatus};
 use crate::progress::{Observer, Silent};
 use crate::Error;
-use nalgebra::{DVector, Matrix3};
+use nalgebra::DVector;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -93,183 +97,6 @@ impl Default for IdentifySettings {
             lm: LmSettings::default(),
         }
     }
-}
-
-/// One parameter in the estimate report (display units: mm, deg).
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct ParameterEstimate {
-    /// Parameter name in the model's registry.
-    pub name: String,
-    /// Display unit: `mm` or `deg`.
-    pub unit: String,
-    /// Nominal value (display unit).
-    pub nominal: f64,
-    /// Value at the solution (display unit).
-    pub estimate: f64,
-    /// Standard deviation (display unit); `None` for fixed parameters.
-    pub sigma: Option<f64>,
-    /// Whether the parameter was estimated.
-    pub free: bool,
-}
-
-/// Solver statistics.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct SolverReport {
-    /// Solver used.
-    pub method: Method,
-    /// Robust loss of an IRLS fit; `None` for plain least squares.
-    pub robust: Option<Loss>,
-    /// How the (last) solver run ended.
-    pub status: Status,
-    /// Iterations of the last solver run.
-    pub iterations: usize,
-    /// Wall-clock time of the last solver run (ms).
-    pub time_ms: f64,
-    /// Cost ½‖r‖² of the whitened residual after each iteration (index 0: the start).
-    pub history: Vec<f64>,
-}
-
-/// Residual statistics per axis (mm) of the position-bearing measurements.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct ResidualReport {
-    /// x components of the position residuals (instrument frame, mm).
-    pub x: ErrorStats,
-    /// y components of the position residuals (instrument frame, mm).
-    pub y: ErrorStats,
-    /// z components of the position residuals (instrument frame, mm).
-    pub z: ErrorStats,
-    /// Euclidean position error per measurement (scalar error for distances and planes).
-    pub norm: ErrorStats,
-    /// Every measurement's residual, in data order (for the report's histograms and
-    /// per-pose plot).
-    #[serde(default)]
-    pub per_measurement: Vec<MeasurementResidual>,
-}
-
-/// One measurement's residual, `model − measured` (mm; the robust weights undone).
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct MeasurementResidual {
-    /// The configuration's number in the data file (1-based, in the file's order, also
-    /// when part of the file was held out).
-    pub pose: usize,
-    /// The configuration's `pose_id` in the data file.
-    pub pose_id: String,
-    /// Position residual x, y, z (mm); `None` for distance and plane measurements.
-    pub xyz: Option<[f64; 3]>,
-    /// Euclidean position error (the scalar error for distances and planes, mm).
-    pub norm: f64,
-}
-
-/// Held-out validation (position error on configurations not used in the fit, mm).
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct Validation {
-    /// What the fit was validated on: a held-out fraction of the data file, or the user's
-    /// test data file.
-    #[serde(default)]
-    pub test_data: String,
-    /// Number of configurations fitted.
-    pub train_configurations: usize,
-    /// Number of configurations validated on.
-    pub test_configurations: usize,
-    /// The `pose_id`s of the fitted configurations (data file), in file order.
-    #[serde(default)]
-    pub train_ids: Vec<String>,
-    /// The `pose_id`s of the validation configurations (data file, or the test file), in
-    /// file order.
-    #[serde(default)]
-    pub test_ids: Vec<String>,
-    /// Nominal model, nothing fitted.
-    pub nominal: ErrorStats,
-    /// Nominal robot with only the base, tool, instrument and target frames fitted (for a
-    /// cell whose only free parameters are frames: the calibration itself).
-    pub frames_only: ErrorStats,
-    /// Full calibration.
-    pub calibrated: ErrorStats,
-}
-
-/// Everything an identification produced: what `estimate.json` holds.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct Estimate {
-    /// Name of the cell.
-    pub cell: String,
-    /// Where the fitted data came from ([`Dataset::source`]).
-    pub data: String,
-    /// The identified model (internal units: mm, rad), for predict / compensate / export.
-    pub model: ModelSpec,
-    /// Every model parameter, free or fixed, in registry order (display units).
-    pub parameters: Vec<ParameterEstimate>,
-    /// Why each parameter not estimated was left out (identifiability analysis).
-    pub fixed_reasons: Vec<(String, String)>,
-    /// Why fewer parameters than the generic count were identified (at the fit, from these
-    /// data), if so.
-    #[serde(default)]
-    pub rank_deficit: Option<RankDeficit>,
-    /// Solver statistics of the fit.
-    pub solver: SolverReport,
-    /// C_p, σ's, correlations and the χ² test of the free parameters (internal units).
-    pub uncertainty: ParameterUncertainty,
-    /// Names of the free parameters, the order of C_p.
-    pub free: Vec<String>,
-    /// Pairs of free parameters with correlation |ρ| > 0.95, and ρ.
-    pub strong_correlations: Vec<(String, String, f64)>,
-    /// C_s = G C_p Gᵀ at each working configuration.
-    pub tcp: Vec<TcpCovariance>,
-    /// C_s by the constrained formulation (paper eq. 19), same order.
-    pub tcp_constrained: Vec<Matrix3<f64>>,
-    /// Observability indices of the data rows of the whitened Jacobian at the solution
-    /// (book §4.5.3, paper eqs. 8–10).
-    pub observability: Observability,
-    /// Residuals of the fitted data, `model − measured` (mm).
-    pub residuals: ResidualReport,
-    /// Measurements a robust fit left out (of the χ² test and C_p too).
-    pub outliers: Vec<Outlier>,
-    /// Free angles more than 90° from nominal that no equivalent parameter set brings
-    /// closer (the estimate is reported in the equivalent set nearest the nominal).
-    #[serde(default)]
-    pub far_from_nominal: Vec<crate::model::branch::FarAngle>,
-    /// Robust scale of the whitened residuals at the end of an IRLS fit (≈ 1 if σ is
-    /// right); `None` for plain least squares.
-    pub robust_scale: Option<f64>,
-    /// Held-out validation; `None` without held-out or test data.
-    pub validation: Option<Validation>,
-    /// Number of measurements fitted (the training part).
-    pub measurements: usize,
-    /// Number of configurations fitted (the training part).
-    pub configurations: usize,
-    /// Solver, χ² and identifiability verdicts; `None` in files of an older armcal, which
-    /// consumers treat as unverified ([`Estimate::check_usable`]).
-    #[serde(default)]
-    pub verdicts: Option<Verdicts>,
-    /// The cell model the estimate was identified on; `None` in files of an older armcal
-    /// (then only the parameter names are checked, [`Estimate::check_model`]).
-    #[serde(default)]
-    pub fingerprint: Option<ModelFingerprint>,
-}
-
-/// Whether the caller accepts an estimate whose fit did not converge (or that records no
-/// verdicts), and how its user would say so, in the caller's own words (the CLI: its
-/// flags): [`Estimate::check_usable`] names them in the refusal and in the line every
-/// output made with an accepted estimate carries.
-#[derive(Clone, Copy, Debug)]
-pub struct Acceptance<'a> {
-    /// The user accepted the estimate as it is.
-    pub accepted: bool,
-    /// How the user accepts it (the CLI passes its flag's name).
-    pub accept: &'a str,
-    /// How the user raises the identification's iteration limit (the CLI passes its flag's
-    /// name).
-    pub raise_iterations: &'a str,
-}
-
-/// Whether an estimate may be used ([`Estimate::check_usable`]).
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Usability {
-    /// Set when the estimate is used only because the caller accepted an unconverged (or
-    /// unverified) fit: every output written with it must carry this line.
-    pub overridden: Option<String>,
-    /// What else the user should know (χ² not consistent with the stated σ, fewer parameters
-    /// than the generic count), one sentence each.
-    pub notes: Vec<String>,
 }
 
 /// The cell's model with its free set for `data`, decided at the parameters `at` (the
@@ -758,147 +585,5 @@ fn fit_free_set(
         }
         at = solution.params;
         decided = recheck;
-    }
-}
-
-impl Estimate {
-    /// Reads an `estimate.json`.
-    pub fn from_file(path: &std::path::Path) -> Result<Estimate, Error> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::File {
-            file: path.display().to_string(),
-            message: e.to_string(),
-        })?;
-        serde_json::from_str(&text).map_err(|e| Error::File {
-            file: path.display().to_string(),
-            message: format!("not an armcal estimate: {e}"),
-        })
-    }
-
-    /// Whether the estimate may be used: an estimate whose fit did not converge — or that
-    /// records no verdicts (written by an older armcal) — is an error naming the status,
-    /// unless `acceptance.accepted`, when [`Usability::overridden`] says what every output
-    /// must carry. Both say how the user accepts it, in the caller's words
-    /// ([`Acceptance`]). The χ² and identifiability verdicts worth knowing come back as
-    /// notes.
-    pub fn check_usable(&self, acceptance: &Acceptance) -> Result<Usability, Error> {
-        let accept = acceptance.accept;
-        let flag = format!("pass {accept} to use it anyway");
-        let Some(v) = &self.verdicts else {
-            if !acceptance.accepted {
-                return Err(Error::Input(format!(
-                    "the estimate (cell `{}`) was written by an older armcal: it records no solver, χ² or identifiability verdict and no model fingerprint; identify again, or {flag}",
-                    self.cell
-                )));
-            }
-            return Ok(Usability {
-                overridden: Some(format!(
-                    "armcal: estimate of cell `{}` unverified (no recorded verdicts), used with {accept}",
-                    self.cell
-                )),
-                notes: Vec::new(),
-            });
-        };
-        let mut usability = Usability::default();
-        if !v.solver.is_converged() {
-            if !acceptance.accepted {
-                return Err(Error::Input(format!(
-                    "the fit of this estimate (cell `{}`) did not converge: {} after {} iterations; its parameters are not a least-squares solution. Identify again (check the nominal model, the data's units and joint columns, or raise {}), or {flag}",
-                    self.cell, v.solver, self.solver.iterations, acceptance.raise_iterations
-                )));
-            }
-            usability.overridden = Some(format!(
-                "armcal: estimate of cell `{}` did not converge ({}), used with {accept}",
-                self.cell, v.solver
-            ));
-        }
-        if v.chi2.outcome != Chi2Outcome::Consistent {
-            usability.notes.push(format!("χ² test: {}", v.chi2.meaning));
-        }
-        if v.identifiability.is_short() {
-            usability
-                .notes
-                .push(format!("identifiability: {}", v.identifiability.meaning));
-        }
-        Ok(usability)
-    }
-
-    /// Checks that this estimate belongs to `model`: the same parameter names and, for an
-    /// estimate that carries a [`ModelFingerprint`], the same conventions, joints, nominal
-    /// geometry, frames, targets and free set. The error names every difference.
-    pub fn check_model(&self, model: &Model) -> Result<(), Error> {
-        self.check_names(model)?;
-        let Some(f) = &self.fingerprint else {
-            return Ok(());
-        };
-        let differences = f.differences(model);
-        if differences.is_empty() {
-            return Ok(());
-        }
-        Err(Error::Input(format!(
-            "the estimate (cell `{}`) was identified on another model than `{}`: {}; identify again with this cell, or use the cell the estimate was made for",
-            self.cell,
-            model.name,
-            differences.join("; ")
-        )))
-    }
-
-    /// The full parameter vector of `model` from this estimate (by parameter name), after
-    /// [`Estimate::check_model`].
-    pub fn params_for(&self, model: &Model) -> Result<Vec<f64>, Error> {
-        self.check_model(model)?;
-        let by_name: std::collections::HashMap<&str, &ParameterEstimate> = self
-            .parameters
-            .iter()
-            .map(|p| (p.name.as_str(), p))
-            .collect();
-        Ok(model
-            .registry
-            .iter()
-            .map(|p| by_name[p.name.as_str()].estimate / p.unit.display_factor())
-            .collect())
-    }
-
-    /// An estimate of a different robot or cell (other parameter names) is an error that
-    /// names the mismatch.
-    fn check_names(&self, model: &Model) -> Result<(), Error> {
-        let by_name: std::collections::HashMap<&str, &ParameterEstimate> = self
-            .parameters
-            .iter()
-            .map(|p| (p.name.as_str(), p))
-            .collect();
-        let missing: Vec<&str> = model
-            .registry
-            .iter()
-            .filter(|p| !by_name.contains_key(p.name.as_str()))
-            .map(|p| p.name.as_str())
-            .collect();
-        let extra: Vec<&str> = self
-            .parameters
-            .iter()
-            .filter(|p| model.registry.index_of(&p.name).is_none())
-            .map(|p| p.name.as_str())
-            .collect();
-        if !missing.is_empty() || !extra.is_empty() {
-            return Err(Error::Input(format!(
-                "the estimate (cell `{}`) does not belong to model `{}`: {}{}",
-                self.cell,
-                model.name,
-                if missing.is_empty() {
-                    String::new()
-                } else {
-                    format!("the estimate lacks {}", missing.join(", "))
-                },
-                if extra.is_empty() {
-                    String::new()
-                } else {
-                    format!(
-                        "{}the model has no {}",
-                        if missing.is_empty() { "" } else { "; " },
-                        extra.join(", ")
-                    )
-                },
-            )));
-        }
-        Ok(())
     }
 }
