@@ -100,8 +100,9 @@ pub struct PlanResult {
     pub exchange_value: f64,
     /// Sweeps of the best start's exchange.
     pub exchange_sweeps: usize,
-    /// How the refinement ended ([`RefineResult::describe`](crate::design::refine::RefineResult::describe),
-    /// with a note when its design was rejected); `None` when it did not run.
+    /// How the refinement ended
+    /// ([`RefineResult::describe`](crate::design::refine::RefineResult::describe), with a
+    /// note when its design was rejected); `None` when it did not run.
     pub refine_status: Option<String>,
     /// Refinement iterations (0 when it did not run).
     pub refine_iterations: usize,

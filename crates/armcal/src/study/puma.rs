@@ -376,7 +376,8 @@ impl Default for PumaSettings {
 /// One identification.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct FitSummary {
-    /// The model identified, e.g. `modified DH (Table 6.1)`, `zero reference (Table 6.2, eq. 6.11)`.
+    /// The model identified: `modified DH (Table 6.1)` or
+    /// `zero reference (Table 6.2, eq. 6.11)`.
     pub model: String,
     /// Free parameters estimated.
     pub free: usize,
