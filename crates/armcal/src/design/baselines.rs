@@ -12,9 +12,14 @@ use rand_chacha::ChaCha8Rng;
 /// The book's observation strategies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Strategy {
+    /// Strategy 1: every joint swept from its lower to its upper limit in equal increments, all
+    /// simultaneously.
     S1,
+    /// Strategy 2: one joint swept at a time, the others at mid-range.
     S2,
+    /// Strategy 3: one joint held at mid-range at a time, the others swept simultaneously.
     S3,
+    /// Strategy 4: uniform random configurations within the joint limits (Monte Carlo, seeded).
     S4,
 }
 

@@ -30,6 +30,8 @@ pub struct OptimalityBound {
     pub efficiency: f64,
     /// Largest sensitivity found and where.
     pub max_sensitivity: f64,
+    /// The configuration (joint values, internal units: rad, mm) where `max_sensitivity` was
+    /// found.
     pub argmax: Vec<f64>,
 }
 

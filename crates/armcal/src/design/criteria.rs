@@ -26,18 +26,29 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Criterion {
+    /// `tr(C)/n_p`, C in mm and rad unscaled (paper's φ_A(C_p)).
     A,
+    /// `log det C / n_p` (D-optimality).
     D,
+    /// `λ_max(C) = 1/λ_min(M)` (E-optimality).
     E,
+    /// Weighted mean TCP position variance at the working configurations (mm², paper eq. 24,
+    /// φ_A(C_s)).
     Kpi,
+    /// `−log O1`, O1 ∝ (Π σ_i)^{1/n} (Borm & Menq; book §4.5.3), σ_i = √λ_i(M).
     O1,
+    /// `−log O2`, O2 = σ_min/σ_max, the inverse condition number (book §4.5.3).
     O2,
+    /// `−log O3`, O3 = σ_min, the minimum singular value (book §4.5.3).
     O3,
+    /// `−log O4`, O4 = σ_min²/σ_max, the noise amplification index (book §4.5.3).
     O4,
+    /// `−log O5`, O5 = 1/Σ σ_i⁻¹ (book §4.5.3).
     O5,
 }
 
 impl Criterion {
+    /// The criterion named `s` as [`Criterion::name`] writes it; `None` for any other name.
     pub fn from_name(s: &str) -> Option<Criterion> {
         Some(match s {
             "a" => Criterion::A,
@@ -69,6 +80,7 @@ impl Criterion {
         }
     }
 
+    /// Every criterion, in declaration order.
     pub const ALL: [Criterion; 9] = [
         Criterion::A,
         Criterion::D,
@@ -85,6 +97,7 @@ impl Criterion {
 /// Value of a criterion and its gradient w.r.t. the information matrix.
 #[derive(Clone, Debug)]
 pub struct CriterionValue {
+    /// φ(M), minimised (KPI in mm²; D and O1–O5 are logarithms).
     pub value: f64,
     /// `Φ = ∂φ/∂M` (symmetric).
     pub gradient: DMatrix<f64>,

@@ -24,7 +24,11 @@ use std::time::{Duration, Instant};
 /// Settings of [`exchange`].
 #[derive(Clone, Debug)]
 pub struct ExchangeSettings {
+    /// Most sweeps (each removes and re-inserts every design point once) before stopping with
+    /// [`Status::IterationLimit`].
     pub max_sweeps: usize,
+    /// Seed of the random start: the first N pool configurations of a seeded shuffle that
+    /// identify every parameter.
     pub seed: u64,
     /// Relative improvement below which a sweep counts as no progress.
     pub tolerance: f64,
@@ -46,14 +50,20 @@ impl Default for ExchangeSettings {
 /// Result of an exchange run: indices into the pool.
 #[derive(Clone, Debug)]
 pub struct ExchangeResult {
+    /// The design: N indices into the pool.
     pub chosen: Vec<usize>,
+    /// Criterion value of the chosen design (with the prior information of measured poses).
     pub value: f64,
     /// Converged when a sweep improved the criterion by less than the tolerance, else
     /// the sweep limit ([`Status::IterationLimit`]).
     pub status: Status,
+    /// Sweeps run.
     pub sweeps: usize,
+    /// Design points replaced, over all sweeps.
     pub exchanges: usize,
+    /// Criterion value at the start and after each sweep.
     pub history: Vec<f64>,
+    /// Wall-clock time of the run.
     pub time: Duration,
 }
 

@@ -16,7 +16,9 @@ use nalgebra::DMatrix;
 /// the measured targets, row weights, and the KPI rows (TCP at the working configurations).
 #[derive(Clone, Debug)]
 pub struct DesignModel {
+    /// The cell's model (internal units: mm, rad).
     pub model: Model,
+    /// Its nominal parameters, at which the Jacobians are evaluated.
     pub params: Vec<f64>,
     /// Parameter index of each column.
     pub free: Vec<usize>,
@@ -92,6 +94,7 @@ impl DesignModel {
         3 * self.observed.len()
     }
 
+    /// Number of joints (entries of a configuration).
     pub fn dof(&self) -> usize {
         self.model.dof()
     }
@@ -110,6 +113,8 @@ pub struct InformationWorkspace {
 }
 
 impl InformationWorkspace {
+    /// Buffers sized for `d`: one configuration's whitened Jacobian and its derivative w.r.t.
+    /// each joint.
     pub fn new(d: &DesignModel) -> Self {
         let n = d.n();
         InformationWorkspace {

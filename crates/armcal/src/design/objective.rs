@@ -17,7 +17,9 @@ static NEXT_OBJECTIVE_ID: AtomicU64 = AtomicU64::new(0);
 
 /// A criterion on a design model, with the information of poses already measured.
 pub struct DesignObjective<'a> {
+    /// The model, free columns and weights the information is computed from.
     pub design: &'a DesignModel,
+    /// The criterion φ minimised.
     pub criterion: Criterion,
     /// Whitened Jacobian rows of configurations already measured (design augmentation).
     pub prior_rows: DMatrix<f64>,
@@ -46,6 +48,8 @@ pub struct ObjectiveWorkspace {
 }
 
 impl<'a> DesignObjective<'a> {
+    /// φ of `criterion` on `design`, with the configurations `measured` already taken as the
+    /// prior information `M₀ = Σ J_iᵀWJ_i` (design augmentation).
     pub fn new(design: &'a DesignModel, criterion: Criterion, measured: &[Vec<f64>]) -> Self {
         let mut ws = InformationWorkspace::new(design);
         let rows = design.rows();
@@ -62,6 +66,7 @@ impl<'a> DesignObjective<'a> {
         }
     }
 
+    /// Buffers and cache for designs of `n_configs` configurations.
     pub fn workspace(&self, n_configs: usize) -> ObjectiveWorkspace {
         let d = self.design;
         ObjectiveWorkspace {

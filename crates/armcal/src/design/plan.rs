@@ -26,13 +26,16 @@ const EXCHANGE_TOLERANCE_BEFORE_REFINEMENT: f64 = 1e-3;
 /// Settings of [`plan`].
 #[derive(Clone, Debug)]
 pub struct PlanSettings {
+    /// Number N of measurement configurations to design.
     pub poses: usize,
+    /// The criterion minimised (default KPI, paper eq. 24).
     pub criterion: Criterion,
     /// Collision and line-of-sight constraints (the incidence limit applies whenever the
     /// cell sets one).
     pub collisions: bool,
     /// Independent exchange + refinement runs (in parallel).
     pub starts: usize,
+    /// Seed of the candidate pool; start `s` of the exchange uses `seed + 7919 s`.
     pub seed: u64,
     /// Feasible random configurations in the candidate pool.
     pub pool: usize,
@@ -40,6 +43,7 @@ pub struct PlanSettings {
     pub max_draws: usize,
     /// Skip the continuous refinement (exchange only).
     pub exchange_only: bool,
+    /// Settings of the continuous refinement.
     pub refine: RefineSettings,
 }
 
@@ -65,31 +69,49 @@ impl Default for PlanSettings {
 /// Smallest constraint margin of a design.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct DesignMargin {
+    /// Name of the constraint with the smallest value (see [`ConstraintSet::names`]).
     pub constraint: String,
+    /// Index (from 0) of the pose where it occurs.
     pub pose: usize,
+    /// The constraint value `g(q)`: mm for distances, `cos β − cos β_max` for the incidence;
+    /// negative when violated.
     pub value: f64,
 }
 
 /// What a planner run produced.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct PlanResult {
+    /// The criterion minimised.
     pub criterion: Criterion,
+    /// Its value for `design`.
     pub value: f64,
     /// The design, ordered for travel (internal units).
     pub design: Vec<Vec<f64>>,
     /// Every pose within the joint limits and every constraint ≥ 0.
     pub feasible: bool,
+    /// Smallest constraint value over the design (`None` when the set has no constraints).
     pub min_margin: Option<DesignMargin>,
+    /// Constraints checked at each pose.
     pub constraints_per_pose: usize,
+    /// Random draws made to fill the candidate pool.
     pub pool_draws: usize,
+    /// Criterion value after the exchange, before the refinement (NaN when no feasible pool
+    /// could be drawn).
     pub exchange_value: f64,
+    /// Sweeps of the best start's exchange.
     pub exchange_sweeps: usize,
+    /// How the refinement ended
+    /// ([`RefineResult::describe`](crate::design::refine::RefineResult::describe), with a
+    /// note when its design was rejected); `None` when it did not run.
     pub refine_status: Option<String>,
+    /// Refinement iterations (0 when it did not run).
     pub refine_iterations: usize,
+    /// Optimality bound and efficiency of the design (criteria with [`has_bound`] only).
     pub bound: Option<OptimalityBound>,
     /// When no feasible pool could be drawn: each constraint that blocks random
     /// configurations, with the fraction of draws (within the joint limits) it rejects.
     pub blocking: Vec<(String, f64)>,
+    /// Wall-clock time of the run.
     pub time: Duration,
 }
 
@@ -161,16 +183,23 @@ fn infeasible_report(
 /// exchange sweeps, and the refinement's status and iterations (if it ran).
 #[derive(Clone, Debug)]
 pub struct PoolDesign {
+    /// The design (internal units: rad, mm), not yet ordered for travel.
     pub design: Vec<Vec<f64>>,
+    /// Its criterion value.
     pub value: f64,
+    /// The criterion value of that start's exchange design.
     pub exchange_value: f64,
+    /// Sweeps of that start's exchange.
     pub sweeps: usize,
+    /// The refinement's status text and iterations; `None` when it did not run (exchange only).
     pub refine: Option<(String, usize)>,
 }
 
 /// Adapts a cell's [`ConstraintSet`] to the refinement's constraint interface.
 pub struct CellConstraints<'a> {
+    /// The constraints of one configuration.
     pub set: &'a ConstraintSet,
+    /// Model parameters at which they are evaluated (internal units: mm, rad).
     pub params: &'a [f64],
     ws: RefCell<ConstraintWorkspace>,
     /// Constraints whose value does not depend on q (see [`constant_constraints`]).
@@ -178,6 +207,7 @@ pub struct CellConstraints<'a> {
 }
 
 impl<'a> CellConstraints<'a> {
+    /// `set` at `params`, with the constraints whose value does not depend on q found once.
     pub fn new(set: &'a ConstraintSet, params: &'a [f64]) -> Self {
         let mut ws = set.workspace();
         let constant = constant_constraints(set, &mut ws, params);

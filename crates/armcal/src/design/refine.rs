@@ -34,10 +34,14 @@ use std::time::{Duration, Instant};
 
 /// Per-configuration constraints `g(q) ≥ 0` with their Jacobian (row-major `len × dof`).
 pub trait ConfigurationConstraints {
+    /// Number of constraints.
     fn len(&self) -> usize;
+    /// Whether there are none.
     fn is_empty(&self) -> bool {
         self.len() == 0
     }
+    /// Values `g(q)` of all constraints into `values` and, if asked, their Jacobian w.r.t. q
+    /// into `jacobian` (row-major `len × dof`).
     fn evaluate(&self, q: &[f64], values: &mut [f64], jacobian: Option<&mut [f64]>);
     /// Evaluates only the constraints in `rows`, writing their values (and Jacobian rows) at
     /// their own index of the full-length buffers; other entries may change. The default
@@ -65,7 +69,9 @@ pub struct RefineSettings {
     pub check_every: usize,
     /// Stop when a round lowers φ by less than this fraction.
     pub min_relative_improvement: f64,
+    /// Wall-clock limit of the whole refinement.
     pub max_duration: Duration,
+    /// L-BFGS memory of PANOC (correction pairs kept).
     pub lbfgs_memory: usize,
 }
 
@@ -85,8 +91,11 @@ impl Default for RefineSettings {
 /// Result of a refinement.
 #[derive(Clone, Debug)]
 pub struct RefineResult {
+    /// The refined design, one configuration per pose (internal units: rad, mm).
     pub q: Vec<Vec<f64>>,
+    /// φ of the refined design.
     pub value: f64,
+    /// φ of the start design.
     pub start_value: f64,
     /// How the PANOC rounds ended: a convergence criterion, the iteration or time limit, or
     /// a stall (no further descent), after which projected-gradient steps continue.
@@ -94,9 +103,11 @@ pub struct RefineResult {
     /// The projected-gradient steps after a stall (`None`: they did not run, no stall or
     /// no iterations left).
     pub projected_gradient_steps: Option<usize>,
+    /// PANOC iterations and projected-gradient steps run.
     pub iterations: usize,
     /// φ at the start and after each round.
     pub history: Vec<f64>,
+    /// Wall-clock time of the refinement.
     pub time: Duration,
 }
 

@@ -12,8 +12,11 @@ use std::path::Path;
 /// One input of a report.
 #[derive(Clone, Debug)]
 pub enum Document {
+    /// An identification result (`armcal identify`, `armcal demo`).
     Estimate(Box<Estimate>),
+    /// A design record (the .json `armcal plan` writes beside the design CSV).
     Design(Box<DesignRecord>),
+    /// The result of `armcal study paper`.
     Study(StudyRecord),
     /// The `summary.json` of `armcal demo`.
     Demo(Box<DemoSummary>),

@@ -14,12 +14,16 @@ use statrs::distribution::{ChiSquared, ContinuousCDF};
 /// A coordinate plane of the instrument frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Plane {
+    /// The x–y plane (coordinates 0 and 1).
     Xy,
+    /// The x–z plane (coordinates 0 and 2).
     Xz,
+    /// The y–z plane (coordinates 1 and 2).
     Yz,
 }
 
 impl Plane {
+    /// The three planes, in the order the report draws them.
     pub const ALL: [Plane; 3] = [Plane::Xy, Plane::Xz, Plane::Yz];
 
     /// The two coordinate indices (0 = x, 1 = y, 2 = z).
@@ -28,14 +32,6 @@ impl Plane {
             Plane::Xy => (0, 1),
             Plane::Xz => (0, 2),
             Plane::Yz => (1, 2),
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Plane::Xy => "xy",
-            Plane::Xz => "xz",
-            Plane::Yz => "yz",
         }
     }
 

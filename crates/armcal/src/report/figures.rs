@@ -98,7 +98,7 @@ pub fn tick(v: &f64) -> String {
 
 /// How a legend entry is drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Mark {
+enum Mark {
     Line,
     Dashed,
     Dot,
@@ -194,6 +194,7 @@ fn styled_mesh<'a, 'b, DB: DrawingBackend>(
 /// One TCP covariance to draw as a confidence ellipse.
 #[derive(Clone, Debug)]
 pub struct EllipseSeries {
+    /// Legend entry (plain text).
     pub label: String,
     /// C_s at the working pose (mm²).
     pub covariance: Matrix3<f64>,
@@ -488,7 +489,9 @@ pub fn histogram_figure(
 /// A horizontal reference line drawn dashed across a [`series_figure`].
 #[derive(Clone, Debug)]
 pub struct Reference {
+    /// Legend entry (plain text).
     pub label: String,
+    /// Where the line is drawn, in the units of the figure's y axis.
     pub value: f64,
 }
 
@@ -564,10 +567,15 @@ pub fn series_figure(
 /// One joint of a design: its values at every pose and its limits (display units).
 #[derive(Clone, Debug)]
 pub struct JointTrace {
+    /// Joint name (panel title).
     pub name: String,
+    /// Display unit of the values and limits (e.g. `deg`, `mm`).
     pub unit: String,
+    /// Lower joint limit (display units).
     pub lower: f64,
+    /// Upper joint limit (display units).
     pub upper: f64,
+    /// The joint's value at each pose, in pose order (display units).
     pub values: Vec<f64>,
 }
 

@@ -93,7 +93,9 @@ pub fn facts(rows: &[(&str, String)]) -> String {
 /// One inline SVG figure and its caption (HTML).
 #[derive(Clone, Debug)]
 pub struct Figure {
+    /// The figure as an inline `<svg>` element.
     pub svg: String,
+    /// Caption below the figure (HTML).
     pub caption: String,
 }
 
@@ -106,7 +108,9 @@ enum Block {
 /// A section of the report: a heading and, in order, HTML blocks and figures.
 #[derive(Clone, Debug)]
 pub struct Section {
+    /// HTML id of the section, the target of its table-of-contents link (plain text, escaped).
     pub id: String,
+    /// Heading and table-of-contents entry (plain text, escaped).
     pub title: String,
     blocks: Vec<Block>,
     /// A complete fragment with its own `<section>` and heading (e.g. the 3D view), placed
@@ -175,9 +179,11 @@ impl Section {
 /// cell view) placed after the section named in `after` or at the end.
 #[derive(Clone, Debug, Default)]
 pub struct Page {
+    /// Page title, in `<title>` and the top heading (plain text).
     pub title: String,
     /// Plain text below the title.
     pub subtitle: String,
+    /// The sections in page order.
     pub sections: Vec<Section>,
 }
 

@@ -34,14 +34,18 @@ pub struct Input {
     pub label: String,
     /// Where it came from (file name), for the inputs table.
     pub source: String,
+    /// The document read from the file.
     pub document: Document,
 }
 
 /// What a report shows.
 #[derive(Clone, Debug, Default)]
 pub struct ReportContent<'a> {
+    /// Page title (plain text).
     pub title: &'a str,
+    /// Text below the title (plain text).
     pub subtitle: &'a str,
+    /// The documents to show, in order.
     pub inputs: &'a [Input],
     /// The demo's summary, shown first (else the first demo summary among the inputs).
     pub demo: Option<&'a DemoSummary>,

@@ -14,6 +14,7 @@ pub const CONFIDENCE: f64 = 0.95;
 /// One TCP covariance to compare.
 #[derive(Clone, Debug)]
 pub struct TcpItem {
+    /// Label in the table and the figure legends (plain text).
     pub label: String,
     /// `true`: predicted by a design; `false`: from an identification.
     pub predicted: bool,

@@ -178,7 +178,11 @@ pub fn ik(m: &Model, params: &[f64], target: &Pose<f64>, seed: &[f64]) -> Option
 /// The book's arm configurations (§6.2, Fig. 6.10).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ArmConfiguration {
+    /// Right arm: the forearm plane offset to the right of axis 1, looking horizontally from
+    /// axis 1 towards the wrist (module documentation).
     pub right_arm: bool,
+    /// Elbow up: the elbow above the line from the shoulder to the wrist centre, in the arm
+    /// plane.
     pub elbow_up: bool,
 }
 
@@ -276,9 +280,11 @@ fn place(
     )))
 }
 
-/// The 3 × 2 × 2 grid (in, CMM frame; module documentation).
+/// Grid x values of the 3 × 2 × 2 grid (in, CMM frame; module documentation).
 pub const GRID_X: [f64; 3] = [-11.0, -5.0, 1.0];
+/// Grid y values (in, CMM frame; y is vertical, along axis 1).
 pub const GRID_Y: [f64; 2] = [21.0, 27.0];
+/// Grid z values (in, CMM frame).
 pub const GRID_Z: [f64; 2] = [8.0, 14.0];
 
 /// Joint vectors (rad).
@@ -370,20 +376,26 @@ impl Default for PumaSettings {
 /// One identification.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct FitSummary {
+    /// The model identified: `modified DH (Table 6.1)` or
+    /// `zero reference (Table 6.2, eq. 6.11)`.
     pub model: String,
     /// Free parameters estimated.
     pub free: usize,
     /// Parameters fixed at the start value as unidentifiable (with the reason).
     pub unidentifiable: Vec<(String, String)>,
+    /// Iterations of the identification solver.
     pub iterations: usize,
+    /// Whether the identification converged.
     pub converged: bool,
     /// Whitened sum of squares at the solution (≈ residual rows − free parameters).
     pub ssq: f64,
     /// A-posteriori variance factor σ̂₀² = SSQ / (rows − free); ≈ 1.
     pub variance_factor: f64,
+    /// Residual rows of the identification data (the `rows` of σ̂₀²).
     pub rows: usize,
     /// Identification data, RMS δr (in) and δθ (deg) of the calibrated model.
     pub fit_rms_dr_in: f64,
+    /// RMS δθ (deg) of the calibrated model on the identification data.
     pub fit_rms_dtheta_deg: f64,
 }
 
@@ -392,16 +404,25 @@ pub struct FitSummary {
 /// modified-DH model, the truth (Table 6.5), and the book's Table 6.9.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ConversionRow {
+    /// The book's transform, `B->0` … `4->5`.
     pub transform: String,
+    /// The armcal link of that transform (`base`, `j1` … `j5`).
     pub link: String,
+    /// Names of parameters 1–3: `d, a, alpha` (Type 1, `dh`), `a, alpha, beta` (Type 2,
+    /// `hayati`) or `dx, dy, dz` (Type 3).
     pub fields: [String; 3],
+    /// Parameters 1–3 of the zero-reference estimate converted to DH (in, deg).
     pub converted: [f64; 3],
+    /// Parameters 1–3 identified with the modified-DH model (in, deg).
     pub identified: [f64; 3],
     /// Standard deviations of the modified-DH estimate implied by the Table 6.4 noise
     /// (`C_p = (FᵀF)⁻¹` at the estimate).
     pub identified_sigma: [f64; 3],
+    /// Parameters 1–3 of the truth, Table 6.5 (in, deg).
     pub truth: [f64; 3],
+    /// The book's converted values, Table 6.9 (in, deg; NaN where the table has no row).
     pub book_converted: [f64; 3],
+    /// The book's identified values, Table 6.9 (in, deg; NaN where the table has no row).
     pub book_identified: [f64; 3],
 }
 
@@ -410,24 +431,38 @@ pub struct ConversionRow {
 /// book's values for its pose of the same number.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct HeldOutRow {
+    /// Held-out pose number (from 1), as in Table 6.13.
     pub pose: usize,
+    /// δr (in) of the nominal model (eq. 6.41).
     pub nominal_dr_in: f64,
+    /// δθ (deg) of the nominal model (eq. 6.42).
     pub nominal_dtheta_deg: f64,
+    /// δr (in) of the calibrated modified-DH model.
     pub mdh_dr_in: f64,
+    /// δθ (deg) of the calibrated modified-DH model.
     pub mdh_dtheta_deg: f64,
+    /// δr (in) of the calibrated zero-reference model.
     pub zrp_dr_in: f64,
+    /// δθ (deg) of the calibrated zero-reference model.
     pub zrp_dtheta_deg: f64,
+    /// The book's row of the same number (`None` beyond the table).
     pub book: Option<BookAccuracy>,
 }
 
 /// A row of Table 6.13 (or its means).
 #[derive(Clone, Copy, Debug, Serialize, Deserialize)]
 pub struct BookAccuracy {
+    /// δr (in) of the nominal model.
     pub nominal_dr_in: f64,
+    /// δθ (deg) of the nominal model.
     pub nominal_dtheta_deg: f64,
+    /// δr (in) of the calibrated modified-DH model.
     pub mdh_dr_in: f64,
+    /// δθ (deg) of the calibrated modified-DH model.
     pub mdh_dtheta_deg: f64,
+    /// δr (in) of the calibrated zero-reference model.
     pub zrp_dr_in: f64,
+    /// δθ (deg) of the calibrated zero-reference model.
     pub zrp_dtheta_deg: f64,
 }
 
@@ -462,29 +497,39 @@ fn mean_accuracy(rows: &[BookAccuracy]) -> BookAccuracy {
 /// The result of `armcal study puma`.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct PumaStudy {
+    /// Seed of the measurement noise ([`PumaSettings::seed`]).
     pub seed: u64,
+    /// Seed of the poses ([`PumaSettings::pose_seed`]).
     pub pose_seed: u64,
     /// σ of the simulated CMM: position (mm, per axis) and rotation (rad, per axis).
     pub sigma_mm: [f64; 3],
+    /// Rotation σ (rad, per axis).
     pub sigma_rad: f64,
+    /// Poses used for identification (50).
     pub identification_poses: usize,
+    /// Held-out poses (10).
     pub held_out_poses: usize,
+    /// The modified-DH identification (Table 6.1 → Table 6.5).
     pub mdh: FitSummary,
+    /// The zero-reference identification (Table 6.2, eq. 6.11).
     pub zrp: FitSummary,
     /// Tables 6.9/6.10: the zero-reference estimate converted to DH vs the modified-DH
     /// estimate (transforms B→0 … 4→5).
     pub conversion: Vec<ConversionRow>,
     /// Largest |converted − identified| over the conversion rows: lengths (in), angles (deg).
     pub conversion_max_dlength_in: f64,
+    /// Largest |converted − identified| angle (deg).
     pub conversion_max_dangle_deg: f64,
     /// Table 6.13.
     pub held_out: Vec<HeldOutRow>,
     /// Means over the held-out poses (armcal) and of Table 6.13 (book).
     pub held_out_mean: BookAccuracy,
+    /// Means of the book's Table 6.13.
     pub book_mean: BookAccuracy,
     /// Against the true (noise-free) held-out poses: mean δr (in), δθ (deg) of the
     /// modified-DH and zero-reference models.
     pub exact_mean_mdh: (f64, f64),
+    /// Mean δr (in), δθ (deg) of the zero-reference model against the true held-out poses.
     pub exact_mean_zrp: (f64, f64),
 }
 

@@ -126,6 +126,7 @@ pub struct RobotCapsule {
     pub joints: usize,
     /// Endpoints in the frame of `link` (mm).
     pub a: Vector3<f64>,
+    /// Second endpoint, in the same frame (mm).
     pub b: Vector3<f64>,
     /// Radius (mm).
     pub radius: f64,
@@ -225,9 +226,14 @@ enum Reflector {
 /// The smallest constraint value of a configuration.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Margin<'a> {
+    /// Index of the constraint in the set.
     pub index: usize,
+    /// Its value `g(q)`: mm for distances, `cos β − cos β_max` for the incidence; negative when
+    /// violated.
     pub value: f64,
+    /// Its name (see [`ConstraintSet::names`]).
     pub name: &'a str,
+    /// What it guards against.
     pub kind: ConstraintKind,
 }
 
@@ -397,6 +403,7 @@ impl ConstraintSet {
         self.items.len()
     }
 
+    /// Whether the set has no constraints.
     pub fn is_empty(&self) -> bool {
         self.items.is_empty()
     }
@@ -440,7 +447,7 @@ impl ConstraintSet {
 }
 
 impl ConstraintWorkspace {
-    pub fn new(set: &ConstraintSet) -> Self {
+    pub(crate) fn new(set: &ConstraintSet) -> Self {
         ConstraintWorkspace {
             data: Data::new(&set.model),
             ends: vec![[Vector3::zeros(); 2]; set.capsules.len()],
