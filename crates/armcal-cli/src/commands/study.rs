@@ -4,7 +4,7 @@
 use super::output::write_new;
 use super::progress::Progress;
 use armcal::study::paper::{self, RobotSelection, StudySettings, PAPER_SUMMARY, PAPER_TABLE6};
-use armcal::study::{puma, puma_record};
+use armcal::study::puma;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -131,7 +131,7 @@ fn run_puma(a: &Args) -> anyhow::Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out/study-puma"));
-    let record = puma_record::run_record(
+    let record = puma::record::run_record(
         &puma::PumaSettings {
             seed: a.seed,
             ..Default::default()

@@ -25,6 +25,10 @@
 //! fails is σ_min computed (inverse iteration). One forward-kinematics evaluation per
 //! iteration: the trial point of an accepted step is the next iterate. Nothing is allocated
 //! inside the iterations.
+//!
+//! (Over 600 lines: one algorithm — the run, its singularity escape and the diagnosis of
+//! why a solve ended — whose parts share the workspace and the run state; the step itself
+//! is in [`super::damped_step`].)
 
 use crate::compensate::closed_form::{NoClosedForm, SphericalWristIk};
 pub use crate::compensate::damped_step::{damped_step, task_jacobian_columns};

@@ -3,4 +3,3 @@
 pub mod demo;
 pub mod paper;
 pub mod puma;
-pub mod puma_record;

@@ -2,7 +2,7 @@
 //! `puma.json`) and the study's two tables as CSV (`puma-conversion.csv` for Tables
 //! 6.9/6.10, `puma-accuracy.csv` for Table 6.13).
 
-use super::puma::{run, PumaSettings, PumaStudy};
+use super::{run, PumaSettings, PumaStudy};
 use crate::progress::Observer;
 use crate::Error;
 use serde::{Deserialize, Serialize};
