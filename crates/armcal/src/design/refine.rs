@@ -18,8 +18,8 @@
 //! (`projected_gradient`). The objective is divided by its value at the start so the
 //! tolerances are relative.
 //!
-//! The file is over 600 lines because the projection (`FeasibleSet`, with its anchors and
-//! bounds) and the two descents that use it are one algorithm sharing private buffers.
+//! (Over 600 lines because the projection (`FeasibleSet`, with its anchors and
+//! bounds) and the two descents that use it are one algorithm sharing private buffers.)
 
 use crate::design::objective::DesignObjective;
 use crate::design::small_cholesky;

@@ -12,7 +12,7 @@
 //!
 //! Instrument and targets are copied unchanged: the tool frame is the same in both models.
 //!
-//! (One file of ~650 lines, ~75 of them tests: the three conversions share the frame
+//! (Over 600 lines, ~75 of them tests: the three conversions share the frame
 //! helpers `frame6_geometry`, `fixed_link` and `end_names`; apart they would need those
 //! helpers public across files.)
 

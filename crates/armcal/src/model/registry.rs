@@ -219,13 +219,6 @@ impl Registry {
         self.params[i].status = status;
     }
 
-    /// Sets the nominal value of parameter `i` (internal units). Not called by the library;
-    /// kept for the tests' cell with an unplaced tracker (`tests/common`), which moves a
-    /// nominal without rebuilding the model and its statuses.
-    pub fn set_nominal(&mut self, i: usize, value: f64) {
-        self.params[i].nominal = value;
-    }
-
     /// Nominal parameter vector.
     pub fn nominal(&self) -> Vec<f64> {
         self.params.iter().map(|p| p.nominal).collect()

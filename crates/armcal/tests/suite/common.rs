@@ -165,12 +165,16 @@ pub fn unplaced_tracker_paper_cell(frames_only: bool, seed: u64) -> (Cell, Vec<f
     let placed = example_cell("paper-cell.toml");
     let truth =
         armcal::sim::perturbed_truth(&placed.model, &armcal::sim::Perturbation::default(), seed);
-    let mut cell = placed.clone();
+    let text = armcal::cell::builtin::PAPER_CELL
+        .replace("xyz_mm = [2730.88, 4554.68, 1397.67]", "xyz_mm = [0, 0, 0]")
+        .replace("rpy_deg = [-95.63, -95.63, 0.23]", "rpy_deg = [0, 0, 0]");
+    assert_ne!(
+        text,
+        armcal::cell::builtin::PAPER_CELL,
+        "the tracker pose lines moved"
+    );
+    let mut cell = Cell::from_toml(&text, "paper-cell.toml", Path::new(".")).unwrap();
     for i in 0..cell.model.param_count() {
-        let p = cell.model.registry.get(i);
-        if p.frame() == "tracker" {
-            cell.model.registry.set_nominal(i, 0.0);
-        }
         if frames_only && !armcal::identify::is_frame_parameter(&placed.model, i) {
             cell.model.registry.set_status(i, Status::Fixed);
         }

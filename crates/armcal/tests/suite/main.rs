@@ -51,5 +51,6 @@ mod report {
 }
 mod repository {
     mod builtin_cells;
+    mod file_size;
     mod layering;
 }
