@@ -8,6 +8,7 @@
 //! distance to a fixed point, or a point on a plane. Blocks of different kinds mix freely
 //! in one least-squares problem.
 
+pub mod angles;
 pub mod csv;
 pub mod noise;
 pub mod residual;
