@@ -59,7 +59,7 @@ impl Orientation {
     }
 
     /// Number of columns: 3 angles or 4 quaternion components.
-    pub fn len(self) -> usize {
+    pub fn columns(self) -> usize {
         if self.is_angles() {
             3
         } else {
@@ -73,14 +73,14 @@ impl Orientation {
     }
 
     /// The rotation of `values` (angles in rad; a quaternion need not be normalised).
-    /// Panics if `values` has not [`Orientation::len`] entries.
+    /// Panics if `values` has not [`Orientation::columns`] entries.
     pub fn to_rot(self, values: &[f64]) -> Matrix3<f64> {
         assert_eq!(
             values.len(),
-            self.len(),
+            self.columns(),
             "{} takes {} values",
             self.name(),
-            self.len()
+            self.columns()
         );
         let v = values;
         match self {
@@ -174,7 +174,7 @@ mod tests {
             assert_eq!(Orientation::from_name(o.name()), Some(o));
             let r = Orientation::XyzIntrinsic.to_rot(&ANGLES);
             let v = o.from_rot(&r);
-            assert_eq!(v.len(), o.len());
+            assert_eq!(v.len(), o.columns());
             assert!((o.to_rot(&v) - r).norm() < 1e-12, "{}", o.name());
             if o.is_angles() {
                 // Angles with the middle one inside ±π/2 come back as they were.
