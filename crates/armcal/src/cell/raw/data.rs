@@ -187,3 +187,112 @@ pub(super) fn data_columns(
         format,
     }))
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::cell::Cell;
+    use crate::measure::csv::read_format_str;
+    use crate::measure::MeasurementKind;
+    use std::path::Path;
+
+    const HEAD: &str = "[robot]\nbuiltin = \"ur10\"\n[data]\njoints = [\"a\", \"b\", \"c\", \"d\", \"e\", \"f\"]\n";
+
+    fn cell(data: &str) -> Result<Cell, String> {
+        Cell::from_toml(&format!("{HEAD}{data}"), "c.toml", Path::new("."))
+            .map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn a_mapping_names_its_units_and_convention_or_fails_with_line_and_field() {
+        let pos = "position = { columns = [\"x\", \"y\", \"z\"], unit = \"mm\" }\n";
+        let e = cell(&format!(
+            "{pos}orientation = {{ columns = [\"r\", \"p\", \"w\"], unit = \"deg\" }}\n"
+        ))
+        .unwrap_err();
+        assert!(
+            e.contains("line 6") && e.contains("`data.orientation`") && e.contains("no default"),
+            "{e}"
+        );
+        let e = cell(&format!("{pos}orientation = {{ columns = [\"r\", \"p\", \"w\"], unit = \"deg\", convention = \"zyx\" }}\n")).unwrap_err();
+        assert!(e.contains("unknown convention `zyx`"), "{e}");
+        let e = cell(&format!("{pos}orientation = {{ columns = [\"r\", \"p\", \"w\"], convention = \"quat-xyzw\" }}\n")).unwrap_err();
+        assert!(e.contains("takes 4 columns"), "{e}");
+        let e = cell(&format!(
+            "{pos}orientation = {{ columns = [\"r\", \"p\", \"w\"], convention = \"rpy\" }}\n"
+        ))
+        .unwrap_err();
+        assert!(e.contains("`orientation.unit` is needed"), "{e}");
+        let e =
+            cell("position = { columns = [\"x\", \"y\", \"z\"], unit = \"feet\" }\n").unwrap_err();
+        assert!(
+            e.contains("line 5")
+                && e.contains("`data.position`")
+                && e.contains("unknown unit `feet`"),
+            "{e}"
+        );
+        let e =
+            cell("position = { columns = [\"x\", \"y\", \"z\"], unit = \"deg\" }\n").unwrap_err();
+        assert!(e.contains("must be a length"), "{e}");
+        let e = cell(&format!("decimal = \",\"\n{pos}")).unwrap_err();
+        assert!(e.contains("another `delimiter`"), "{e}");
+        let e = cell("joint_unit = \"mm\"\n").unwrap_err();
+        assert!(e.contains("joint `q1` is not one"), "{e}");
+        let e = cell(&format!(
+            "{pos}temperature = {{ column = \"t\", unit = \"K\" }}\n"
+        ))
+        .unwrap_err();
+        assert!(
+            e.contains("`data.temperature`") && e.contains("degC"),
+            "{e}"
+        );
+        let e = cell("sigma_position = { columns = [\"x\", \"y\", \"z\"], unit = \"mm\" }\n")
+            .unwrap_err();
+        assert!(e.contains("need `position` mapped"), "{e}");
+    }
+
+    #[test]
+    fn a_vendor_file_reads_per_field_with_crlf_lf_and_nul() {
+        let c = cell(
+            "delimiter = \";\"\ndecimal = \",\"\njoint_unit = \"rad\"\n\
+             position = { columns = [\"x\", \"y\", \"z\"], unit = \"m\" }\n\
+             orientation = { columns = [\"qx\", \"qy\", \"qz\", \"qw\"], convention = \"quat-xyzw\" }\n\
+             temperature = { column = \"t\", unit = \"degC\" }\n",
+        )
+        .unwrap();
+        let f = c.data_format();
+        let text = "a;b;c;d;e;f;x;y;z;qx;qy;qz;qw;t\r\n\
+                    0;0;0;0;0;0;1,5;2,78E-3;0;0;0;0;1;20,5\r\n\
+                    0,1;0;0;0;0;0; -1 ;0;0;0;0;0,7071067811865476;0,7071067811865476;21\0\n";
+        let (data, report) = read_format_str(text, "v.csv", &c.model, &f).unwrap();
+        assert!(report.ignored.is_empty());
+        assert_eq!(data.measurements.len(), 2);
+        assert_eq!(data.configurations[1][0], 0.1);
+        assert_eq!(data.measurements[1].covariates.temperature_c, Some(21.0));
+        let MeasurementKind::Pose { value, sigma: None } = &data.measurements[0].kind else {
+            panic!("a pose without σ")
+        };
+        assert_eq!(value.trans[0], 1500.0);
+        assert!((value.trans[1] - 2.78).abs() < 1e-12);
+        let MeasurementKind::Pose { value, .. } = &data.measurements[1].kind else {
+            panic!()
+        };
+        assert_eq!(value.trans[0], -1000.0);
+        assert!((value.rot[(1, 0)] - 1.0).abs() < 1e-12, "90° about z");
+        // A missing mapped column names the column and the [data] field.
+        let e = read_format_str("a;b;c;d;e;f;x;y\n0;0;0;0;0;0;1;2\n", "v.csv", &c.model, &f)
+            .unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("no column `z` (the cell's [data] position)"),
+            "{e}"
+        );
+        // A point in a decimal-comma file is not a number.
+        let bad = "a;b;c;d;e;f;x;y;z;qx;qy;qz;qw;t\n0;0;0;0;0;0;1.5;0;0;0;0;0;1;20\n";
+        let e = read_format_str(bad, "v.csv", &c.model, &f).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("line 2: `x` = `1.5` is not a number"),
+            "{e}"
+        );
+    }
+}
