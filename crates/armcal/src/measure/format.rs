@@ -71,6 +71,18 @@ impl ColumnUnit {
         })
     }
 
+    /// The name a cell file uses.
+    pub fn name(self) -> &'static str {
+        match self {
+            ColumnUnit::Mm => "mm",
+            ColumnUnit::M => "m",
+            ColumnUnit::In => "in",
+            ColumnUnit::Um => "um",
+            ColumnUnit::Deg => "deg",
+            ColumnUnit::Rad => "rad",
+        }
+    }
+
     /// Whether this is a length (else an angle).
     pub fn is_length(self) -> bool {
         !matches!(self, ColumnUnit::Deg | ColumnUnit::Rad)
@@ -184,6 +196,54 @@ impl DataFormat {
             joints: joints.map(<[String]>::to_vec),
             ..DataFormat::armcal()
         }
+    }
+
+    /// The body of a cell's `[data]` section that reads as this format (the joints line
+    /// alone for armcal's own files with named joint columns).
+    pub fn to_toml(&self) -> String {
+        let mut out = Vec::new();
+        if self.delimiter != ',' {
+            out.push(format!("delimiter = {:?}", self.delimiter.to_string()));
+        }
+        if self.decimal == Decimal::Comma {
+            out.push("decimal = \",\"".into());
+        }
+        if let Some(j) = &self.joints {
+            out.push(format!("joints = {j:?}"));
+        }
+        if let Some(u) = self.joint_unit {
+            out.push(format!("joint_unit = {:?}", u.name()));
+        }
+        let three = |field: &str, c: &Option<Columns>| {
+            c.as_ref().map(|c| {
+                let optional = if c.optional { ", optional = true" } else { "" };
+                format!(
+                    "{field} = {{ columns = {:?}, unit = {:?}{optional} }}",
+                    c.columns,
+                    c.unit.name()
+                )
+            })
+        };
+        out.extend(three("position", &self.position));
+        if let Some(o) = &self.orientation {
+            let unit = o
+                .unit
+                .map(|u| format!(", unit = {:?}", u.name()))
+                .unwrap_or_default();
+            out.push(format!(
+                "orientation = {{ columns = {:?}{unit}, convention = {:?} }}",
+                o.columns,
+                o.convention.name()
+            ));
+        }
+        out.extend(three("sigma_position", &self.sigma_position));
+        out.extend(three("sigma_orientation", &self.sigma_orientation));
+        if let Some(t) = &self.temperature {
+            out.push(format!(
+                "temperature = {{ column = {t:?}, unit = \"degC\" }}"
+            ));
+        }
+        out.join("\n")
     }
 
     /// Checks the format against itself and the model; the message names the field.

@@ -343,3 +343,11 @@ fn the_commanded_pose_is_the_nominal_ur10_with_the_planned_tcp() {
         );
     }
 }
+
+#[test]
+fn an_exported_cell_keeps_the_data_mapping() {
+    let cell = cell();
+    let text = armcal::cell::export::to_cell_toml(&cell, &cell.model, &cell.model.spec()).unwrap();
+    let back = Cell::from_toml(&text, "export.toml", Path::new(".")).unwrap();
+    assert_eq!(back.data_format(), cell.data_format());
+}
