@@ -146,9 +146,7 @@ pub fn read_configurations(
     model: &Model,
     joint_columns: Option<&[String]>,
 ) -> Result<Vec<(String, Vec<f64>)>, Error> {
-    let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| err(&file, e.to_string()))?;
-    read_configurations_str(&text, &file, model, joint_columns)
+    read_configurations_with(path, model, &DataFormat::armcal_with_joints(joint_columns))
 }
 
 /// As [`read_configurations`], from text.
@@ -158,8 +156,34 @@ pub fn read_configurations_str(
     model: &Model,
     joint_columns: Option<&[String]>,
 ) -> Result<Vec<(String, Vec<f64>)>, Error> {
-    let format = DataFormat::armcal_with_joints(joint_columns);
-    let (mut rdr, header, lines) = reader(text, file, &format)?;
+    read_configurations_format_str(
+        text,
+        file,
+        model,
+        &DataFormat::armcal_with_joints(joint_columns),
+    )
+}
+
+/// Joint configurations from a file laid out as `format` says (its delimiter, decimal
+/// notation, joint columns and unit; the other mapped columns are not needed).
+pub fn read_configurations_with(
+    path: &Path,
+    model: &Model,
+    format: &DataFormat,
+) -> Result<Vec<(String, Vec<f64>)>, Error> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| err(&file, e.to_string()))?;
+    read_configurations_format_str(&text, &file, model, format)
+}
+
+/// As [`read_configurations_with`], from text; `file` names it in errors.
+pub fn read_configurations_format_str(
+    text: &str,
+    file: &str,
+    model: &Model,
+    format: &DataFormat,
+) -> Result<Vec<(String, Vec<f64>)>, Error> {
+    let (mut rdr, header, lines) = reader(text, file, format)?;
     let mut used = vec![false; header.len()];
     let joints = format.joint_layout(&header, model, file, &mut used)?;
     let id_col = header.iter().position(|h| h == "pose_id");
