@@ -29,6 +29,8 @@ enum Command {
     Simulate(commands::simulate::Args),
     /// Identify the cell's parameters from a data file.
     Identify(commands::identify::Args),
+    /// Read a data file as the cell's `[data]` section maps it; write it in armcal's CSV.
+    Import(commands::import::Args),
     /// Predict what the instrument measures at given joint configurations.
     Predict(commands::predict::Args),
     /// Plan optimal measurement poses (paper's KPI method or a classic criterion).
@@ -69,6 +71,7 @@ fn main() {
         Command::Fk(a) => commands::fk::run(&a),
         Command::Simulate(a) => commands::simulate::run(&a),
         Command::Identify(a) => commands::identify::run(&a),
+        Command::Import(a) => commands::import::run(&a),
         Command::Predict(a) => commands::predict::run(&a),
         Command::Plan(a) => commands::plan::run_plan(&a),
         Command::Evaluate(a) => commands::plan::run_evaluate(&a),

@@ -7,6 +7,7 @@ pub mod demo;
 pub mod export;
 pub mod fk;
 pub mod identify;
+pub mod import;
 pub mod model;
 pub mod output;
 pub mod plan;

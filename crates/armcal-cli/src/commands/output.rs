@@ -23,17 +23,13 @@ pub fn load_cell(name_or_path: &str) -> anyhow::Result<armcal::cell::Cell> {
     Ok(cell)
 }
 
-/// Reads a data file for a cell (its joint-column mapping), noting ignored columns on
+/// Reads a data file for a cell (its `[data]` column mapping), noting ignored columns on
 /// stderr.
 pub fn load_data(
     cell: &armcal::cell::Cell,
     path: &Path,
 ) -> anyhow::Result<armcal::measure::Dataset> {
-    let (data, report) = armcal::measure::csv::read(
-        path,
-        &cell.model,
-        cell.data_columns.as_ref().map(|d| d.joints.as_slice()),
-    )?;
+    let (data, report) = armcal::measure::csv::read_with(path, &cell.model, &cell.data_format())?;
     if !report.ignored.is_empty() {
         eprintln!("note: ignored columns: {}", report.ignored.join(", "));
     }

@@ -29,11 +29,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
     let (params, note) = load_params(a.estimate.as_deref(), &a.accept, model)?;
-    let poses = csv::read_configurations(
-        &a.joints,
-        model,
-        cell.data_columns.as_ref().map(|d| d.joints.as_slice()),
-    )?;
+    let poses = csv::read_configurations_with(&a.joints, model, &cell.data_format())?;
     let data = predict(model, &params, &poses)?;
     write_new(
         &a.out,

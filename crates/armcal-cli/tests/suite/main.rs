@@ -6,4 +6,5 @@ mod browser;
 mod cli;
 mod compensate_cli;
 mod estimate_checks;
+mod import_cli;
 mod workflow;

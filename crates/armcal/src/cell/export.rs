@@ -80,7 +80,7 @@ pub fn to_cell_toml(cell: &Cell, identified: &Model, spec: &ModelSpec) -> Result
         };
     }
     if let Some(d) = &cell.data_columns {
-        let _ = writeln!(s.tail, "\n[data]\njoints = {:?}", d.joints);
+        let _ = writeln!(s.tail, "\n[data]\n{}", d.format.to_toml());
     }
     to_cell_toml_with(spec, &s)
 }

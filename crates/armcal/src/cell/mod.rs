@@ -88,6 +88,8 @@ pub fn half_space_unit_normal(
 pub struct DataColumns {
     /// One column name per model joint, in joint order.
     pub joints: Vec<String>,
+    /// The whole layout of the data files (`[data]`), these joint columns included.
+    pub format: crate::measure::format::DataFormat,
 }
 
 /// A loaded cell.
@@ -129,6 +131,15 @@ pub struct Cell {
 }
 
 impl Cell {
+    /// How this cell's data files are laid out: its `[data]` section, or armcal's own CSV.
+    pub fn data_format(&self) -> crate::measure::format::DataFormat {
+        self.data_columns
+            .as_ref()
+            .map_or_else(crate::measure::format::DataFormat::armcal, |d| {
+                d.format.clone()
+            })
+    }
+
     /// The instrument's noise model; [`NoiseModel::default`] for a cell without an
     /// instrument.
     pub fn noise(&self) -> NoiseModel {

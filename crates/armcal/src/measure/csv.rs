@@ -8,12 +8,19 @@
 //! * `x`, `y`, `z` — position in the instrument frame [`_mm`; also `_m`, `_in`];
 //! * `roll`, `pitch`, `yaw` — orientation (pose measurements) [`_deg`; also `_rad`];
 //! * `sigma_x` … `sigma_z` or `u_x` … `u_z` — stated σ per axis [`_mm`; also `_m`, `_in`],
-//!   and `sigma_roll` … for pose rows.
+//!   and `sigma_roll` … for pose rows (σ of the residual's rotation rows);
+//! * `temperature_c` — air temperature at the measurement, °C (a covariate).
+//!
+//! That is [`DataFormat::armcal`]; a cell's `[data]` section maps any other layout
+//! ([`crate::measure::format`]: delimiter, decimal comma, column names, units, orientation
+//! convention), read by [`read_with`] and converted to this format by [`import`].
 //!
 //! Other columns are ignored and listed in [`ReadReport::ignored`]; a known column with an
 //! unknown unit suffix is an error.
 
-use crate::measure::{Dataset, Measurement, MeasurementKind};
+use crate::measure::columns::{Column, SigmaOf};
+use crate::measure::format::{clean, number, DataFormat, Decimal};
+use crate::measure::{Covariates, Dataset, Measurement, MeasurementKind};
 use crate::model::{Joint, JointKind, Model, Observed, Pose};
 use crate::Error;
 use nalgebra::Vector3;
@@ -27,43 +34,6 @@ pub struct ReadReport {
     pub ignored: Vec<String>,
 }
 
-/// Unit factor to internal units for a length suffix.
-fn length_factor(suffix: &str) -> Option<f64> {
-    match suffix {
-        "" | "mm" => Some(1.0),
-        "m" => Some(1000.0),
-        "in" => Some(25.4),
-        "um" => Some(1e-3),
-        _ => None,
-    }
-}
-
-fn angle_factor(suffix: &str) -> Option<f64> {
-    match suffix {
-        "" | "deg" => Some(std::f64::consts::PI / 180.0),
-        "rad" => Some(1.0),
-        _ => None,
-    }
-}
-
-/// Splits `x_mm` into (`x`, `mm`), `sigma_x_m` into (`sigma_x`, `m`).
-fn split_unit(name: &str) -> (&str, &str) {
-    for suffix in ["_mm", "_m", "_in", "_um", "_deg", "_rad"] {
-        if let Some(base) = name.strip_suffix(suffix) {
-            return (base, &suffix[1..]);
-        }
-    }
-    match name.rsplit_once('_') {
-        Some((b, s)) if !s.is_empty() && s.chars().all(|c| c.is_ascii_alphabetic()) => (b, s),
-        _ => (name, ""),
-    }
-}
-
-struct Column {
-    index: usize,
-    factor: f64,
-}
-
 fn err(file: &str, msg: String) -> Error {
     Error::File {
         file: file.to_string(),
@@ -71,82 +41,28 @@ fn err(file: &str, msg: String) -> Error {
     }
 }
 
-/// The column of every joint, with its unit factor; marks the columns used.
-fn joint_layout(
-    header: &[String],
-    model: &Model,
-    joint_columns: Option<&[String]>,
-    file: &str,
-    used: &mut [bool],
-) -> Result<Vec<Column>, Error> {
-    let find = |name: &str| header.iter().position(|h| h == name);
-    let mut joints = Vec::new();
-    for (j, joint) in model.joints.iter().enumerate() {
-        let col = match joint_columns {
-            Some(names) => {
-                let name = &names[j];
-                let i = find(name).ok_or_else(|| err(file, format!("header: no column `{name}` for joint `{}` (named in the cell's [data] joints)", joint.name)))?;
-                let (_, suffix) = split_unit(name);
-                (i, suffix.to_string())
-            }
-            None => {
-                let candidates: Vec<usize> = header
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, h)| split_unit(h).0 == joint.name || h.as_str() == joint.name)
-                    .map(|(i, _)| i)
-                    .collect();
-                match candidates.as_slice() {
-                    [i] => (*i, split_unit(&header[*i]).1.to_string()),
-                    [] => {
-                        return Err(err(
-                            file,
-                            format!(
-                                "header: no column for joint `{}` (expected e.g. `{}`)",
-                                joint.name,
-                                joint_column(joint)
-                            ),
-                        ))
-                    }
-                    _ => {
-                        return Err(err(
-                            file,
-                            format!("header: joint `{}` has several columns", joint.name),
-                        ))
-                    }
-                }
-            }
-        };
-        let factor = match joint.kind {
-            JointKind::Revolute => angle_factor(&col.1),
-            JointKind::Prismatic => length_factor(&col.1),
-        }
-        .ok_or_else(|| err(file, format!("column `{}`: unknown unit suffix `{}` for joint `{}` (use deg or rad for revolute, mm, m or in for prismatic joints)", header[col.0], col.1, joint.name)))?;
-        used[col.0] = true;
-        joints.push(Column {
-            index: col.0,
-            factor,
-        });
-    }
-
-    Ok(joints)
-}
-
 /// A CSV reader, the header, and the file line of the header and of every record after it.
 type Table<'t> = (csv::Reader<&'t [u8]>, Vec<String>, Vec<usize>);
 
-/// A trimming CSV reader over `text`, its header, and the file line (1-based) of the header
-/// and of every record after it. Lines that start with `#` are comments (armcal writes one
-/// when an output was made with an accepted unconverged estimate); they and
-/// empty lines are skipped but counted.
-fn reader<'t>(text: &'t str, file: &str) -> Result<Table<'t>, Error> {
+/// A trimming CSV reader over `text` with the format's delimiter, its header, and the file
+/// line (1-based) of the header and of every record after it. Lines that start with `#` are
+/// comments (armcal writes one when an output was made with an accepted unconverged
+/// estimate); they and empty lines are skipped but counted. CRLF and LF both end a line.
+fn reader<'t>(text: &'t str, file: &str, format: &DataFormat) -> Result<Table<'t>, Error> {
     let lines = text
         .lines()
         .enumerate()
         .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'))
         .map(|(i, _)| i + 1)
         .collect();
+    let delimiter = u8::try_from(format.delimiter).map_err(|_| {
+        err(
+            file,
+            format!("delimiter `{}` is not one byte", format.delimiter),
+        )
+    })?;
     let mut rdr = csv::ReaderBuilder::new()
+        .delimiter(delimiter)
         .trim(csv::Trim::All)
         .comment(Some(b'#'))
         .from_reader(text.as_bytes());
@@ -154,57 +70,74 @@ fn reader<'t>(text: &'t str, file: &str) -> Result<Table<'t>, Error> {
         .headers()
         .map_err(|e| err(file, format!("header: {e}")))?
         .iter()
-        .map(str::to_string)
+        .map(|h| clean(h).to_string())
         .collect();
     Ok((rdr, header, lines))
 }
 
-/// Parses the joint values of one record (internal units), with line and column in errors.
-fn record_joints(
-    record: &csv::StringRecord,
-    joints: &[Column],
-    header: &[String],
-    model: &Model,
-    file: &str,
+/// The fields of one record, read with the file's header and decimal notation.
+struct Row<'a> {
+    record: &'a csv::StringRecord,
+    header: &'a [String],
+    file: &'a str,
     line: usize,
-) -> Result<Vec<f64>, Error> {
-    joints
-        .iter()
-        .zip(&model.joints)
-        .map(|(c, j)| cell_value(record, c, header, file, line, &j.name))
-        .collect()
+    decimal: Decimal,
 }
 
-/// One numeric field: missing, unparsable and non-finite values are errors naming line
-/// and column.
-fn cell_value(
-    record: &csv::StringRecord,
-    c: &Column,
-    header: &[String],
-    file: &str,
-    line: usize,
-    what: &str,
-) -> Result<f64, Error> {
-    let s = record.get(c.index).unwrap_or("");
-    if s.is_empty() {
-        return Err(err(
-            file,
-            format!("line {line}: `{}` ({what}) is missing", header[c.index]),
-        ));
+impl Row<'_> {
+    /// A field, trimmed ([`clean`]); empty if absent.
+    fn text(&self, index: usize) -> &str {
+        clean(self.record.get(index).unwrap_or(""))
     }
-    let v: f64 = s.parse().map_err(|_| {
-        err(
-            file,
-            format!("line {line}: `{}` = `{s}` is not a number", header[c.index]),
-        )
-    })?;
-    if !v.is_finite() {
-        return Err(err(
-            file,
-            format!("line {line}: `{}` = `{s}` is not finite", header[c.index]),
-        ));
+
+    /// Whether any of the columns has a value.
+    fn filled(&self, cols: &[Column]) -> bool {
+        cols.iter().any(|c| !self.text(c.index).is_empty())
     }
-    Ok(v * c.factor)
+
+    /// One numeric field in internal units: missing, unparsable and non-finite values are
+    /// errors naming line and column.
+    fn value(&self, c: &Column, what: &str) -> Result<f64, Error> {
+        let (line, name) = (self.line, &self.header[c.index]);
+        let s = self.text(c.index);
+        if s.is_empty() {
+            return Err(err(
+                self.file,
+                format!("line {line}: `{name}` ({what}) is missing"),
+            ));
+        }
+        let v = number(s, self.decimal).ok_or_else(|| {
+            err(
+                self.file,
+                format!("line {line}: `{name}` = `{s}` is not a number"),
+            )
+        })?;
+        if !v.is_finite() {
+            return Err(err(
+                self.file,
+                format!("line {line}: `{name}` = `{s}` is not finite"),
+            ));
+        }
+        Ok(v * c.factor)
+    }
+
+    /// Several fields as a vector.
+    fn values(&self, cols: &[Column], what: &str) -> Result<Vec<f64>, Error> {
+        cols.iter().map(|c| self.value(c, what)).collect()
+    }
+
+    fn v3(&self, cols: &[Column; 3], what: &str) -> Result<Vector3<f64>, Error> {
+        Ok(Vector3::from_iterator(self.values(cols, what)?))
+    }
+
+    /// The joint values (internal units).
+    fn joints(&self, joints: &[Column], model: &Model) -> Result<Vec<f64>, Error> {
+        joints
+            .iter()
+            .zip(&model.joints)
+            .map(|(c, j)| self.value(c, &j.name))
+            .collect()
+    }
 }
 
 /// Reads joint configurations (a pose list or a joint program): `pose_id` (optional) and
@@ -214,9 +147,7 @@ pub fn read_configurations(
     model: &Model,
     joint_columns: Option<&[String]>,
 ) -> Result<Vec<(String, Vec<f64>)>, Error> {
-    let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| err(&file, e.to_string()))?;
-    read_configurations_str(&text, &file, model, joint_columns)
+    read_configurations_with(path, model, &DataFormat::armcal_with_joints(joint_columns))
 }
 
 /// As [`read_configurations`], from text.
@@ -226,18 +157,51 @@ pub fn read_configurations_str(
     model: &Model,
     joint_columns: Option<&[String]>,
 ) -> Result<Vec<(String, Vec<f64>)>, Error> {
-    let (mut rdr, header, lines) = reader(text, file)?;
+    read_configurations_format_str(
+        text,
+        file,
+        model,
+        &DataFormat::armcal_with_joints(joint_columns),
+    )
+}
+
+/// Joint configurations from a file laid out as `format` says (its delimiter, decimal
+/// notation, joint columns and unit; the other mapped columns are not needed).
+pub fn read_configurations_with(
+    path: &Path,
+    model: &Model,
+    format: &DataFormat,
+) -> Result<Vec<(String, Vec<f64>)>, Error> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| err(&file, e.to_string()))?;
+    read_configurations_format_str(&text, &file, model, format)
+}
+
+/// As [`read_configurations_with`], from text; `file` names it in errors.
+pub fn read_configurations_format_str(
+    text: &str,
+    file: &str,
+    model: &Model,
+    format: &DataFormat,
+) -> Result<Vec<(String, Vec<f64>)>, Error> {
+    let (mut rdr, header, lines) = reader(text, file, format)?;
     let mut used = vec![false; header.len()];
-    let joints = joint_layout(&header, model, joint_columns, file, &mut used)?;
+    let joints = format.joint_layout(&header, model, file, &mut used)?;
     let id_col = header.iter().position(|h| h == "pose_id");
     let mut out = Vec::new();
     for (r, record) in rdr.records().enumerate() {
         let line = lines.get(r + 1).copied().unwrap_or(r + 2);
         let record = record.map_err(|e| err(file, format!("line {line}: {e}")))?;
-        let q = record_joints(&record, &joints, &header, model, file, line)?;
+        let row = Row {
+            record: &record,
+            header: &header,
+            file,
+            line,
+            decimal: format.decimal,
+        };
+        let q = row.joints(&joints, model)?;
         let id = id_col
-            .and_then(|c| record.get(c))
-            .map(str::to_string)
+            .map(|c| row.text(c).to_string())
             .unwrap_or_else(|| format!("{}", r + 1));
         out.push((id, q));
     }
@@ -254,9 +218,7 @@ pub fn read(
     model: &Model,
     joint_columns: Option<&[String]>,
 ) -> Result<(Dataset, ReadReport), Error> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| err(&path.display().to_string(), e.to_string()))?;
-    read_str(&text, &path.display().to_string(), model, joint_columns)
+    read_with(path, model, &DataFormat::armcal_with_joints(joint_columns))
 }
 
 /// As [`read`], from text; `file` names it in errors.
@@ -266,93 +228,34 @@ pub fn read_str(
     model: &Model,
     joint_columns: Option<&[String]>,
 ) -> Result<(Dataset, ReadReport), Error> {
-    let (mut rdr, header, lines) = reader(text, file)?;
-    let find = |name: &str| header.iter().position(|h| h == name);
-    let mut used = vec![false; header.len()];
+    read_format_str(
+        text,
+        file,
+        model,
+        &DataFormat::armcal_with_joints(joint_columns),
+    )
+}
 
-    let joints = joint_layout(&header, model, joint_columns, file, &mut used)?;
+/// Reads a data file laid out as `format` says (a cell's `[data]`, [`crate::cell::Cell::data_format`]).
+pub fn read_with(
+    path: &Path,
+    model: &Model,
+    format: &DataFormat,
+) -> Result<(Dataset, ReadReport), Error> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| err(&file, e.to_string()))?;
+    read_format_str(&text, &file, model, format)
+}
 
-    // Named value columns with unit checks.
-    let mut named = |base: &str, length: bool, aliases: &[&str]| -> Result<Option<Column>, Error> {
-        for (i, h) in header.iter().enumerate() {
-            let (b, suffix) = split_unit(h);
-            if b == base || aliases.contains(&b) {
-                let f = if length {
-                    length_factor(suffix)
-                } else {
-                    angle_factor(suffix)
-                };
-                let f = f.ok_or_else(|| {
-                    err(
-                        file,
-                        format!(
-                            "column `{h}`: unknown unit suffix `{suffix}` (use {})",
-                            if length {
-                                "mm, m, in or um"
-                            } else {
-                                "deg or rad"
-                            }
-                        ),
-                    )
-                })?;
-                used[i] = true;
-                return Ok(Some(Column {
-                    index: i,
-                    factor: f,
-                }));
-            }
-        }
-        Ok(None)
-    };
-    let xyz = [
-        named("x", true, &[])?,
-        named("y", true, &[])?,
-        named("z", true, &[])?,
-    ];
-    let rpy = [
-        named("roll", false, &[])?,
-        named("pitch", false, &[])?,
-        named("yaw", false, &[])?,
-    ];
-    let sxyz = [
-        named("sigma_x", true, &["u_x"])?,
-        named("sigma_y", true, &["u_y"])?,
-        named("sigma_z", true, &["u_z"])?,
-    ];
-    let srpy = [
-        named("sigma_roll", false, &[])?,
-        named("sigma_pitch", false, &[])?,
-        named("sigma_yaw", false, &[])?,
-    ];
-    let present = |c: &[Option<Column>; 3]| c.iter().filter(|x| x.is_some()).count();
-    if present(&xyz) != 3 {
-        return Err(err(
-            file,
-            "header: need the position columns x, y, z (e.g. x_mm, y_mm, z_mm)".into(),
-        ));
-    }
-    for (group, name) in [
-        (&rpy, "roll, pitch, yaw"),
-        (&sxyz, "sigma_x, sigma_y, sigma_z"),
-        (&srpy, "sigma_roll, sigma_pitch, sigma_yaw"),
-    ] {
-        let k = present(group);
-        if k != 0 && k != 3 {
-            return Err(err(file, format!("header: give all of {name} or none")));
-        }
-    }
-    let pose_col = find("pose_id");
-    let target_col = find("target");
-    for c in [pose_col, target_col].into_iter().flatten() {
-        used[c] = true;
-    }
-    let ignored: Vec<String> = header
-        .iter()
-        .zip(&used)
-        .filter(|(_, u)| !**u)
-        .map(|(h, _)| h.clone())
-        .collect();
-
+/// As [`read_with`], from text; `file` names it in errors.
+pub fn read_format_str(
+    text: &str,
+    file: &str,
+    model: &Model,
+    format: &DataFormat,
+) -> Result<(Dataset, ReadReport), Error> {
+    let (mut rdr, header, lines) = reader(text, file, format)?;
+    let layout = format.layout(&header, model, file)?;
     let mut data = Dataset {
         source: file.to_string(),
         ..Default::default()
@@ -362,11 +265,17 @@ pub fn read_str(
     for (r, record) in rdr.records().enumerate() {
         let line = lines.get(r + 1).copied().unwrap_or(r + 2);
         let record = record.map_err(|e| err(file, format!("line {line}: {e}")))?;
-        let value = |c: &Column, what: &str| cell_value(&record, c, &header, file, line, what);
-        let q = record_joints(&record, &joints, &header, model, file, line)?;
-        let id = pose_col
-            .and_then(|c| record.get(c))
-            .map(str::to_string)
+        let row = Row {
+            record: &record,
+            header: &header,
+            file,
+            line,
+            decimal: format.decimal,
+        };
+        let q = row.joints(&layout.joints, model)?;
+        let id = layout
+            .pose_id
+            .map(|c| row.text(c).to_string())
             .unwrap_or_else(|| format!("{}", r + 1));
         let config = match config_of.get(&id) {
             Some(&c) => {
@@ -388,7 +297,7 @@ pub fn read_str(
                 c
             }
         };
-        let observed = match target_col.and_then(|c| record.get(c)) {
+        let observed = match layout.target.map(|c| row.text(c)) {
             Some(name) if !name.is_empty() => {
                 let k = targets.iter().position(|t| *t == name).ok_or_else(|| {
                     err(
@@ -415,60 +324,98 @@ pub fn read_str(
                 }
             },
         };
-        let v3 = |cols: &[Option<Column>; 3], what: &str| -> Result<Vector3<f64>, Error> {
-            Ok(Vector3::new(
-                value(cols[0].as_ref().expect("checked"), what)?,
-                value(cols[1].as_ref().expect("checked"), what)?,
-                value(cols[2].as_ref().expect("checked"), what)?,
-            ))
+        let position = row.v3(&layout.position, "position")?;
+        let sigma = match &layout.sigma_position {
+            Some(c) if row.filled(c) => Some(row.v3(c, "σ")?),
+            _ => None,
         };
-        let position = v3(&xyz, "position")?;
-        let filled = |cols: &[Option<Column>; 3]| {
-            cols.iter()
-                .flatten()
-                .any(|c| !record.get(c.index).unwrap_or("").is_empty())
-        };
-        let sigma = if filled(&sxyz) {
-            Some(v3(&sxyz, "σ")?)
-        } else {
-            None
-        };
-        let kind = if filled(&rpy) {
-            let a = v3(&rpy, "orientation")?;
-            let pose = Pose::from_xyz_rpy(position.into(), a.into());
-            let sr = if filled(&srpy) {
-                Some(v3(&srpy, "σ")?)
-            } else {
-                None
-            };
-            let sigma = match (sigma, sr) {
-                (Some(s), Some(r)) => Some([s[0], s[1], s[2], r[0], r[1], r[2]]),
-                (None, None) => None,
-                _ => return Err(err(file, format!("line {line}: pose rows need σ for both position and orientation, or neither"))),
-            };
-            MeasurementKind::Pose { value: pose, sigma }
-        } else {
-            MeasurementKind::Position {
+        let kind = match &layout.orientation {
+            Some((cols, convention)) if row.filled(cols) => {
+                let values = row.values(cols, "orientation")?;
+                let pose = Pose {
+                    rot: convention.to_rot(&values),
+                    trans: position,
+                };
+                let sr = match &layout.sigma_orientation {
+                    Some((c, of)) if row.filled(c) => {
+                        let s = row.v3(c, "σ")?;
+                        Some(match of {
+                            SigmaOf::RotationRows => s,
+                            SigmaOf::Angles => {
+                                let angles = [values[0], values[1], values[2]];
+                                Vector3::from(
+                                    convention
+                                        .rotation_sigma(&angles, &s.into())
+                                        .expect("checked: an angle convention"),
+                                )
+                            }
+                        })
+                    }
+                    _ => None,
+                };
+                let sigma = match (sigma, sr) {
+                    (Some(s), Some(r)) => Some([s[0], s[1], s[2], r[0], r[1], r[2]]),
+                    (None, None) => None,
+                    _ => return Err(err(file, format!("line {line}: pose rows need σ for both position and orientation, or neither"))),
+                };
+                MeasurementKind::Pose { value: pose, sigma }
+            }
+            _ => MeasurementKind::Position {
                 value: position,
                 sigma,
-            }
+            },
+        };
+        let covariates = Covariates {
+            temperature_c: match &layout.temperature {
+                Some(c) if row.filled(std::slice::from_ref(c)) => {
+                    Some(row.value(c, "temperature")?)
+                }
+                _ => None,
+            },
         };
         data.measurements.push(Measurement {
             config,
             observed,
             kind,
             line,
+            covariates,
         });
     }
     if data.measurements.is_empty() {
         return Err(err(file, "no data rows".into()));
     }
-    Ok((data, ReadReport { ignored }))
+    Ok((
+        data,
+        ReadReport {
+            ignored: layout.ignored,
+        },
+    ))
+}
+
+/// A data file read through a format and written in armcal's own CSV ([`import`]).
+#[derive(Clone, Debug)]
+pub struct Import {
+    /// What was read.
+    pub data: Dataset,
+    /// The columns the format did not use.
+    pub report: ReadReport,
+    /// `data` in armcal's CSV ([`write_string`]).
+    pub csv: String,
+}
+
+/// Reads `path` laid out as `format` and writes it in armcal's own CSV, so a user can see
+/// what armcal read: joints in degrees, positions in mm, orientations as `rpy` in degrees
+/// (converted through the rotation matrix), σ of the residual rows, `temperature_c`.
+pub fn import(path: &Path, model: &Model, format: &DataFormat) -> Result<Import, Error> {
+    let (data, report) = read_with(path, model, format)?;
+    let csv = write_string(&data, model)?;
+    Ok(Import { data, report, csv })
 }
 
 /// Writes a dataset in armcal's format: `pose_id`, `q<i>_deg` (or `_mm`), `target`, `x_mm`,
 /// `y_mm`, `z_mm`, then `roll_deg`, `pitch_deg`, `yaw_deg` for pose rows and σ columns if
-/// any measurement has them. Only position and pose measurements have a CSV form.
+/// any measurement has them, and `temperature_c` if any measurement recorded one. Only
+/// position and pose measurements have a CSV form.
 pub fn write_string(data: &Dataset, model: &Model) -> Result<String, Error> {
     let any_pose = data
         .measurements
@@ -479,6 +426,10 @@ pub fn write_string(data: &Dataset, model: &Model) -> Result<String, Error> {
         MeasurementKind::Pose { sigma, .. } => sigma.is_some(),
         _ => false,
     });
+    let any_temperature = data
+        .measurements
+        .iter()
+        .any(|m| m.covariates.temperature_c.is_some());
     let mut w = csv::Writer::from_writer(Vec::new());
     let mut header = vec!["pose_id".to_string()];
     header.extend(model.joints.iter().map(joint_column));
@@ -491,6 +442,9 @@ pub fn write_string(data: &Dataset, model: &Model) -> Result<String, Error> {
         if any_pose {
             header.extend(["sigma_roll_deg", "sigma_pitch_deg", "sigma_yaw_deg"].map(String::from));
         }
+    }
+    if any_temperature {
+        header.push("temperature_c".into());
     }
     w.write_record(&header)
         .map_err(|e| Error::Output(e.to_string()))?;
@@ -543,6 +497,9 @@ pub fn write_string(data: &Dataset, model: &Model) -> Result<String, Error> {
                     _ => row.extend(blank()),
                 }
             }
+        }
+        if any_temperature {
+            row.push(m.covariates.temperature_c.map(f).unwrap_or_default());
         }
         w.write_record(&row)
             .map_err(|e| Error::Output(e.to_string()))?;

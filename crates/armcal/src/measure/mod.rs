@@ -8,7 +8,10 @@
 //! distance to a fixed point, or a point on a plane. Blocks of different kinds mix freely
 //! in one least-squares problem.
 
+pub mod angles;
+mod columns;
 pub mod csv;
+pub mod format;
 pub mod noise;
 pub mod residual;
 
@@ -103,6 +106,24 @@ pub struct Measurement {
     pub kind: MeasurementKind,
     /// Line in the data file (1-based, header = 1), 0 for synthetic data.
     pub line: usize,
+    /// What else the file recorded with the measurement (not used by identification yet).
+    #[serde(default, skip_serializing_if = "Covariates::is_empty")]
+    pub covariates: Covariates,
+}
+
+/// Conditions recorded with a measurement that a model may use as covariates.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Covariates {
+    /// Air temperature at the measurement (°C).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub temperature_c: Option<f64>,
+}
+
+impl Covariates {
+    /// Whether nothing was recorded.
+    pub fn is_empty(&self) -> bool {
+        self.temperature_c.is_none()
+    }
 }
 
 /// Joint configurations and the measurements taken at them.

@@ -107,6 +107,7 @@ pub fn simulate(
                     }
                 },
                 line: 0,
+                covariates: Default::default(),
             };
             if let Some(noise) = noise {
                 let s = noise.sigmas(&m, pose.trans.norm())?;

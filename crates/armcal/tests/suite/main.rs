@@ -44,6 +44,7 @@ mod book {
 mod real_data {
     mod motoman_calibration;
     mod motoman_nominal;
+    mod ur10_import;
 }
 mod report {
     mod cell_view;

@@ -1,8 +1,8 @@
 //! The TOML layer of the cell file: raw structures with spans, unit suffixes, and errors
 //! that give file, line and field. [`parse`] reads the file section by section, one module
 //! per section: [`robot`] (`[robot]`, `[[tool_capsules]]`), [`instrument`], [`frames`]
-//! (`[base]`, `[tool]`, `[[targets]]`), [`parameters`], [`working`], [`obstacles`], and
-//! `[data]` here; [`fields`] holds the field readers they share.
+//! (`[base]`, `[tool]`, `[[targets]]`), [`parameters`], [`working`], [`obstacles`] and
+//! [`data`]; [`fields`] holds the field readers they share.
 
 use super::*;
 use crate::model::complete::LinkForm;
@@ -12,6 +12,7 @@ use serde::Deserialize;
 use std::collections::BTreeMap;
 use toml::Spanned;
 
+mod data;
 mod fields;
 mod frames;
 mod instrument;
@@ -37,7 +38,7 @@ struct RawCell {
     obstacles: Vec<Spanned<toml::Table>>,
     #[serde(default)]
     tool_capsules: Vec<Spanned<toml::Table>>,
-    data: Option<RawData>,
+    data: Option<Spanned<data::RawData>>,
 }
 
 #[derive(Deserialize)]
@@ -80,12 +81,6 @@ struct RawParameters {
     #[serde(default)]
     priors: BTreeMap<String, toml::Table>,
     measurement: Option<String>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawData {
-    joints: Vec<String>,
 }
 
 /// Error helper: file, line of a span, field path.
@@ -162,7 +157,7 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
             });
         }
     }
-    let data_columns = data_columns(file, raw.data, &model)?;
+    let data_columns = data::data_columns(&ctx, raw.data, &model)?;
     let mut cell = Cell {
         name: raw.name.unwrap_or_else(|| robot.name.clone()),
         origin: file.to_string(),
@@ -187,29 +182,4 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
         report.apply(&mut cell.model)?;
     }
     Ok(cell)
-}
-
-/// `[data]`: the data-file column of every joint, one per joint.
-fn data_columns(
-    file: &str,
-    data: Option<RawData>,
-    model: &Model,
-) -> Result<Option<DataColumns>, Error> {
-    let data_columns = match data {
-        Some(d) => {
-            if d.joints.len() != model.dof() {
-                return Err(Error::File {
-                    file: file.to_string(),
-                    message: format!(
-                        "`data.joints` lists {} columns, the robot has {} joints",
-                        d.joints.len(),
-                        model.dof()
-                    ),
-                });
-            }
-            Some(DataColumns { joints: d.joints })
-        }
-        None => None,
-    };
-    Ok(data_columns)
 }

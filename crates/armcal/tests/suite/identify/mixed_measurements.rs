@@ -34,6 +34,7 @@ fn mixed(model: &Model, truth: &[f64], qs: &[Vec<f64>]) -> Dataset {
                 sigma: None,
             },
             line: 0,
+            covariates: Default::default(),
         });
         data.measurements.push(Measurement {
             config: c,
@@ -44,6 +45,7 @@ fn mixed(model: &Model, truth: &[f64], qs: &[Vec<f64>]) -> Dataset {
                 sigma: None,
             },
             line: 0,
+            covariates: Default::default(),
         });
         if c % 3 == 0 {
             // A plane through the point (a probe touching a surface).
@@ -56,6 +58,7 @@ fn mixed(model: &Model, truth: &[f64], qs: &[Vec<f64>]) -> Dataset {
                     sigma: None,
                 },
                 line: 0,
+                covariates: Default::default(),
             });
         }
     }

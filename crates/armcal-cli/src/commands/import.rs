@@ -1,0 +1,40 @@
+//! `armcal import`: a data file as the cell's `[data]` section maps it, written in armcal's
+//! own CSV (to see what armcal reads, or to keep a converted copy).
+
+use super::output::{load_cell, write_new};
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Cell file whose `[data]` section says how the file is laid out.
+    #[arg(long)]
+    pub cell: String,
+    /// The data file as it comes from the instrument or vendor.
+    #[arg(long)]
+    pub data: PathBuf,
+    /// Output (armcal's CSV).
+    #[arg(long)]
+    pub out: PathBuf,
+    #[arg(long)]
+    pub force: bool,
+}
+
+pub fn run(a: &Args) -> anyhow::Result<()> {
+    let cell = load_cell(&a.cell)?;
+    let import = armcal::measure::csv::import(&a.data, &cell.model, &cell.data_format())?;
+    write_new(&a.out, &import.csv, a.force)?;
+    if !import.report.ignored.is_empty() {
+        eprintln!(
+            "note: ignored columns: {}",
+            import.report.ignored.join(", ")
+        );
+    }
+    println!(
+        "read {} measurements at {} configurations from {} → {}",
+        import.data.measurements.len(),
+        import.data.configurations.len(),
+        a.data.display(),
+        a.out.display()
+    );
+    Ok(())
+}

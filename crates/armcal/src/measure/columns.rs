@@ -1,0 +1,317 @@
+//! A [`DataFormat`] resolved against a file's header: which column index feeds each joint, the
+//! position, the orientation, their σ and the temperature, with the factor to internal units.
+//! armcal's own files are resolved by name with unit suffixes (`x_mm`, `q1_deg`, `u_x_m`, see
+//! [`crate::measure::csv`]); a cell's mapped columns by their exact names.
+
+use crate::measure::angles::Orientation;
+use crate::measure::format::{angle_factor, length_factor, ColumnUnit, Columns, DataFormat};
+use crate::model::{JointKind, Model};
+use crate::Error;
+
+/// A resolved column: its index in the header and the factor to internal units.
+pub(crate) struct Column {
+    pub index: usize,
+    pub factor: f64,
+}
+
+/// What the σ columns of an orientation are σ of.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum SigmaOf {
+    /// σ of the pose residual's rotation rows (armcal's own files).
+    RotationRows,
+    /// σ of the mapped convention's angles.
+    Angles,
+}
+
+/// A format resolved against a file's header.
+pub(crate) struct Layout {
+    pub joints: Vec<Column>,
+    pub position: [Column; 3],
+    pub orientation: Option<(Vec<Column>, Orientation)>,
+    pub sigma_position: Option<[Column; 3]>,
+    pub sigma_orientation: Option<([Column; 3], SigmaOf)>,
+    pub temperature: Option<Column>,
+    pub pose_id: Option<usize>,
+    pub target: Option<usize>,
+    /// Header names no column of the layout uses.
+    pub ignored: Vec<String>,
+}
+
+fn err(file: &str, msg: String) -> Error {
+    Error::File {
+        file: file.to_string(),
+        message: msg,
+    }
+}
+
+/// Splits `x_mm` into (`x`, `mm`), `sigma_x_m` into (`sigma_x`, `m`).
+fn split_unit(name: &str) -> (&str, &str) {
+    for suffix in ["_mm", "_m", "_in", "_um", "_deg", "_rad"] {
+        if let Some(base) = name.strip_suffix(suffix) {
+            return (base, &suffix[1..]);
+        }
+    }
+    match name.rsplit_once('_') {
+        Some((b, s)) if !s.is_empty() && s.chars().all(|c| c.is_ascii_alphabetic()) => (b, s),
+        _ => (name, ""),
+    }
+}
+
+impl DataFormat {
+    /// The column of every joint, with its unit factor; marks the columns used.
+    pub(crate) fn joint_layout(
+        &self,
+        header: &[String],
+        model: &Model,
+        file: &str,
+        used: &mut [bool],
+    ) -> Result<Vec<Column>, Error> {
+        let find = |name: &str| header.iter().position(|h| h == name);
+        let mut joints = Vec::new();
+        for (j, joint) in model.joints.iter().enumerate() {
+            let col = match &self.joints {
+                Some(names) => {
+                    let name = &names[j];
+                    let i = find(name).ok_or_else(|| err(file, format!("header: no column `{name}` for joint `{}` (named in the cell's [data] joints)", joint.name)))?;
+                    (i, split_unit(name).1.to_string())
+                }
+                None => {
+                    let candidates: Vec<usize> = header
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, h)| split_unit(h).0 == joint.name || h.as_str() == joint.name)
+                        .map(|(i, _)| i)
+                        .collect();
+                    match candidates.as_slice() {
+                        [i] => (*i, split_unit(&header[*i]).1.to_string()),
+                        [] => {
+                            return Err(err(
+                                file,
+                                format!(
+                                    "header: no column for joint `{}` (expected e.g. `{}`)",
+                                    joint.name,
+                                    super::csv::joint_column(joint)
+                                ),
+                            ))
+                        }
+                        _ => {
+                            return Err(err(
+                                file,
+                                format!("header: joint `{}` has several columns", joint.name),
+                            ))
+                        }
+                    }
+                }
+            };
+            let factor = match (self.joint_unit, joint.kind) {
+                (Some(u), _) => Some(u.factor()),
+                (None, JointKind::Revolute) => angle_factor(&col.1),
+                (None, JointKind::Prismatic) => length_factor(&col.1),
+            }
+            .ok_or_else(|| err(file, format!("column `{}`: unknown unit suffix `{}` for joint `{}` (use deg or rad for revolute, mm, m or in for prismatic joints)", header[col.0], col.1, joint.name)))?;
+            used[col.0] = true;
+            joints.push(Column {
+                index: col.0,
+                factor,
+            });
+        }
+        Ok(joints)
+    }
+
+    /// Resolves the format against a file's header (`file` names it in errors).
+    pub(crate) fn layout(
+        &self,
+        header: &[String],
+        model: &Model,
+        file: &str,
+    ) -> Result<Layout, Error> {
+        let mut used = vec![false; header.len()];
+        let joints = self.joint_layout(header, model, file, &mut used)?;
+        let (position, orientation, sigma_position, sigma_orientation, temperature) =
+            match &self.position {
+                Some(_) => self.mapped(header, file, &mut used)?,
+                None => armcal_columns(header, file, &mut used)?,
+            };
+        let find = |name: &str| header.iter().position(|h| h == name);
+        let pose_id = find("pose_id");
+        let target = find("target");
+        for c in [pose_id, target].into_iter().flatten() {
+            used[c] = true;
+        }
+        let ignored = header
+            .iter()
+            .zip(&used)
+            .filter(|(_, u)| !**u)
+            .map(|(h, _)| h.clone())
+            .collect();
+        Ok(Layout {
+            joints,
+            position,
+            orientation,
+            sigma_position,
+            sigma_orientation,
+            temperature,
+            pose_id,
+            target,
+            ignored,
+        })
+    }
+
+    /// The columns a cell maps by name.
+    fn mapped(&self, header: &[String], file: &str, used: &mut [bool]) -> Result<Groups, Error> {
+        let mut find = |name: &str, field: &str, factor: f64| -> Result<Column, Error> {
+            let index = header.iter().position(|h| h == name).ok_or_else(|| {
+                err(
+                    file,
+                    format!("header: no column `{name}` (the cell's [data] {field})"),
+                )
+            })?;
+            used[index] = true;
+            Ok(Column { index, factor })
+        };
+        let mut three = |c: &Columns, field: &str| -> Result<Option<[Column; 3]>, Error> {
+            if c.optional && !c.columns.iter().any(|n| header.contains(n)) {
+                return Ok(None);
+            }
+            let f = c.unit.factor();
+            Ok(Some([
+                find(&c.columns[0], field, f)?,
+                find(&c.columns[1], field, f)?,
+                find(&c.columns[2], field, f)?,
+            ]))
+        };
+        let position = three(self.position.as_ref().expect("mapped"), "position")?
+            .ok_or_else(|| err(file, "header: no position columns".into()))?;
+        let sigma_position = match &self.sigma_position {
+            Some(c) => three(c, "sigma_position")?,
+            None => None,
+        };
+        let sigma_orientation = match &self.sigma_orientation {
+            Some(c) => three(c, "sigma_orientation")?.map(|c| (c, SigmaOf::Angles)),
+            None => None,
+        };
+        let orientation = match &self.orientation {
+            Some(o) => {
+                let f = o.unit.map_or(1.0, ColumnUnit::factor);
+                let cols = o
+                    .columns
+                    .iter()
+                    .map(|n| find(n, "orientation", f))
+                    .collect::<Result<Vec<_>, _>>()?;
+                Some((cols, o.convention))
+            }
+            None => None,
+        };
+        let temperature = self
+            .temperature
+            .as_ref()
+            .map(|n| find(n, "temperature", 1.0))
+            .transpose()?;
+        Ok((
+            position,
+            orientation,
+            sigma_position,
+            sigma_orientation,
+            temperature,
+        ))
+    }
+}
+
+/// Position, orientation, their σ and the temperature, as resolved.
+type Groups = (
+    [Column; 3],
+    Option<(Vec<Column>, Orientation)>,
+    Option<[Column; 3]>,
+    Option<([Column; 3], SigmaOf)>,
+    Option<Column>,
+);
+
+/// armcal's own columns, found by name with unit suffixes (see [`crate::measure::csv`]).
+fn armcal_columns(header: &[String], file: &str, used: &mut [bool]) -> Result<Groups, Error> {
+    let mut named = |base: &str, length: bool, aliases: &[&str]| -> Result<Option<Column>, Error> {
+        for (i, h) in header.iter().enumerate() {
+            let (b, suffix) = split_unit(h);
+            if b == base || aliases.contains(&b) {
+                let f = if length {
+                    length_factor(suffix)
+                } else {
+                    angle_factor(suffix)
+                };
+                let f = f.ok_or_else(|| {
+                    err(
+                        file,
+                        format!(
+                            "column `{h}`: unknown unit suffix `{suffix}` (use {})",
+                            if length {
+                                "mm, m, in or um"
+                            } else {
+                                "deg or rad"
+                            }
+                        ),
+                    )
+                })?;
+                used[i] = true;
+                return Ok(Some(Column {
+                    index: i,
+                    factor: f,
+                }));
+            }
+        }
+        Ok(None)
+    };
+    let xyz = [
+        named("x", true, &[])?,
+        named("y", true, &[])?,
+        named("z", true, &[])?,
+    ];
+    let rpy = [
+        named("roll", false, &[])?,
+        named("pitch", false, &[])?,
+        named("yaw", false, &[])?,
+    ];
+    let sxyz = [
+        named("sigma_x", true, &["u_x"])?,
+        named("sigma_y", true, &["u_y"])?,
+        named("sigma_z", true, &["u_z"])?,
+    ];
+    let srpy = [
+        named("sigma_roll", false, &[])?,
+        named("sigma_pitch", false, &[])?,
+        named("sigma_yaw", false, &[])?,
+    ];
+    let present = |c: &[Option<Column>; 3]| c.iter().filter(|x| x.is_some()).count();
+    if present(&xyz) != 3 {
+        return Err(err(
+            file,
+            "header: need the position columns x, y, z (e.g. x_mm, y_mm, z_mm)".into(),
+        ));
+    }
+    for (group, name) in [
+        (&rpy, "roll, pitch, yaw"),
+        (&sxyz, "sigma_x, sigma_y, sigma_z"),
+        (&srpy, "sigma_roll, sigma_pitch, sigma_yaw"),
+    ] {
+        let k = present(group);
+        if k != 0 && k != 3 {
+            return Err(err(file, format!("header: give all of {name} or none")));
+        }
+    }
+    let all = |c: [Option<Column>; 3]| -> Option<[Column; 3]> {
+        let [a, b, c] = c;
+        Some([a?, b?, c?])
+    };
+    let temperature = header
+        .iter()
+        .position(|h| h == "temperature_c")
+        .map(|index| {
+            used[index] = true;
+            Column { index, factor: 1.0 }
+        });
+    Ok((
+        all(xyz).expect("checked"),
+        all(rpy).map(|c| (c.into_iter().collect(), Orientation::Rpy)),
+        all(sxyz),
+        all(srpy).map(|c| (c, SigmaOf::RotationRows)),
+        temperature,
+    ))
+}
