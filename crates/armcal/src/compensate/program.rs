@@ -13,7 +13,7 @@
 //! targets if its header has orientation columns, a joint program otherwise, and returns the
 //! compensated program as CSV with a status per row.
 
-use crate::compensate::ik::{CalibratedIk, IkResult, IkSettings, IkStatus, IkTarget};
+use crate::compensate::ik::{CalibratedIk, IkResult, IkSettings, IkTarget};
 use crate::compensate::nonparametric::ResidualCorrection;
 use crate::measure::{csv, MeasurementKind};
 use crate::model::{forward_kinematics, Data, JointKind, Model, Pose};
@@ -262,7 +262,7 @@ pub fn compensate_program(
         ));
         for (i, row) in rows.iter().enumerate() {
             let (xyz, rpy) = row.pose.to_xyz_rpy();
-            failed += usize::from(row.result.status != IkStatus::Converged);
+            failed += usize::from(!row.result.status.status().is_converged());
             out.push_str(&format!(
                 "{},{},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{}{}\n",
                 data.config_ids[data.measurements[i].config],
@@ -290,7 +290,7 @@ pub fn compensate_program(
             "pose_id,{joints_header},{correction_header}status,position_error_mm,orientation_error_deg\n",
         ));
         for row in &rows {
-            failed += usize::from(row.result.status != IkStatus::Converged);
+            failed += usize::from(!row.result.status.status().is_converged());
             out.push_str(&format!(
                 "{},{},{}{}\n",
                 row.id,

@@ -322,3 +322,28 @@ fn damping_keeps_wrist_corrections_bounded_near_the_wrist_singularity() {
     assert!(undamped[3] * undamped[5] < 0.0, "Δθ4 ≈ −Δθ6");
     assert!(deg(damped[3]) < 0.5 * deg(undamped[3]));
 }
+
+/// IK's domain status maps onto the solver vocabulary every solver shares: only a
+/// converged solve is converged there, and every other outcome keeps its reason.
+#[test]
+fn ik_status_speaks_the_shared_solver_vocabulary() {
+    use armcal::compensate::IkStatus;
+    use armcal::Status;
+    for s in [
+        IkStatus::Converged,
+        IkStatus::Singular,
+        IkStatus::JointLimits,
+        IkStatus::Unreachable,
+        IkStatus::IterationLimit,
+    ] {
+        let shared = s.status();
+        assert_eq!(shared.is_converged(), s == IkStatus::Converged, "{s:?}");
+        match shared {
+            Status::Stalled { reason } | Status::Infeasible { reason } => {
+                assert!(!reason.is_empty())
+            }
+            Status::Converged { .. } | Status::IterationLimit => {}
+            other => panic!("{s:?} maps to {other:?}"),
+        }
+    }
+}
