@@ -46,6 +46,9 @@ mod real_data {
     mod motoman_nominal;
     mod ur10_import;
 }
+mod hostile {
+    mod cell_values;
+}
 mod report {
     mod cell_view;
     mod html;
