@@ -48,6 +48,9 @@ mod real_data {
 }
 mod hostile {
     mod cell_values;
+    mod input_size;
+    mod report_ranges;
+    mod urdf_depth;
 }
 mod report {
     mod cell_view;
