@@ -52,3 +52,31 @@ alpha_deg = 0
 "#;
     assert_refused(text, "robot.links[0]", "|x| ≤ 1000000 mm");
 }
+
+/// Also: the instrument's placement and frames are checked after converting too.
+#[test]
+fn instrument_and_target_placements_are_checked_after_unit_conversion() {
+    assert_refused(
+        "[robot]\nbuiltin = \"paper\"\n[instrument]\nxyz_m = [1e306, 0, 0]\n",
+        "instrument",
+        "|x| ≤ 1000000 mm",
+    );
+    assert_refused(
+        "[robot]\nbuiltin = \"paper\"\n[[targets]]\nxyz_m = [1e306, 0, 0]\n",
+        "targets[0]",
+        "|x| ≤ 1000000 mm",
+    );
+}
+
+/// Also: a prior pattern over parameters of different units took the first one's unit.
+#[test]
+fn a_prior_pattern_over_mixed_units_is_an_error_naming_them() {
+    let text =
+        "[robot]\nbuiltin = \"paper\"\n[parameters]\npriors = { \"j2.*\" = { sigma_mm = 0.1 } }\n";
+    let e = parse(text).err().expect("the cell is refused");
+    assert!(e.contains("`parameters.priors.j2.*`"), "{e}");
+    assert!(
+        e.contains("different units") && e.contains("(deg)") && e.contains("(mm)"),
+        "{e}"
+    );
+}
