@@ -36,7 +36,7 @@ impl LinkSpec {
             )
         };
         for ((field, unit), &v) in fields.iter().zip(&self.geometry.values) {
-            if !(v.abs() <= unit.max_abs()) {
+            if !unit.holds(v) {
                 return Err(outside(format!("`{}.{field}`", self.name), v, *unit));
             }
         }
@@ -46,7 +46,7 @@ impl LinkSpec {
                 JointKind::Prismatic => Unit::Mm,
             };
             for (end, v) in [("lower", j.lower), ("upper", j.upper)] {
-                if !(v.abs() <= unit.max_abs()) {
+                if !unit.holds(v) {
                     return Err(outside(
                         format!("the {end} limit of joint `{}`", j.name),
                         v,

@@ -39,6 +39,11 @@ impl Unit {
         }
     }
 
+    /// Whether `v` (internal units) is within [`Unit::max_abs`]; false for NaN and ±∞.
+    pub fn holds(self, v: f64) -> bool {
+        v.abs() <= self.max_abs()
+    }
+
     /// The range of [`Unit::max_abs`] in display units, for an error message: `|x| ≤ 1e6 mm`.
     pub fn range_text(self) -> String {
         format!(

@@ -41,7 +41,7 @@ pub(super) fn number(v: &toml::Value) -> Option<f64> {
 /// not in mm): within [`Unit::max_abs`], else an error naming the field `k` and the range.
 fn converted(x: f64, f: f64, unit: Unit, k: &str) -> Result<f64, String> {
     let y = x * f;
-    if y.abs() <= unit.max_abs() {
+    if unit.holds(y) {
         Ok(y)
     } else {
         Err(format!(

@@ -9,7 +9,9 @@ fn parse(text: &str) -> Result<Cell, String> {
 }
 
 fn assert_refused(text: &str, field: &str, range: &str) {
-    let e = parse(text).err().expect("the cell is refused");
+    let Err(e) = parse(text) else {
+        panic!("the cell was not refused")
+    };
     assert!(e.contains("cell.toml") && e.contains("line "), "{e}");
     assert!(e.contains(&format!("`{field}`")), "{e}");
     assert!(e.contains(range), "{e}");
@@ -73,7 +75,9 @@ fn instrument_and_target_placements_are_checked_after_unit_conversion() {
 fn a_prior_pattern_over_mixed_units_is_an_error_naming_them() {
     let text =
         "[robot]\nbuiltin = \"paper\"\n[parameters]\npriors = { \"j2.*\" = { sigma_mm = 0.1 } }\n";
-    let e = parse(text).err().expect("the cell is refused");
+    let Err(e) = parse(text) else {
+        panic!("the cell was not refused")
+    };
     assert!(e.contains("`parameters.priors.j2.*`"), "{e}");
     assert!(
         e.contains("different units") && e.contains("(deg)") && e.contains("(mm)"),
