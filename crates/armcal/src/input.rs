@@ -37,7 +37,7 @@ pub fn read_capped(path: &Path, default: u64) -> std::io::Result<String> {
             std::io::ErrorKind::InvalidData,
             format!(
                 "the file is larger than {} MiB, the most armcal reads (set {CAP_VARIABLE} \
-                 to the MiB to allow)",
+                 to a larger number of MiB to raise the cap)",
                 cap >> 20
             ),
         ));

@@ -29,7 +29,7 @@ impl LinkSpec {
         let fields = self.geometry.convention.fields(kind);
         let outside = |what: String, v: f64, unit: Unit| {
             format!(
-                "{what} = {} {} is outside the range armcal accepts ({})",
+                "{what} = {:e} {} is outside the range armcal accepts ({})",
                 v * unit.display_factor(),
                 unit.display_name(),
                 unit.range_text()

@@ -45,7 +45,7 @@ fn converted(x: f64, f: f64, unit: Unit, k: &str) -> Result<f64, String> {
         Ok(y)
     } else {
         Err(format!(
-            "`{k}` = {x} is outside the range armcal accepts ({})",
+            "`{k}` = {x:e} is outside the range armcal accepts ({})",
             unit.range_text()
         ))
     }

@@ -54,10 +54,17 @@ fn a_design_with_an_overflowing_joint_range_is_refused() {
         source: "design.json".into(),
         document: Document::Design(Box::new(design)),
     }];
-    assert_too_wide(report::page(&ReportContent {
+    let e = report::page(&ReportContent {
         title: "t",
         subtitle: "s",
         inputs: &inputs,
         ..Default::default()
-    }));
+    })
+    .map(|_| ())
+    .expect_err("the design is refused")
+    .to_string();
+    assert!(
+        e.starts_with("design.json: ") && e.contains("too wide to draw"),
+        "{e}"
+    );
 }
