@@ -52,6 +52,7 @@ pub mod design;
 pub mod error;
 pub mod geometry;
 pub mod identify;
+pub mod input;
 pub mod json;
 pub mod measure;
 pub mod model;

@@ -52,7 +52,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let (est, note) = load_estimate(&a.estimate, &a.accept, Some(model))?;
     let calibrated = est.params_for(model)?;
     let program = ProgramFile::read(
-        std::fs::read_to_string(&a.targets)?,
+        armcal::input::read_capped(&a.targets, armcal::input::DATA_CAP)?,
         &a.targets.display().to_string(),
         model,
     )?;

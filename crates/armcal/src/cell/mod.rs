@@ -151,10 +151,11 @@ impl Cell {
 
     /// Reads a cell file.
     pub fn from_file(path: &Path) -> Result<Cell, Error> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::File {
-            file: path.display().to_string(),
-            message: e.to_string(),
-        })?;
+        let text =
+            crate::input::read_capped(path, crate::input::TEXT_CAP).map_err(|e| Error::File {
+                file: path.display().to_string(),
+                message: e.to_string(),
+            })?;
         let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
         Cell::from_toml(&text, &path.display().to_string(), &dir)
     }

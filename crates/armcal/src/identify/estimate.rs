@@ -194,10 +194,11 @@ pub struct Usability {
 impl Estimate {
     /// Reads an `estimate.json`.
     pub fn from_file(path: &std::path::Path) -> Result<Estimate, Error> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::File {
-            file: path.display().to_string(),
-            message: e.to_string(),
-        })?;
+        let text =
+            crate::input::read_capped(path, crate::input::TEXT_CAP).map_err(|e| Error::File {
+                file: path.display().to_string(),
+                message: e.to_string(),
+            })?;
         serde_json::from_str(&text).map_err(|e| Error::File {
             file: path.display().to_string(),
             message: format!("not an armcal estimate: {e}"),

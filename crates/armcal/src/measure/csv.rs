@@ -173,7 +173,8 @@ pub fn read_configurations_with(
     format: &DataFormat,
 ) -> Result<Vec<(String, Vec<f64>)>, Error> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| err(&file, e.to_string()))?;
+    let text = crate::input::read_capped(path, crate::input::DATA_CAP)
+        .map_err(|e| err(&file, e.to_string()))?;
     read_configurations_format_str(&text, &file, model, format)
 }
 
@@ -243,7 +244,8 @@ pub fn read_with(
     format: &DataFormat,
 ) -> Result<(Dataset, ReadReport), Error> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| err(&file, e.to_string()))?;
+    let text = crate::input::read_capped(path, crate::input::DATA_CAP)
+        .map_err(|e| err(&file, e.to_string()))?;
     read_format_str(&text, &file, model, format)
 }
 

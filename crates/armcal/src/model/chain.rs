@@ -3,7 +3,7 @@
 //! threads; buffers for one evaluation live in [`crate::model::Data`].
 
 use crate::model::link::{Convention, Joint, JointKind, LinkGeometry, Motion};
-use crate::model::registry::{Registry, Segment, Status};
+use crate::model::registry::{Registry, Segment, Status, Unit};
 use crate::Error;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -19,6 +19,44 @@ pub struct LinkSpec {
     /// Joint driving the link; `None` for fixed links, frames and targets.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub joint: Option<Joint>,
+}
+
+impl LinkSpec {
+    /// Every value of the link and its joint limits finite and within the range a model
+    /// holds ([`Unit::max_abs`]); the error names the value, its unit and the range.
+    pub fn check_values(&self) -> Result<(), String> {
+        let kind = self.joint.as_ref().map(|j| j.kind);
+        let fields = self.geometry.convention.fields(kind);
+        let outside = |what: String, v: f64, unit: Unit| {
+            format!(
+                "{what} = {:e} {} is outside the range armcal accepts ({})",
+                v * unit.display_factor(),
+                unit.display_name(),
+                unit.range_text()
+            )
+        };
+        for ((field, unit), &v) in fields.iter().zip(&self.geometry.values) {
+            if !unit.holds(v) {
+                return Err(outside(format!("`{}.{field}`", self.name), v, *unit));
+            }
+        }
+        if let Some(j) = &self.joint {
+            let unit = match j.kind {
+                JointKind::Revolute => Unit::Rad,
+                JointKind::Prismatic => Unit::Mm,
+            };
+            for (end, v) in [("lower", j.lower), ("upper", j.upper)] {
+                if !unit.holds(v) {
+                    return Err(outside(
+                        format!("the {end} limit of joint `{}`", j.name),
+                        v,
+                        unit,
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Everything needed to build a [`Model`]; also what exports and estimate files store.
@@ -150,6 +188,7 @@ impl Model {
                     ls.name
                 )));
             }
+            ls.check_values().map_err(Error::Model)?;
             let joint = match &ls.joint {
                 Some(j) => {
                     if g.convention.joint_field(j.kind).is_none() {

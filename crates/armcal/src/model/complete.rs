@@ -267,10 +267,10 @@ pub fn complete_minimal(spec: &ModelSpec) -> Result<Formed, Error> {
 fn dh_to_hayati(spec: &ModelSpec, k: usize) -> Option<ModelSpec> {
     let g = &spec.links[k].geometry;
     let kind = spec.links[k].joint.as_ref().map(|j| j.kind);
-    let dh = link_pose(g, kind);
+    let dh = link_pose(g, kind).ok()?;
     let next_axis = dh.rot * Vector3::z();
     let hayati = hayati_link(next_axis, dh.trans, g.values[0], &spec.links[k].name).ok()?;
-    let f = link_pose(&hayati, kind).inverse().compose(&dh);
+    let f = link_pose(&hayati, kind).ok()?.inverse().compose(&dh);
     let screw = (f.rot[(2, 2)] - 1.0).abs() < 1e-12 && f.trans.xy().norm() < 1e-9;
     if !screw {
         return None;

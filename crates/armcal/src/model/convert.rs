@@ -410,8 +410,9 @@ pub(crate) fn hayati_link(
     Ok(LinkGeometry::hayati(theta, l, alpha, beta))
 }
 
-/// The pose of a link geometry at q = 0 (a one-link model evaluated at its nominal values).
-pub(crate) fn link_pose(g: &LinkGeometry, kind: Option<JointKind>) -> Pose<f64> {
+/// The pose of a link geometry at q = 0 (a one-link model evaluated at its nominal values);
+/// an error if the geometry is not a valid link (e.g. a conversion's value out of range).
+pub(crate) fn link_pose(g: &LinkGeometry, kind: Option<JointKind>) -> Result<Pose<f64>, Error> {
     let joint = kind.map(|kind| crate::model::Joint {
         name: "q".into(),
         kind,
@@ -428,11 +429,12 @@ pub(crate) fn link_pose(g: &LinkGeometry, kind: Option<JointKind>) -> Pose<f64> 
         }],
         targets: vec![],
     };
-    let model = Model::from_spec(&spec).expect("a converted link is valid");
+    let model = Model::from_spec(&spec)
+        .map_err(|e| Error::Conversion(format!("a converted link is not valid: {e}")))?;
     let mut data = Data::<f64>::new(&model);
     let q = vec![0.0; model.dof()];
     forward_kinematics(&model, &mut data, &model.nominal(), &q);
-    *data.tool()
+    Ok(*data.tool())
 }
 
 /// DH model of any serial chain, by the common normals of consecutive joint axes (book
@@ -501,7 +503,7 @@ pub fn zrp_to_dh(spec: &ModelSpec, nominal: Option<&ModelSpec>) -> Result<ModelS
     let (u, p) = axis_in(&frame, &axes[0]);
     let mut g = dh_link(u, p, theta_of(nominal_base, None, "theta"));
     unwrap_towards(&mut g, nominal_base, None);
-    frame = frame.compose(&link_pose(&g, None));
+    frame = frame.compose(&link_pose(&g, None)?);
     links.push(fixed_link(&base_name, g));
 
     for (i, (ls, axis)) in joint_links.iter().zip(&axes).enumerate() {
@@ -540,7 +542,7 @@ pub fn zrp_to_dh(spec: &ModelSpec, nominal: Option<&ModelSpec>) -> Result<ModelS
             (None, _) => LinkGeometry::dh(theta_nom, 0.0, 0.0, 0.0),
         };
         unwrap_towards(&mut g, nominal_link, Some(kind));
-        frame = frame.compose(&link_pose(&g, Some(kind)));
+        frame = frame.compose(&link_pose(&g, Some(kind))?);
         links.push(LinkSpec {
             name: ls.name.clone(),
             geometry: g,
@@ -599,7 +601,7 @@ mod tests {
         for (tz_nom, expected_tz) in [(0.0, 0.4), (PI, wrap(0.4 + PI))] {
             let g = book_type3_to(&m, tz_nom);
             assert!((g.values[5] - expected_tz).abs() < 1e-12, "{:?}", g.values);
-            let p = link_pose(&g, None);
+            let p = link_pose(&g, None).unwrap();
             assert!((p.rot - m.rot).amax() < 1e-12 && (p.trans - m.trans).amax() < 1e-12);
         }
     }
@@ -614,7 +616,7 @@ mod tests {
             let (theta, l) = (g.values[0], g.values[1]);
             assert!(wrap(theta - theta_nom).abs() <= FRAC_PI_2);
             assert!((l > 0.0) == (theta_nom == 0.0), "θ = {theta}, l = {l}");
-            let f = link_pose(&g, Some(JointKind::Revolute));
+            let f = link_pose(&g, Some(JointKind::Revolute)).unwrap();
             assert!((f.rot.column(2) - u).amax() < 1e-12, "z is the next axis");
             assert!((f.trans - Vector3::new(100.0, 20.0, 0.0)).amax() < 1e-9);
         }
@@ -641,7 +643,7 @@ mod tests {
             for theta_nom in [0.0, 2.5] {
                 let g = dh_link(u, p, theta_nom);
                 assert!(wrap(g.values[0] - theta_nom).abs() <= FRAC_PI_2);
-                let f = link_pose(&g, Some(JointKind::Revolute));
+                let f = link_pose(&g, Some(JointKind::Revolute)).unwrap();
                 assert!((f.rot.column(2) - u).amax() < 1e-12, "z is the next axis");
                 let off = f.trans - p;
                 assert!(

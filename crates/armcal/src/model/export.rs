@@ -251,8 +251,8 @@ pub fn suspicious_values(reference: &Model, spec: &ModelSpec) -> Result<Vec<Stri
             g.convention,
             Convention::Frame6 | Convention::Urdf | Convention::BookType3
         ) {
-            let d = convert::link_pose(g, kind)
-                .rotation_angle_to(&convert::link_pose(&r.geometry, kind))
+            let d = convert::link_pose(g, kind)?
+                .rotation_angle_to(&convert::link_pose(&r.geometry, kind)?)
                 .to_degrees();
             if d > 45.0 {
                 out.push(format!(

@@ -410,12 +410,22 @@ pub fn analyze_at(
         } else {
             String::new()
         };
-        excluded.push(Exclusion {
-            reason: format!(
+        // No partner above the threshold: the column is within rounding of the others'
+        // span without a named combination (values so large every digit is lost).
+        let reason = if shown.is_empty() {
+            format!(
+                "`{pname}` cannot be separated from the other parameters numerically: its effect on the {} measurement is lost in rounding",
+                measurement_name(opts.measurement)
+            )
+        } else {
+            format!(
                 "`{pname}` cannot be separated from {}{more}: its effect on the {} measurement is a combination of theirs",
                 shown.join(", "),
                 measurement_name(opts.measurement)
-            ),
+            )
+        };
+        excluded.push(Exclusion {
+            reason,
             name: pname,
             partners,
         });

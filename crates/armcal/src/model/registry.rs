@@ -28,6 +28,31 @@ impl Unit {
         }
     }
 
+    /// The largest magnitude a model value of this unit may have, in internal units: lengths
+    /// 10⁶ mm (1 km), angles 3600° (ten turns, 20π rad), dimensionless 10⁶. Beyond these the
+    /// kinematics and the conversions between conventions lose every digit (and overflow), so
+    /// a model refuses them ([`crate::model::LinkSpec::check_values`]).
+    pub fn max_abs(self) -> f64 {
+        match self {
+            Unit::Mm | Unit::Unitless => 1e6,
+            Unit::Rad => 20.0 * std::f64::consts::PI,
+        }
+    }
+
+    /// Whether `v` (internal units) is within [`Unit::max_abs`]; false for NaN and ±∞.
+    pub fn holds(self, v: f64) -> bool {
+        v.abs() <= self.max_abs()
+    }
+
+    /// The range of [`Unit::max_abs`] in display units, for an error message: `|x| ≤ 1e6 mm`.
+    pub fn range_text(self) -> String {
+        format!(
+            "|x| ≤ {} {}",
+            self.max_abs() * self.display_factor(),
+            self.display_name()
+        )
+    }
+
     /// Name of the display unit.
     pub fn display_name(self) -> &'static str {
         match self {

@@ -87,10 +87,11 @@ impl Document {
 
     /// Reads a file.
     pub fn from_file(path: &Path) -> Result<Document, Error> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::File {
-            file: path.display().to_string(),
-            message: e.to_string(),
-        })?;
+        let text =
+            crate::input::read_capped(path, crate::input::TEXT_CAP).map_err(|e| Error::File {
+                file: path.display().to_string(),
+                message: e.to_string(),
+            })?;
         Document::from_json(&text, &path.display().to_string())
     }
 

@@ -74,6 +74,20 @@ fn range_of(values: impl Iterator<Item = f64>, pad: f64) -> (f64, f64) {
     (lo - pad * span, hi + pad * span)
 }
 
+/// A chart axis `lo..hi`, refused unless both ends and the span are finite: on an infinite
+/// span plotters' tick search never ends (issue 15: a design's joint range of ±1e308, or
+/// residuals of 1e308 and −1e308, froze `armcal report`).
+fn axis(lo: f64, hi: f64) -> Result<std::ops::Range<f64>, Error> {
+    if lo.is_finite() && hi.is_finite() && (hi - lo).is_finite() {
+        Ok(lo..hi)
+    } else {
+        Err(Error::Input(format!(
+            "a chart axis from {lo} to {hi} is too wide to draw: the values it shows are out of \
+             any physical range"
+        )))
+    }
+}
+
 /// Tick label text: integer positions get `names[i]`, others nothing.
 fn category_label(x: f64, names: &[String]) -> String {
     let i = x.round();
@@ -242,7 +256,7 @@ pub fn ellipse_figure(plane: Plane, series: &[EllipseSeries], k: f64) -> Result<
             .margin(margin)
             .x_label_area_size(xl)
             .y_label_area_size(yl)
-            .build_cartesian_2d(-r..r, -ry..ry)
+            .build_cartesian_2d(axis(-r, r)?, axis(-ry, ry)?)
             .map_err(drawing_error)?;
         styled_mesh(&mut chart)
             .x_desc(format!("δ{xn} (mm)"))
@@ -292,7 +306,7 @@ pub fn cdf_figure(
             .margin(12)
             .x_label_area_size(46)
             .y_label_area_size(64)
-            .build_cartesian_2d(0.0..hi.max(1e-9), 0.0..100.0)
+            .build_cartesian_2d(axis(0.0, hi.max(1e-9))?, 0.0..100.0)
             .map_err(drawing_error)?;
         styled_mesh(&mut chart)
             .x_desc(x_label)
@@ -374,7 +388,7 @@ pub fn bar_figure(
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(70)
-            .build_cartesian_2d(-0.5..(n as f64 - 0.5), lo..hi)
+            .build_cartesian_2d(-0.5..(n as f64 - 0.5), axis(lo, hi)?)
             .map_err(drawing_error)?;
         let x_tick = |x: &f64| category_label(*x, categories);
         let mut mesh = styled_mesh(&mut chart);
@@ -469,7 +483,7 @@ pub fn histogram_figure(
                 .margin(8)
                 .x_label_area_size(44)
                 .y_label_area_size(48)
-                .build_cartesian_2d(lo..hi, 0.0..top)
+                .build_cartesian_2d(axis(lo, hi)?, 0.0..top)
                 .map_err(drawing_error)?;
             styled_mesh(&mut chart)
                 .x_desc(x_label)
@@ -523,7 +537,7 @@ pub fn series_figure(
             .margin(12)
             .x_label_area_size(46)
             .y_label_area_size(70)
-            .build_cartesian_2d(x0..x1, y0..y1)
+            .build_cartesian_2d(axis(x0, x1)?, axis(y0, y1)?)
             .map_err(drawing_error)?;
         styled_mesh(&mut chart)
             .x_desc(x_label)
@@ -599,7 +613,7 @@ pub fn joint_figure(title: &str, joints: &[JointTrace]) -> Result<String, Error>
                 .margin(8)
                 .x_label_area_size(40)
                 .y_label_area_size(56)
-                .build_cartesian_2d(0.5..(n + 0.5), (j.lower - pad)..(j.upper + pad))
+                .build_cartesian_2d(0.5..(n + 0.5), axis(j.lower - pad, j.upper + pad)?)
                 .map_err(drawing_error)?;
             styled_mesh(&mut chart)
                 .x_desc("pose")

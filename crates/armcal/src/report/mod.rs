@@ -99,6 +99,14 @@ fn inputs_section(inputs: &[Input], notes: &[String]) -> Section {
 /// design, the 3D view, each estimate, the studies.
 pub fn page(c: &ReportContent) -> Result<Page, Error> {
     let mut sections = Vec::new();
+    // A document that cannot be drawn (e.g. values out of any physical range) is named.
+    let of = |i: &Input| {
+        let file = i.source.clone();
+        move |e: Error| Error::File {
+            file,
+            message: e.to_string(),
+        }
+    };
     let demo = c.demo.or_else(|| {
         c.inputs.iter().find_map(|i| match &i.document {
             Document::Demo(d) => Some(d.as_ref()),
@@ -130,11 +138,9 @@ pub fn page(c: &ReportContent) -> Result<Page, Error> {
     sections.extend(tcp::tcp_section("tcp", &items)?);
     for (k, i) in c.inputs.iter().enumerate() {
         if let Document::Design(d) = &i.document {
-            sections.push(design::design_section(
-                &format!("design-{}", k + 1),
-                &i.label,
-                d,
-            )?);
+            sections.push(
+                design::design_section(&format!("design-{}", k + 1), &i.label, d).map_err(of(i))?,
+            );
         }
     }
     if let Some(view) = &c.cell_view {
@@ -146,11 +152,10 @@ pub fn page(c: &ReportContent) -> Result<Page, Error> {
     }
     for (k, i) in c.inputs.iter().enumerate() {
         if let Document::Estimate(e) = &i.document {
-            sections.push(estimate::estimate_section(
-                &format!("estimate-{}", k + 1),
-                &i.label,
-                e,
-            )?);
+            sections.push(
+                estimate::estimate_section(&format!("estimate-{}", k + 1), &i.label, e)
+                    .map_err(of(i))?,
+            );
         }
     }
     let studies: Vec<(String, &StudyRecord)> = c

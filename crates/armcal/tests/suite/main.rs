@@ -46,6 +46,12 @@ mod real_data {
     mod motoman_nominal;
     mod ur10_import;
 }
+mod hostile {
+    mod cell_values;
+    mod input_size;
+    mod report_ranges;
+    mod urdf_depth;
+}
 mod report {
     mod cell_view;
     mod html;

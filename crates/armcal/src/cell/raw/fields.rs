@@ -37,6 +37,20 @@ pub(super) fn number(v: &toml::Value) -> Option<f64> {
         .filter(|x| x.is_finite())
 }
 
+/// `x` times the unit factor `f`, checked after converting (`x_m = 1e306` is finite but
+/// not in mm): within [`Unit::max_abs`], else an error naming the field `k` and the range.
+fn converted(x: f64, f: f64, unit: Unit, k: &str) -> Result<f64, String> {
+    let y = x * f;
+    if unit.holds(y) {
+        Ok(y)
+    } else {
+        Err(format!(
+            "`{k}` = {x:e} is outside the range armcal accepts ({})",
+            unit.range_text()
+        ))
+    }
+}
+
 /// A number with a unit suffix (see [`find_with_unit`]), in internal units.
 pub(super) fn unit_value(
     t: &toml::Table,
@@ -46,9 +60,10 @@ pub(super) fn unit_value(
 ) -> Result<Option<f64>, String> {
     match find_with_unit(t, key, unit, used)? {
         None => Ok(None),
-        Some((k, v, f)) => number(v)
-            .map(|x| Some(x * f))
-            .ok_or_else(|| format!("`{k}` must be a finite number")),
+        Some((k, v, f)) => {
+            let x = number(v).ok_or_else(|| format!("`{k}` must be a finite number"))?;
+            converted(x, f, unit, &k).map(Some)
+        }
     }
 }
 
@@ -66,7 +81,7 @@ pub(super) fn unit_triple(
             let arr = v.as_array().filter(|a| a.len() == 3).ok_or_else(bad)?;
             let mut out = [0.0; 3];
             for (o, x) in out.iter_mut().zip(arr) {
-                *o = number(x).ok_or_else(bad)? * f;
+                *o = converted(number(x).ok_or_else(bad)?, f, unit, &k)?;
             }
             Ok(Some(out))
         }

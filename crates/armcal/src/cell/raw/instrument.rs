@@ -32,6 +32,14 @@ pub(super) fn instrument(
                     ))
                 }
             };
+            let frame = LinkSpec {
+                name: ri.name.as_deref().unwrap_or("tracker").into(),
+                geometry: LinkGeometry::frame6(xyz, rpy),
+                joint: None,
+            };
+            frame
+                .check_values()
+                .map_err(|e| ctx.err(span.clone(), "instrument", e))?;
             let noise = match &ri.noise {
                 Some(t) => noise(t).map_err(|e| ctx.err(span.clone(), "instrument.noise", e))?,
                 None => NoiseModel::default(),

@@ -57,6 +57,22 @@ pub(super) fn parameters(
                 .matching(name)
                 .map_err(|e| ctx.err(span.clone(), &format!("parameters.priors.{name}"), e))?;
             let unit = model.registry.get(i[0]).unit;
+            // One σ has one unit: a pattern over lengths and angles together is an error.
+            if let Some(&other) = i.iter().find(|&&k| model.registry.get(k).unit != unit) {
+                let (a, b) = (model.registry.get(i[0]), model.registry.get(other));
+                return Err(ctx.err(
+                    span.clone(),
+                    &format!("parameters.priors.{name}"),
+                    format!(
+                        "the pattern matches parameters of different units, `{}` ({}) and `{}` \
+                         ({}); give one prior per unit",
+                        a.name,
+                        a.unit.display_name(),
+                        b.name,
+                        b.unit.display_name()
+                    ),
+                ));
+            }
             let mut used = Vec::new();
             let s = unit_value(t, "sigma", unit, &mut used)
                 .and_then(|v| v.ok_or_else(|| "missing `sigma_deg` / `sigma_mm`".into()))

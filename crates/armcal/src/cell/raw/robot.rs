@@ -25,11 +25,14 @@ pub(super) fn robot(
         ));
     }
     let mut robot = if let Some(b) = &rr.builtin {
-        robots::robot(b).map_err(|e| ctx.err(rspan.clone(), "robot.builtin", e))?
+        let robot = robots::robot(b).map_err(|e| ctx.err(rspan.clone(), "robot.builtin", e))?;
+        check_values(ctx, &robot.spec.links, rspan.clone(), "robot.builtin")?;
+        robot
     } else if let Some(u) = &rr.urdf {
         let path = dir.join(u);
         let spec = crate::model::urdf::read_urdf(&path, rr.tip.as_deref())
             .map_err(|e| ctx.err(rspan.clone(), "robot.urdf", e))?;
+        check_values(ctx, &spec.links, rspan.clone(), "robot.urdf")?;
         Robot {
             name: rr.name.clone().unwrap_or_else(|| spec.name.clone()),
             summary: format!("imported from {u}"),
@@ -48,8 +51,10 @@ pub(super) fn robot(
             if has_joint {
                 joint_index += 1;
             }
-            let spec = inline_link(l.get_ref(), joint_index)
-                .map_err(|e| ctx.err(l.span(), &format!("robot.links[{i}]"), e))?;
+            let field = format!("robot.links[{i}]");
+            let spec =
+                inline_link(l.get_ref(), joint_index).map_err(|e| ctx.err(l.span(), &field, e))?;
+            check_values(ctx, std::slice::from_ref(&spec), l.span(), &field)?;
             links.push(spec);
         }
         // Every chain starts with a base frame and ends with a tool frame.
@@ -94,6 +99,12 @@ pub(super) fn robot(
             };
             j.lower = lo * f;
             j.upper = hi * f;
+            check_values(
+                ctx,
+                std::slice::from_ref(link),
+                rspan.clone(),
+                &format!("robot.limits.{jname}"),
+            )?;
         }
     }
     for (i, c) in rr.capsules.iter().enumerate() {
@@ -102,6 +113,20 @@ pub(super) fn robot(
         robot.capsules.push(cap);
     }
     Ok(robot)
+}
+
+/// Every value of `links` within the range a model holds
+/// ([`crate::model::LinkSpec::check_values`]), after unit conversion; the error is at `field`.
+fn check_values(
+    ctx: &Ctx,
+    links: &[crate::model::LinkSpec],
+    span: Range<usize>,
+    field: &str,
+) -> Result<(), Error> {
+    links.iter().try_for_each(|l| {
+        l.check_values()
+            .map_err(|e| ctx.err(span.clone(), field, e))
+    })
 }
 
 /// `robot.convention`: the form the chain is put in ([`LinkForm`]; default `auto`).

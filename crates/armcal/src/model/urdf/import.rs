@@ -15,10 +15,11 @@ use super::{unique, CONTINUOUS_RANGE, M_PER_MM};
 pub fn read_urdf(path: impl AsRef<Path>, tip: Option<&str>) -> Result<ModelSpec, Error> {
     let path = path.as_ref();
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| Error::File {
-        file: file.clone(),
-        message: format!("cannot read the URDF file: {e}"),
-    })?;
+    let text =
+        crate::input::read_capped(path, crate::input::TEXT_CAP).map_err(|e| Error::File {
+            file: file.clone(),
+            message: format!("cannot read the URDF file: {e}"),
+        })?;
     from_urdf_str(&text, tip).map_err(|e| Error::File {
         file,
         message: match e {
@@ -28,8 +29,10 @@ pub fn read_urdf(path: impl AsRef<Path>, tip: Option<&str>) -> Result<ModelSpec,
     })
 }
 
-/// Parses URDF text and imports the chain from its root to `tip` (default: the single leaf).
+/// Parses URDF text and imports the chain from its root to `tip` (default: the single leaf);
+/// a text nesting deeper than [`super::depth::MAX_DEPTH`] is refused before parsing.
 pub fn from_urdf_str(xml: &str, tip: Option<&str>) -> Result<ModelSpec, Error> {
+    super::depth::check_depth(xml)?;
     let robot = urdf_rs::read_from_string(xml)
         .map_err(|e| Error::Input(format!("not a valid URDF document: {e}")))?;
     from_urdf_robot(&robot, tip)

@@ -32,6 +32,7 @@
 //! URDF links are the joint frames, not armcal's link-end frames; the end of the chain and the
 //! targets are exact.
 
+pub mod depth;
 pub mod export;
 pub mod import;
 
