@@ -340,7 +340,13 @@ impl StudyRecord {
 
     /// The file name without extension: `study-collisions` or `study-no-collisions`.
     pub fn file_stem(&self) -> &'static str {
-        if self.collisions {
+        StudyRecord::stem(self.collisions)
+    }
+
+    /// [`StudyRecord::file_stem`] of a study with or without collision avoidance, known
+    /// before it runs.
+    pub fn stem(collisions: bool) -> &'static str {
+        if collisions {
             "study-collisions"
         } else {
             "study-no-collisions"
