@@ -62,6 +62,7 @@ pub mod robots;
 pub mod sim;
 pub mod solve;
 pub mod study;
+pub mod table;
 pub mod workflow;
 
 pub use error::{Error, Result};

@@ -2,9 +2,9 @@
 //! one-joint-at-a-time sweeps, with each axis' σ (direction in degrees, point across the
 //! axis in mm), compared with the cell's nominal axes; warnings for axes not to be trusted.
 
-use super::output::{load_cell, load_data, write_new};
+use super::output::{load_cell, load_data, Outputs};
 use armcal::identify::circle_point::record::axes_record;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -22,9 +22,14 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
+    let outs: Vec<&Path> = a.out.iter().map(PathBuf::as_path).collect();
+    let outputs = Outputs::plan(a.force, &[Path::new(&a.cell), &a.data], &outs)?;
     let cell = load_cell(&a.cell)?;
     let data = load_data(&cell, &a.data)?;
     let rec = axes_record(&cell.model, &data)?;
+    if let Some(p) = &a.out {
+        outputs.commit(&[(p, &rec.to_json()?)])?;
+    }
     println!(
         "{:<6} {:>28} {:>34} {:>10} {:>9} {:>9} {:>8} {:>9} {:>10} {:>10}",
         "joint",
@@ -55,7 +60,6 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         eprintln!("warning: {w}");
     }
     if let Some(p) = &a.out {
-        write_new(p, &rec.to_json()?, a.force)?;
         println!("→ {}", p.display());
     }
     Ok(())

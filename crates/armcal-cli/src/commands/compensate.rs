@@ -3,12 +3,12 @@
 //! (book §5.4).
 
 use super::output::{
-    load_cell, load_data, load_estimate, with_note, write_new, AcceptUnconverged, NoteStyle,
+    load_cell, load_data, load_estimate, with_note, AcceptUnconverged, NoteStyle, Outputs,
 };
 use armcal::compensate::nonparametric::{CorrectionInputs, ResidualCorrection};
 use armcal::compensate::program::{compensate_program, ProgramFile};
 use armcal::compensate::IkSettings;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -47,6 +47,9 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
+    let mut inputs = vec![Path::new(&a.cell), &a.estimate, &a.targets];
+    inputs.extend(a.nonparametric.as_deref());
+    let outputs = Outputs::plan(a.force, &inputs, &[&a.out])?;
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
     let (est, note) = load_estimate(&a.estimate, &a.accept, Some(model))?;
@@ -87,11 +90,10 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         &IkSettings::default(),
         correction.as_ref(),
     )?;
-    write_new(
+    outputs.commit(&[(
         &a.out,
         &with_note(comp.csv, note.as_deref(), NoteStyle::Hash),
-        a.force,
-    )?;
+    )])?;
     println!(
         "{} {} filtered through the calibrated model → {} ({} not converged; see the status column)",
         comp.rows,

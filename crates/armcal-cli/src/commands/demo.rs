@@ -1,9 +1,10 @@
 //! `armcal demo`: the whole workflow on the built-in paper cell.
 
+use super::output::Outputs;
 use super::progress::Progress;
-use anyhow::{bail, Context};
-use armcal::workflow::demo::demo;
-use std::path::PathBuf;
+use anyhow::Context;
+use armcal::workflow::demo::{demo, FILES};
+use std::path::{Path, PathBuf};
 
 /// Marks a folder as written by `armcal demo`, which may then overwrite it.
 const MARKER: &str = ".armcal-demo";
@@ -18,23 +19,33 @@ pub struct Args {
     /// No progress display.
     #[arg(long)]
     pub quiet: bool,
+    /// Overwrite existing files in a folder that is not the demo's own (one it wrote, which
+    /// it rewrites without `--force`).
+    #[arg(long)]
+    pub force: bool,
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
-    if a.out.exists() && std::fs::read_dir(&a.out)?.next().is_some() && !a.out.join(MARKER).exists()
-    {
-        bail!(
-            "{} exists and was not written by `armcal demo`; choose another --out",
-            a.out.display()
-        );
-    }
+    // The demo's own folder (it holds the marker) is rewritten without `--force`: the
+    // marker stands for it. Any other existing file is refused as every command refuses it.
+    let force = a.force || a.out.join(MARKER).is_file();
+    let paths: Vec<PathBuf> = std::iter::once(MARKER)
+        .chain(FILES)
+        .map(|name| a.out.join(name))
+        .collect();
+    let planned: Vec<&Path> = paths.iter().map(PathBuf::as_path).collect();
+    let outputs = Outputs::plan(force, &[], &planned)?;
     let t0 = std::time::Instant::now();
     let demo = demo(a.seed, &mut Progress::new(a.quiet))?;
-    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
-    std::fs::write(a.out.join(MARKER), "written by armcal demo\n")?;
+    let mut files = vec![(paths[0].as_path(), "written by armcal demo\n")];
     for (name, content) in &demo.files {
-        std::fs::write(a.out.join(name), content).with_context(|| format!("writing {name}"))?;
+        let path = paths
+            .iter()
+            .find(|p| p.file_name().is_some_and(|f| f == name.as_str()));
+        let path = path.with_context(|| format!("the demo wrote an unplanned file {name}"))?;
+        files.push((path.as_path(), content.as_str()));
     }
+    outputs.commit(&files)?;
     let s = &demo.summary;
     println!("armcal demo — paper cell (λ = 650 mm, μ = 600 mm), laser tracker σ = 1 mm, car body and wall, {} poses per design, seed {}", s.poses, s.seed);
     println!();

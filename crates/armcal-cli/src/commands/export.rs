@@ -1,9 +1,9 @@
 //! `armcal export`: the calibrated model as a cell file (DH, modified-DH or zero-reference
 //! links), a parameter table, JSON or URDF.
 
-use super::output::{load_estimate, with_note, write_new, AcceptUnconverged, NoteStyle};
+use super::output::{load_estimate, with_note, AcceptUnconverged, NoteStyle, Outputs};
 use armcal::cell::export::{export_model, ExportFormat};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -29,6 +29,15 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
+    let format = ExportFormat::from_name(&a.format).expect("clap checked");
+    let table = a.out.with_extension("csv");
+    let mut outs = vec![a.out.as_path()];
+    if matches!(format, ExportFormat::Cell(_)) {
+        outs.push(&table);
+    }
+    let mut inputs = vec![a.estimate.as_path()];
+    inputs.extend(a.cell.as_deref().map(Path::new));
+    let outputs = Outputs::plan(a.force, &inputs, &outs)?;
     let cell = a
         .cell
         .as_deref()
@@ -36,22 +45,17 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         .transpose()?;
     let (est, note) = load_estimate(&a.estimate, &a.accept, cell.as_ref().map(|c| &c.model))?;
     let note = note.as_deref();
-    let format = ExportFormat::from_name(&a.format).expect("clap checked");
     let exported = export_model(&est.model, cell.as_ref(), format)?;
     for w in &exported.warnings {
         eprintln!("warning: {w}");
     }
     match format {
-        ExportFormat::Json => write_new(
-            &a.out,
-            &with_note(exported.content, note, NoteStyle::Json),
-            a.force,
-        )?,
-        ExportFormat::Urdf => write_new(
-            &a.out,
-            &with_note(exported.content, note, NoteStyle::Xml),
-            a.force,
-        )?,
+        ExportFormat::Json => {
+            outputs.commit(&[(&a.out, &with_note(exported.content, note, NoteStyle::Json))])?
+        }
+        ExportFormat::Urdf => {
+            outputs.commit(&[(&a.out, &with_note(exported.content, note, NoteStyle::Xml))])?
+        }
         ExportFormat::Cell(_) => {
             if cell.is_none() {
                 eprintln!(
@@ -60,20 +64,17 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
                      --cell to carry them"
                 );
             }
-            write_new(
-                &a.out,
-                &with_note(exported.content, note, NoteStyle::Hash),
-                a.force,
-            )?;
-            write_new(
-                &a.out.with_extension("csv"),
-                &with_note(
-                    exported.table_csv.unwrap_or_default(),
-                    note,
-                    NoteStyle::Hash,
+            outputs.commit(&[
+                (&a.out, &with_note(exported.content, note, NoteStyle::Hash)),
+                (
+                    &table,
+                    &with_note(
+                        exported.table_csv.unwrap_or_default(),
+                        note,
+                        NoteStyle::Hash,
+                    ),
                 ),
-                a.force,
-            )?;
+            ])?;
         }
     }
     println!("{} model of `{}` → {}", a.format, est.cell, a.out.display());

@@ -1,12 +1,12 @@
 //! `armcal identify`: calibrate the cell's free parameters from a data file.
 
-use super::output::{load_cell, load_data, write_new};
+use super::output::{load_cell, load_data, Outputs};
 use super::progress::Progress;
 use anyhow::bail;
 use armcal::identify::{
     identify, Estimate, IdentifySettings, LmSettings, Loss, Method, ToleranceSettings,
 };
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -48,6 +48,9 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
+    let mut inputs = vec![Path::new(&a.cell), a.data.as_path()];
+    inputs.extend(a.test.as_deref());
+    let outputs = Outputs::plan(a.force, &inputs, &[&a.out])?;
     let cell = load_cell(&a.cell)?;
     let data = load_data(&cell, &a.data)?;
     let test = a.test.as_deref().map(|t| load_data(&cell, t)).transpose()?;
@@ -65,12 +68,9 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
             ..Default::default()
         },
     };
-    if a.out.exists() && !a.force {
-        bail!("{} exists; pass --force to overwrite it", a.out.display());
-    }
     let est = identify(&cell, &data, &opts, &mut Progress::new(a.quiet))?;
+    outputs.commit(&[(&a.out, &serde_json::to_string_pretty(&est)?)])?;
     print_summary(&est);
-    write_new(&a.out, &serde_json::to_string_pretty(&est)?, a.force)?;
     println!("\nestimate → {}", a.out.display());
     if !est.solver.status.is_converged() {
         bail!(

@@ -1,8 +1,8 @@
 //! `armcal import`: a data file as the cell's `[data]` section maps it, written in armcal's
 //! own CSV (to see what armcal reads, or to keep a converted copy).
 
-use super::output::{load_cell, write_new};
-use std::path::PathBuf;
+use super::output::{load_cell, Outputs};
+use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -20,9 +20,10 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
+    let outputs = Outputs::plan(a.force, &[Path::new(&a.cell), &a.data], &[&a.out])?;
     let cell = load_cell(&a.cell)?;
     let import = armcal::measure::csv::import(&a.data, &cell.model, &cell.data_format())?;
-    write_new(&a.out, &import.csv, a.force)?;
+    outputs.commit(&[(&a.out, &import.csv)])?;
     if !import.report.ignored.is_empty() {
         eprintln!(
             "note: ignored columns: {}",

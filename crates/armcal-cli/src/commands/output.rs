@@ -1,17 +1,159 @@
-//! Writing output files without losing anything a user has.
+//! Loading a command's inputs and writing its outputs all or nothing.
+//!
+//! Every command that writes files makes an [`Outputs`] plan first, before it computes
+//! anything: each output path is refused if it exists (without `--force`), if it is one of
+//! the command's own input files (even with `--force`; paths compared canonically), if two
+//! outputs are one file, or if its directory cannot be written. After the computation,
+//! [`Outputs::commit`] writes every file to a temporary name in its own directory, then
+//! renames them into place; if anything fails, the temporary files, the files it created and
+//! the directories it made are removed again, so a failed command leaves no new file behind.
 
 use anyhow::{bail, Context};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-/// Writes `content` to `path`, refusing to replace an existing file unless `force`.
-pub fn write_new(path: &Path, content: &str, force: bool) -> anyhow::Result<()> {
-    if path.exists() && !force {
-        bail!("{} exists; pass --force to overwrite it", path.display());
+/// The files a command will write, checked before it computes anything.
+pub struct Outputs {
+    paths: Vec<PathBuf>,
+    force: bool,
+}
+
+impl Outputs {
+    /// Checks `outputs` against the rules above; `inputs` are the files the command reads
+    /// (paths that do not exist, e.g. a built-in cell's name, are no file and are skipped).
+    pub fn plan(force: bool, inputs: &[&Path], outputs: &[&Path]) -> anyhow::Result<Outputs> {
+        let canonical: Vec<PathBuf> = inputs
+            .iter()
+            .filter_map(|p| std::fs::canonicalize(p).ok())
+            .collect();
+        let mut seen: Vec<PathBuf> = Vec::new();
+        for &path in outputs {
+            if path.is_dir() {
+                bail!("{} is a directory; name a file", path.display());
+            }
+            if let Ok(c) = std::fs::canonicalize(path) {
+                if canonical.contains(&c) {
+                    bail!(
+                        "{} is an input of this command; write the output to another file",
+                        path.display()
+                    );
+                }
+            }
+            if path.exists() && !force {
+                bail!("{} exists; pass --force to overwrite it", path.display());
+            }
+            let full = absolute(path)?;
+            if seen.contains(&full) {
+                bail!("{} is given as two outputs", path.display());
+            }
+            check_writable(&full)?;
+            seen.push(full);
+        }
+        Ok(Outputs {
+            paths: outputs.iter().map(|p| p.to_path_buf()).collect(),
+            force,
+        })
     }
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+
+    /// Writes `files` (each a planned path with its content), all or nothing.
+    pub fn commit(&self, files: &[(&Path, &str)]) -> anyhow::Result<()> {
+        let mut done = Commit::default();
+        let result = self.write_all(files, &mut done);
+        if result.is_err() {
+            done.undo();
+        }
+        result
     }
-    std::fs::write(path, content).with_context(|| format!("writing {}", path.display()))
+
+    fn write_all(&self, files: &[(&Path, &str)], done: &mut Commit) -> anyhow::Result<()> {
+        for (path, content) in files {
+            if !self.paths.iter().any(|p| p == path) {
+                bail!("{} was not planned as an output", path.display());
+            }
+            if path.exists() && !self.force {
+                bail!("{} exists; pass --force to overwrite it", path.display());
+            }
+            let dir = parent(path);
+            let mut missing: Vec<PathBuf> = dir
+                .ancestors()
+                .take_while(|d| !d.exists())
+                .map(Path::to_path_buf)
+                .collect();
+            missing.reverse();
+            for d in missing {
+                std::fs::create_dir(&d).with_context(|| format!("creating {}", d.display()))?;
+                done.dirs.push(d);
+            }
+            let name = path.file_name().unwrap_or_default().to_string_lossy();
+            let temp = dir.join(format!(".{name}.armcal-{}.tmp", std::process::id()));
+            done.temps.push(temp.clone());
+            std::fs::write(&temp, content)
+                .with_context(|| format!("writing {}", path.display()))?;
+        }
+        for ((path, _), temp) in files.iter().zip(done.temps.clone()) {
+            let created = !path.exists();
+            std::fs::rename(&temp, path).with_context(|| format!("writing {}", path.display()))?;
+            done.temps.retain(|t| t != &temp);
+            if created {
+                done.created.push(path.to_path_buf());
+            }
+        }
+        Ok(())
+    }
+}
+
+/// What a commit has made so far, to be removed if it fails.
+#[derive(Default)]
+struct Commit {
+    temps: Vec<PathBuf>,
+    created: Vec<PathBuf>,
+    dirs: Vec<PathBuf>,
+}
+
+impl Commit {
+    fn undo(&self) {
+        for f in self.temps.iter().chain(&self.created) {
+            let _ = std::fs::remove_file(f);
+        }
+        for d in self.dirs.iter().rev() {
+            let _ = std::fs::remove_dir(d);
+        }
+    }
+}
+
+/// The directory a file path is in (`.` for a bare name).
+fn parent(path: &Path) -> &Path {
+    path.parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."))
+}
+
+fn absolute(path: &Path) -> anyhow::Result<PathBuf> {
+    std::path::absolute(path).with_context(|| format!("resolving {}", path.display()))
+}
+
+/// Whether a file can be made at `path`: its nearest existing ancestor directory accepts a
+/// probe file (which is removed at once).
+fn check_writable(path: &Path) -> anyhow::Result<()> {
+    let Some(dir) = parent(path).ancestors().find(|d| d.exists()) else {
+        bail!("{} has no existing directory above it", path.display());
+    };
+    if !dir.is_dir() {
+        bail!(
+            "cannot write {}: {} is not a directory",
+            path.display(),
+            dir.display()
+        );
+    }
+    let probe = dir.join(format!(".armcal-probe-{}.tmp", std::process::id()));
+    std::fs::write(&probe, "").with_context(|| {
+        format!(
+            "cannot write {}: {} is not writable",
+            path.display(),
+            dir.display()
+        )
+    })?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
 }
 
 /// Loads a cell and prints its warnings to stderr.
@@ -120,5 +262,28 @@ pub fn with_note(content: String, note: Option<&str>, style: NoteStyle) -> Strin
             &format!("{{\n  \"armcal_note\": {},", serde_json::Value::from(note)),
             1,
         ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Outputs;
+
+    #[test]
+    fn a_failed_commit_removes_what_it_wrote() {
+        let dir = std::env::temp_dir().join(format!("armcal-outputs-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let (a, b) = (dir.join("new/a.txt"), dir.join("sub/b.txt"));
+        let outputs = Outputs::plan(false, &[], &[&a, &b]).unwrap();
+        // After the plan, a file takes the place of b's folder: its write fails.
+        std::fs::write(dir.join("sub"), "in the way").unwrap();
+        assert!(outputs.commit(&[(&a, "a"), (&b, "b")]).is_err());
+        let left: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        assert_eq!(left, ["sub"], "the new folder and its file are gone");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -1,7 +1,7 @@
 //! `armcal plan`: optimal measurement poses for a cell; `armcal evaluate`: what any design
 //! (including a hand-made one) gives.
 
-use super::output::{load_cell, write_new};
+use super::output::{load_cell, Outputs};
 use super::progress::Progress;
 use anyhow::bail;
 use armcal::design::assess::evaluate_design;
@@ -62,16 +62,14 @@ pub struct EvaluateArgs {
 }
 
 pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
-    let cell = load_cell(&a.cell)?;
     let report_path = a
         .report
         .clone()
         .unwrap_or_else(|| a.out.with_extension("json"));
-    for p in [&a.out, &report_path] {
-        if p.exists() && !a.force {
-            bail!("{} exists; pass --force to overwrite it", p.display());
-        }
-    }
+    let mut inputs = vec![Path::new(&a.cell)];
+    inputs.extend(a.measured.as_deref());
+    let outputs = Outputs::plan(a.force, &inputs, &[&a.out, &report_path])?;
+    let cell = load_cell(&a.cell)?;
     let measured: Vec<Vec<f64>> = match &a.measured {
         Some(p) => csv::read_configurations(p, &cell.model, None)?
             .into_iter()
@@ -99,16 +97,10 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         &mut Progress::new(a.quiet),
     )?;
     let rep = record.plan.as_ref().expect("a planned design");
-    write_new(
-        &a.out,
-        &csv::write_configurations(&cell.model, &rep.design),
-        a.force,
-    )?;
-    write_new(
-        &report_path,
-        &serde_json::to_string_pretty(&record)?,
-        a.force,
-    )?;
+    outputs.commit(&[
+        (&a.out, &csv::write_configurations(&cell.model, &rep.design)),
+        (&report_path, &serde_json::to_string_pretty(&record)?),
+    ])?;
     println!(
         "{} poses for `{}`, criterion {:?}: value {:.6} (exchange {:.6}; refinement {}) in {:.2} s",
         rep.design.len(),

@@ -1,9 +1,9 @@
 //! `armcal predict`: what the (nominal or identified) model says the instrument measures.
 
-use super::output::{load_cell, load_params, with_note, write_new, AcceptUnconverged, NoteStyle};
+use super::output::{load_cell, load_params, with_note, AcceptUnconverged, NoteStyle, Outputs};
 use armcal::measure::csv;
 use armcal::sim::predict;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -26,20 +26,22 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
+    let mut inputs = vec![Path::new(&a.cell), &a.joints];
+    inputs.extend(a.estimate.as_deref());
+    let outputs = Outputs::plan(a.force, &inputs, &[&a.out])?;
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
     let (params, note) = load_params(a.estimate.as_deref(), &a.accept, model)?;
     let poses = csv::read_configurations_with(&a.joints, model, &cell.data_format())?;
     let data = predict(model, &params, &poses)?;
-    write_new(
+    outputs.commit(&[(
         &a.out,
         &with_note(
             csv::write_string(&data, model)?,
             note.as_deref(),
             NoteStyle::Hash,
         ),
-        a.force,
-    )?;
+    )])?;
     println!(
         "predicted {} measurements at {} configurations with the {} model → {}",
         data.measurements.len(),

@@ -1,10 +1,9 @@
 //! `armcal report`: one self-contained HTML file from armcal's JSON results (estimates,
 //! designs, `study paper` results), with inline SVG figures and the 3D view of the cell.
 
-use super::output::{write_new, AcceptUnconverged};
-use anyhow::bail;
+use super::output::{AcceptUnconverged, Outputs};
 use armcal::report::files::files_report;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -27,16 +26,15 @@ pub struct Args {
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let path = a.out.join("report.html");
-    if path.exists() && !a.force {
-        bail!("{} exists; pass --force to overwrite it", path.display());
-    }
+    let inputs: Vec<&Path> = a.files.iter().map(PathBuf::as_path).collect();
+    let outputs = Outputs::plan(a.force, &inputs, &[&path])?;
     let report = files_report(&a.files, &a.title, &a.accept.acceptance())?;
     for n in &report.notes {
         eprintln!("note: {n}");
     }
     let page = &report.page;
     let html = page.render();
-    write_new(&path, &html, a.force)?;
+    outputs.commit(&[(&path, &html)])?;
     println!(
         "report → {} ({} figure{}{}, {} kB)",
         path.display(),

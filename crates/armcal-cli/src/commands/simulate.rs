@@ -1,9 +1,9 @@
 //! `armcal simulate`: measure joint configurations on a perturbed virtual robot.
 
-use super::output::{load_cell, write_new};
+use super::output::{load_cell, Outputs};
 use armcal::measure::csv;
 use armcal::sim::{simulate_poses, Perturbation};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -40,6 +40,9 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
+    let mut outs = vec![a.out.as_path()];
+    outs.extend(a.truth_out.as_deref());
+    let outputs = Outputs::plan(a.force, &[Path::new(&a.cell), &a.poses], &outs)?;
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
     let poses = csv::read_configurations(&a.poses, model, None)?;
@@ -58,7 +61,11 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         (!a.noise_free).then_some(&noise),
         a.seed,
     )?;
-    write_new(&a.out, &csv::write_string(&sim.data, model)?, a.force)?;
+    let data = csv::write_string(&sim.data, model)?;
+    let truth = sim.truth.to_json()?;
+    let mut files = vec![(a.out.as_path(), data.as_str())];
+    files.extend(a.truth_out.as_deref().map(|t| (t, truth.as_str())));
+    outputs.commit(&files)?;
     println!(
         "simulated {} measurements at {} configurations of `{}` (seed {}) → {}",
         sim.data.measurements.len(),
@@ -68,7 +75,6 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         a.out.display()
     );
     if let Some(t) = &a.truth_out {
-        write_new(t, &sim.truth.to_json()?, a.force)?;
         println!("true parameters → {}", t.display());
     }
     Ok(())

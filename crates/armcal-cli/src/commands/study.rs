@@ -1,9 +1,11 @@
 //! `armcal study paper`: the paper's Tables 6–8 reproduced beside the published values.
 //! `armcal study puma`: the book's Chapter 6 PUMA case (Tables 6.9/6.10 and 6.13).
 
-use super::output::write_new;
+use super::output::Outputs;
 use super::progress::Progress;
-use armcal::study::paper::{self, RobotSelection, StudySettings, PAPER_SUMMARY, PAPER_TABLE6};
+use armcal::study::paper::{
+    self, RobotSelection, StudyRecord, StudySettings, PAPER_SUMMARY, PAPER_TABLE6,
+};
 use armcal::study::puma;
 use std::path::PathBuf;
 
@@ -40,6 +42,10 @@ pub fn run_study(a: &Args) -> anyhow::Result<()> {
         .clone()
         .unwrap_or_else(|| PathBuf::from("out/study-paper"));
     let collisions = a.collisions == "on";
+    let stem = StudyRecord::stem(collisions);
+    let csv_path = out.join(format!("{stem}.csv"));
+    let json_path = out.join(format!("{stem}.json"));
+    let outputs = Outputs::plan(a.force, &[], &[&csv_path, &json_path])?;
     let robots = RobotSelection::from_name(&a.robots)
         .expect("clap checked")
         .robots();
@@ -49,6 +55,11 @@ pub fn run_study(a: &Args) -> anyhow::Result<()> {
         ..StudySettings::default()
     };
     let study = paper::run_study(&robots, &settings, &mut Progress::new(a.quiet));
+    let record = &study.record;
+    outputs.commit(&[
+        (&csv_path, &record.to_csv()),
+        (&json_path, &record.to_json()?),
+    ])?;
     for r in &study.failed {
         println!(
             "{}: no result: {}",
@@ -56,7 +67,6 @@ pub fn run_study(a: &Args) -> anyhow::Result<()> {
             r.error.as_deref().unwrap_or("")
         );
     }
-    let record = &study.record;
     let rows = &record.rows;
     let secs = record.seconds;
     let col = if collisions { "with" } else { "without" };
@@ -116,10 +126,6 @@ pub fn run_study(a: &Args) -> anyhow::Result<()> {
     if !infeasible.is_empty() {
         println!("designs violating constraints: {}", infeasible.join(", "));
     }
-    let csv_path = out.join(format!("{}.csv", record.file_stem()));
-    let json_path = out.join(format!("{}.json", record.file_stem()));
-    write_new(&csv_path, &record.to_csv(), a.force)?;
-    write_new(&json_path, &record.to_json()?, a.force)?;
     println!("\n→ {}, {}", csv_path.display(), json_path.display());
     Ok(())
 }
@@ -131,6 +137,10 @@ fn run_puma(a: &Args) -> anyhow::Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out/study-puma"));
+    let json_path = out.join("puma.json");
+    let conv_path = out.join("puma-conversion.csv");
+    let acc_path = out.join("puma-accuracy.csv");
+    let outputs = Outputs::plan(a.force, &[], &[&json_path, &conv_path, &acc_path])?;
     let record = puma::record::run_record(
         &puma::PumaSettings {
             seed: a.seed,
@@ -139,6 +149,11 @@ fn run_puma(a: &Args) -> anyhow::Result<()> {
         &mut Progress::new(a.quiet),
     )?;
     let s = &record.result;
+    outputs.commit(&[
+        (&conv_path, &s.conversion_csv()),
+        (&acc_path, &s.accuracy_csv()),
+        (&json_path, &record.to_json()?),
+    ])?;
     let secs = record.seconds;
     println!(
         "PUMA 560 study (book ch. 6): truth Table 6.5, {} full poses with Table 6.4 noise \
@@ -258,12 +273,6 @@ fn run_puma(a: &Args) -> anyhow::Result<()> {
          errors include non-geometric errors and the CMM's accuracy)"
     );
 
-    let json_path = out.join("puma.json");
-    let conv_path = out.join("puma-conversion.csv");
-    let acc_path = out.join("puma-accuracy.csv");
-    write_new(&conv_path, &s.conversion_csv(), a.force)?;
-    write_new(&acc_path, &s.accuracy_csv(), a.force)?;
-    write_new(&json_path, &record.to_json()?, a.force)?;
     println!(
         "\n→ {}, {}, {}",
         json_path.display(),

@@ -72,7 +72,7 @@ fn compensate_reports_bad_rows_and_applies_the_nonparametric_correction() {
     assert!(ok, "{err}");
     let text = std::fs::read_to_string(&out_file).unwrap();
     assert!(
-        row(&text, "far").contains(",unreachable: residual "),
+        row(&text, "far").contains(",\"unreachable: residual "),
         "{text}"
     );
 

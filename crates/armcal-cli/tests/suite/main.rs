@@ -7,4 +7,5 @@ mod cli;
 mod compensate_cli;
 mod estimate_checks;
 mod import_cli;
+mod outputs_cli;
 mod workflow;

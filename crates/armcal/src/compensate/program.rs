@@ -16,7 +16,8 @@
 use crate::compensate::ik::{CalibratedIk, IkResult, IkSettings, IkTarget};
 use crate::compensate::nonparametric::ResidualCorrection;
 use crate::measure::{csv, MeasurementKind};
-use crate::model::{forward_kinematics, Data, JointKind, Model, Pose};
+use crate::model::{forward_kinematics, Data, Model, Pose};
+use crate::table::Table;
 use crate::Error;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -189,8 +190,9 @@ pub struct ProgramFile {
 impl ProgramFile {
     /// Reads a program file's text for `model`.
     pub fn read(text: String, file: &str, model: &Model) -> Result<ProgramFile, Error> {
-        let header = text.lines().find(|l| !l.starts_with('#')).unwrap_or("");
-        let cartesian = header.split(',').any(|h| h.trim().starts_with("roll"));
+        let cartesian = csv::header_str(&text, file)?
+            .iter()
+            .any(|h| h.starts_with("roll"));
         let rows = csv::read_configurations_str(&text, file, model, None)?;
         Ok(ProgramFile {
             file: file.into(),
@@ -218,20 +220,38 @@ pub fn compensate_program(
         program.cartesian,
     );
     let with = correction.is_some();
-    let correction_header = if with {
-        "correction_x_mm,correction_y_mm,correction_z_mm,"
-    } else {
-        ""
+    // pose_id, the joints, [the Cartesian target], [the correction], status and residuals.
+    let header = |target: &[&str]| {
+        let mut h = vec!["pose_id".to_string()];
+        h.extend(model.joints.iter().map(csv::joint_column));
+        h.extend(target.iter().map(|c| c.to_string()));
+        if with {
+            h.extend(["correction_x_mm", "correction_y_mm", "correction_z_mm"].map(String::from));
+        }
+        h.extend(["status", "position_error_mm", "orientation_error_deg"].map(String::from));
+        h
     };
-    let joints_header = model
-        .joints
-        .iter()
-        .map(csv::joint_column)
-        .collect::<Vec<_>>()
-        .join(",");
-    let mut out = String::new();
+    // A row: its id, the solved joints, `middle` (the target), the correction and status.
+    let row = |id: &str, r: &IkResult, middle: Vec<String>, c: &Vector3<f64>| {
+        let mut fields = vec![id.to_string()];
+        fields.extend(
+            r.q.iter()
+                .zip(&model.joints)
+                .map(|(v, j)| format!("{:.9}", csv::joint_display(j, *v))),
+        );
+        fields.extend(middle);
+        if with {
+            fields.extend([c.x, c.y, c.z].map(|x| format!("{x:.6}")));
+        }
+        fields.extend([
+            r.describe(model),
+            format!("{:.9}", r.position_error),
+            format!("{:.9}", r.orientation_error.to_degrees()),
+        ]);
+        fields
+    };
     let mut failed = 0;
-    if cartesian {
+    let out = if cartesian {
         // Read the tool poses with a robot-only model: rows become world-frame poses.
         let mut robot_only = model.spec();
         robot_only.instrument = None;
@@ -257,26 +277,26 @@ pub fn compensate_program(
         let rows = corrected_cartesian_targets(
             model, &nominal, calibrated, &poses, &seeds, settings, correction,
         );
-        out.push_str(&format!(
-            "pose_id,{joints_header},x_mm,y_mm,z_mm,roll_deg,pitch_deg,yaw_deg,{correction_header}status,position_error_mm,orientation_error_deg\n",
-        ));
-        for (i, row) in rows.iter().enumerate() {
-            let (xyz, rpy) = row.pose.to_xyz_rpy();
-            failed += usize::from(!row.result.status.status().is_converged());
-            out.push_str(&format!(
-                "{},{},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{}{}\n",
-                data.config_ids[data.measurements[i].config],
-                joint_values(model, &row.result.q),
-                xyz[0],
-                xyz[1],
-                xyz[2],
-                rpy[0].to_degrees(),
-                rpy[1].to_degrees(),
-                rpy[2].to_degrees(),
-                correction_columns(&row.correction, with),
-                status_columns(model, &row.result)
-            ));
+        let mut out = Table::new(header(&[
+            "x_mm",
+            "y_mm",
+            "z_mm",
+            "roll_deg",
+            "pitch_deg",
+            "yaw_deg",
+        ]));
+        for (i, r) in rows.iter().enumerate() {
+            let (xyz, rpy) = r.pose.to_xyz_rpy();
+            failed += usize::from(!r.result.status.status().is_converged());
+            let target = [xyz[0], xyz[1], xyz[2]]
+                .into_iter()
+                .chain(rpy.iter().map(|a| a.to_degrees()))
+                .map(|x| format!("{x:.9}"))
+                .collect();
+            let id = &data.config_ids[data.measurements[i].config];
+            out.row(row(id, &r.result, target, &r.correction));
         }
+        out
     } else {
         let rows = filter_joint_program_corrected(
             model,
@@ -286,62 +306,17 @@ pub fn compensate_program(
             settings,
             correction,
         );
-        out.push_str(&format!(
-            "pose_id,{joints_header},{correction_header}status,position_error_mm,orientation_error_deg\n",
-        ));
-        for row in &rows {
-            failed += usize::from(!row.result.status.status().is_converged());
-            out.push_str(&format!(
-                "{},{},{}{}\n",
-                row.id,
-                joint_values(model, &row.result.q),
-                correction_columns(&row.correction, with),
-                status_columns(model, &row.result)
-            ));
+        let mut out = Table::new(header(&[]));
+        for r in &rows {
+            failed += usize::from(!r.result.status.status().is_converged());
+            out.row(row(&r.id, &r.result, Vec::new(), &r.correction));
         }
-    }
+        out
+    };
     Ok(CompensatedProgram {
         cartesian,
         rows: program.rows.len(),
         not_converged: failed,
-        csv: out,
+        csv: out.into_string(),
     })
-}
-
-/// The joint values of a row in display units (deg, mm), 9 decimals.
-fn joint_values(model: &Model, q: &[f64]) -> String {
-    q.iter()
-        .zip(&model.joints)
-        .map(|(v, j)| {
-            format!(
-                "{:.9}",
-                if j.kind == JointKind::Revolute {
-                    v.to_degrees()
-                } else {
-                    *v
-                }
-            )
-        })
-        .collect::<Vec<_>>()
-        .join(",")
-}
-
-/// Status (with the joint and limit, or the residual, for a row that did not converge) and
-/// residual columns.
-fn status_columns(model: &Model, r: &IkResult) -> String {
-    format!(
-        "{},{:.9},{:.9}",
-        r.describe(model),
-        r.position_error,
-        r.orientation_error.to_degrees()
-    )
-}
-
-/// `correction_x_mm,…,` columns (empty without a correction).
-fn correction_columns(c: &Vector3<f64>, with: bool) -> String {
-    if with {
-        format!("{:.6},{:.6},{:.6},", c.x, c.y, c.z)
-    } else {
-        String::new()
-    }
 }

@@ -22,6 +22,7 @@ use crate::measure::columns::{Column, SigmaOf};
 use crate::measure::format::{clean, number, DataFormat, Decimal};
 use crate::measure::{Covariates, Dataset, Measurement, MeasurementKind};
 use crate::model::{Joint, JointKind, Model, Observed, Pose};
+use crate::table;
 use crate::Error;
 use nalgebra::Vector3;
 use std::collections::HashMap;
@@ -138,6 +139,12 @@ impl Row<'_> {
             .map(|(c, j)| self.value(c, &j.name))
             .collect()
     }
+}
+
+/// The column names of an armcal CSV file's text (its first line that is not a comment),
+/// read as CSV: a quoted name with a comma is one column.
+pub fn header_str(text: &str, file: &str) -> Result<Vec<String>, Error> {
+    reader(text, file, &DataFormat::armcal()).map(|(_, header, _)| header)
 }
 
 /// Reads joint configurations (a pose list or a joint program): `pose_id` (optional) and
@@ -432,7 +439,6 @@ pub fn write_string(data: &Dataset, model: &Model) -> Result<String, Error> {
         .measurements
         .iter()
         .any(|m| m.covariates.temperature_c.is_some());
-    let mut w = csv::Writer::from_writer(Vec::new());
     let mut header = vec!["pose_id".to_string()];
     header.extend(model.joints.iter().map(joint_column));
     header.extend(["target", "x_mm", "y_mm", "z_mm"].map(String::from));
@@ -448,17 +454,12 @@ pub fn write_string(data: &Dataset, model: &Model) -> Result<String, Error> {
     if any_temperature {
         header.push("temperature_c".into());
     }
-    w.write_record(&header)
-        .map_err(|e| Error::Output(e.to_string()))?;
+    let mut w = table::Table::new(&header);
     let f = |x: f64| format!("{x:.9}");
     for m in &data.measurements {
         let mut row = vec![data.config_ids[m.config].clone()];
         for (v, j) in data.configurations[m.config].iter().zip(&model.joints) {
-            row.push(f(if j.kind == JointKind::Revolute {
-                v.to_degrees()
-            } else {
-                *v
-            }));
+            row.push(f(joint_display(j, *v)));
         }
         row.push(match m.observed {
             Observed::Target(k) => model.targets[k].spec.name.clone(),
@@ -503,11 +504,9 @@ pub fn write_string(data: &Dataset, model: &Model) -> Result<String, Error> {
         if any_temperature {
             row.push(m.covariates.temperature_c.map(f).unwrap_or_default());
         }
-        w.write_record(&row)
-            .map_err(|e| Error::Output(e.to_string()))?;
+        w.row(&row);
     }
-    let bytes = w.into_inner().map_err(|e| Error::Output(e.to_string()))?;
-    String::from_utf8(bytes).map_err(|e| Error::Output(e.to_string()))
+    Ok(w.into_string())
 }
 
 /// The column name of a joint in the data files armcal writes: its name with the unit of
@@ -516,29 +515,29 @@ pub fn joint_column(joint: &Joint) -> String {
     format!("{}_{}", joint.name, joint.kind.unit().display_name())
 }
 
+/// A joint value in the unit of its column ([`joint_column`]): degrees for a revolute
+/// joint, millimetres for a prismatic one.
+pub fn joint_display(joint: &Joint, q: f64) -> f64 {
+    if joint.kind == JointKind::Revolute {
+        q.to_degrees()
+    } else {
+        q
+    }
+}
+
 /// Writes joint configurations (a pose list, design or joint program): `pose_id` 1, 2, …
 /// and one column per joint, `_deg` for revolute and `_mm` for prismatic joints — the format
 /// [`read_configurations`] reads.
 pub fn write_configurations(model: &Model, qs: &[Vec<f64>]) -> String {
-    let mut s = String::from("pose_id");
-    for j in &model.joints {
-        s.push(',');
-        s.push_str(&joint_column(j));
-    }
-    s.push('\n');
+    let mut t = table::Table::new(
+        std::iter::once("pose_id".to_string()).chain(model.joints.iter().map(joint_column)),
+    );
     for (i, q) in qs.iter().enumerate() {
-        s.push_str(&format!("{}", i + 1));
-        for (v, j) in q.iter().zip(&model.joints) {
-            s.push_str(&format!(
-                ",{:.6}",
-                if j.kind == JointKind::Revolute {
-                    v.to_degrees()
-                } else {
-                    *v
-                }
-            ));
-        }
-        s.push('\n');
+        let values = q.iter().zip(&model.joints);
+        t.row(
+            std::iter::once((i + 1).to_string())
+                .chain(values.map(|(v, j)| format!("{:.6}", joint_display(j, *v)))),
+        );
     }
-    s
+    t.into_string()
 }

@@ -6,6 +6,7 @@ use crate::model::complete::LinkForm;
 use crate::model::convert;
 use crate::model::link::{Convention, JointKind};
 use crate::model::registry::{Segment, Unit};
+use crate::table::Table;
 use crate::Error;
 use std::fmt::Write;
 
@@ -152,7 +153,7 @@ pub fn to_cell_toml_with(spec: &ModelSpec, sections: &CellSections) -> Result<St
 
 /// A parameter table: one row per link with its convention and fields (mm, deg).
 pub fn to_table_csv(spec: &ModelSpec) -> String {
-    let mut out = String::from("link,convention,joint,field,value,unit\n");
+    let mut out = Table::new(["link", "convention", "joint", "field", "value", "unit"]);
     let links = spec
         .instrument
         .iter()
@@ -168,19 +169,17 @@ pub fn to_table_csv(spec: &ModelSpec) -> String {
             .iter()
             .zip(&l.geometry.values)
         {
-            let _ = writeln!(
-                out,
-                "{},{},{},{},{:?},{}",
-                l.name,
+            out.row([
+                l.name.as_str(),
                 l.geometry.convention.name(),
                 joint,
                 field,
-                display(*unit, *v),
-                unit.display_name()
-            );
+                &format!("{:?}", display(*unit, *v)),
+                unit.display_name(),
+            ]);
         }
     }
-    out
+    out.into_string()
 }
 
 /// `spec` in the link form of an export, forward kinematics unchanged: `Zrp` the

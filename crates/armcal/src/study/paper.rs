@@ -340,7 +340,13 @@ impl StudyRecord {
 
     /// The file name without extension: `study-collisions` or `study-no-collisions`.
     pub fn file_stem(&self) -> &'static str {
-        if self.collisions {
+        StudyRecord::stem(self.collisions)
+    }
+
+    /// [`StudyRecord::file_stem`] of a study with or without collision avoidance, known
+    /// before it runs.
+    pub fn stem(collisions: bool) -> &'static str {
+        if collisions {
             "study-collisions"
         } else {
             "study-no-collisions"
@@ -354,22 +360,31 @@ impl StudyRecord {
 
     /// One CSV line per row.
     pub fn to_csv(&self) -> String {
-        let mut csv = String::from("robot,collisions,heuristic_mm2,cp_optimal_mm2,cs_optimal_mm2,gain_vs_heuristic,gain_vs_cp,feasible,seconds\n");
+        let mut csv = crate::table::Table::new([
+            "robot",
+            "collisions",
+            "heuristic_mm2",
+            "cp_optimal_mm2",
+            "cs_optimal_mm2",
+            "gain_vs_heuristic",
+            "gain_vs_cp",
+            "feasible",
+            "seconds",
+        ]);
         for r in &self.rows {
-            csv.push_str(&format!(
-                "{},{},{:.6},{:.6},{:.6},{:.4},{:.4},{},{:.2}\n",
-                r.robot,
-                r.collisions,
-                r.heuristic,
-                r.cp_optimal,
-                r.cs_optimal,
-                r.gain_vs_heuristic,
-                r.gain_vs_cp,
-                r.feasible,
-                r.seconds
-            ));
+            csv.row([
+                r.robot.clone(),
+                r.collisions.to_string(),
+                format!("{:.6}", r.heuristic),
+                format!("{:.6}", r.cp_optimal),
+                format!("{:.6}", r.cs_optimal),
+                format!("{:.4}", r.gain_vs_heuristic),
+                format!("{:.4}", r.gain_vs_cp),
+                r.feasible.to_string(),
+                format!("{:.2}", r.seconds),
+            ]);
         }
-        csv
+        csv.into_string()
     }
 }
 

@@ -5,11 +5,29 @@ use crate::report::{self, Document, Input, ReportContent};
 use crate::study::demo::{run_demo, DemoSummary};
 use crate::Error;
 
+/// The names of the files [`demo`] gives, known before it runs (a command checks where it
+/// will write them first).
+pub const FILES: [&str; 13] = [
+    "cell.toml",
+    "data-heuristic.csv",
+    "data-kpi.csv",
+    "design-heuristic.csv",
+    "design-heuristic.json",
+    "design-kpi.csv",
+    "design-kpi.json",
+    "estimate-heuristic.json",
+    "estimate-kpi.json",
+    "program-corrected.csv",
+    "program.csv",
+    "report.html",
+    "summary.json",
+];
+
 /// The demo's summary and every file it writes (name, content), the report included.
 pub struct DemoFiles {
     /// The demo's numbers.
     pub summary: DemoSummary,
-    /// Every file (name, content), `report.html` last.
+    /// Every file (name, content; the names are [`FILES`]), `report.html` last.
     pub files: Vec<(String, String)>,
 }
 

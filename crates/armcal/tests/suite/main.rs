@@ -41,6 +41,9 @@ mod book {
     mod book_identification;
     mod study_puma;
 }
+mod files {
+    mod read_back;
+}
 mod real_data {
     mod motoman_calibration;
     mod motoman_nominal;

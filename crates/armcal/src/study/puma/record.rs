@@ -4,6 +4,7 @@
 
 use super::{run, PumaSettings, PumaStudy};
 use crate::progress::Observer;
+use crate::table::Table;
 use crate::Error;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
@@ -41,69 +42,71 @@ impl PumaStudy {
     /// Tables 6.9/6.10 as CSV: per transform its fields and the three parameters of each
     /// column (converted, identified, σ, truth, book converted, book identified).
     pub fn conversion_csv(&self) -> String {
-        let mut conv = String::from(
-            "transform,link,field1,field2,field3,conv_p1,conv_p2,conv_p3,ident_p1,ident_p2,ident_p3,\
-             sigma_p1,sigma_p2,sigma_p3,truth_p1,truth_p2,truth_p3,book_conv_p1,book_conv_p2,book_conv_p3,book_ident_p1,\
-             book_ident_p2,book_ident_p3\n",
+        let three = |c: &'static str| (1..=3).map(move |i| format!("{c}_p{i}"));
+        let mut conv = Table::new(
+            ["transform", "link", "field1", "field2", "field3"]
+                .map(String::from)
+                .into_iter()
+                .chain(
+                    ["conv", "ident", "sigma", "truth", "book_conv", "book_ident"]
+                        .into_iter()
+                        .flat_map(three),
+                ),
         );
         for r in &self.conversion {
-            let v: Vec<String> = [
+            let values = [
                 r.converted,
                 r.identified,
                 r.identified_sigma,
                 r.truth,
                 r.book_converted,
                 r.book_identified,
-            ]
-            .iter()
-            .flatten()
-            .map(|x| format!("{x:.6}"))
-            .collect();
-            conv.push_str(&format!(
-                "{},{},{},{}\n",
-                r.transform,
-                r.link,
-                r.fields.join(","),
-                v.join(",")
-            ));
+            ];
+            conv.row(
+                [r.transform.clone(), r.link.clone()]
+                    .into_iter()
+                    .chain(r.fields.iter().cloned())
+                    .chain(values.iter().flatten().map(|x| format!("{x:.6}"))),
+            );
         }
-        conv
+        conv.into_string()
     }
 
     /// Table 6.13 as CSV: per held-out pose δr (in) and δθ (deg) of each model, armcal's
     /// and the book's (empty where the book has no pose of that number).
     pub fn accuracy_csv(&self) -> String {
-        let mut acc = String::from(
-            "pose,nominal_dr_in,nominal_dtheta_deg,mdh_dr_in,mdh_dtheta_deg,zrp_dr_in,zrp_dtheta_deg,\
-             book_nominal_dr_in,book_nominal_dtheta_deg,book_mdh_dr_in,book_mdh_dtheta_deg,\
-             book_zrp_dr_in,book_zrp_dtheta_deg\n",
+        let columns = ["nominal", "mdh", "zrp"]
+            .into_iter()
+            .flat_map(|m| [format!("{m}_dr_in"), format!("{m}_dtheta_deg")]);
+        let mut acc = Table::new(
+            std::iter::once("pose".to_string())
+                .chain(columns.clone())
+                .chain(columns.map(|c| format!("book_{c}"))),
         );
         for r in &self.held_out {
-            let b = r
-                .book
-                .map(|b| {
-                    format!(
-                        "{},{},{},{},{},{}",
-                        b.nominal_dr_in,
-                        b.nominal_dtheta_deg,
-                        b.mdh_dr_in,
-                        b.mdh_dtheta_deg,
-                        b.zrp_dr_in,
-                        b.zrp_dtheta_deg
-                    )
-                })
-                .unwrap_or_else(|| ",,,,,".into());
-            acc.push_str(&format!(
-                "{},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{b}\n",
-                r.pose,
+            let book = match r.book {
+                Some(b) => [
+                    b.nominal_dr_in,
+                    b.nominal_dtheta_deg,
+                    b.mdh_dr_in,
+                    b.mdh_dtheta_deg,
+                    b.zrp_dr_in,
+                    b.zrp_dtheta_deg,
+                ]
+                .map(|x| x.to_string()),
+                None => Default::default(),
+            };
+            let ours = [
                 r.nominal_dr_in,
                 r.nominal_dtheta_deg,
                 r.mdh_dr_in,
                 r.mdh_dtheta_deg,
                 r.zrp_dr_in,
-                r.zrp_dtheta_deg
-            ));
+                r.zrp_dtheta_deg,
+            ]
+            .map(|x| format!("{x:.6}"));
+            acc.row(std::iter::once(r.pose.to_string()).chain(ours).chain(book));
         }
-        acc
+        acc.into_string()
     }
 }

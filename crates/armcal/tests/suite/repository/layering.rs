@@ -11,7 +11,7 @@ const ABOVE_REPORT: &[&str] = &["workflow"];
 
 /// The layers of docs/DESIGN.md, bottom first: a module imports only from lower layers.
 const LAYERS: &[&[&str]] = &[
-    &["solve", "progress", "error", "json", "input"],
+    &["solve", "progress", "error", "json", "input", "table"],
     &["model", "geometry"],
     &["robots", "measure"],
     &["cell", "sim", "accuracy"],
