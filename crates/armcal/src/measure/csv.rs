@@ -172,6 +172,14 @@ pub fn read_configurations_str(
     )
 }
 
+/// A data file's name (for errors) and its text, read with the data-file size cap.
+fn read_data_file(path: &Path) -> Result<(String, String), Error> {
+    let file = path.display().to_string();
+    let text = crate::input::read_capped(path, crate::input::DATA_CAP)
+        .map_err(|e| err(&file, e.to_string()))?;
+    Ok((file, text))
+}
+
 /// Joint configurations from a file laid out as `format` says (its delimiter, decimal
 /// notation, joint columns and unit; the other mapped columns are not needed).
 pub fn read_configurations_with(
@@ -179,9 +187,7 @@ pub fn read_configurations_with(
     model: &Model,
     format: &DataFormat,
 ) -> Result<Vec<(String, Vec<f64>)>, Error> {
-    let file = path.display().to_string();
-    let text = crate::input::read_capped(path, crate::input::DATA_CAP)
-        .map_err(|e| err(&file, e.to_string()))?;
+    let (file, text) = read_data_file(path)?;
     read_configurations_format_str(&text, &file, model, format)
 }
 
@@ -250,9 +256,7 @@ pub fn read_with(
     model: &Model,
     format: &DataFormat,
 ) -> Result<(Dataset, ReadReport), Error> {
-    let file = path.display().to_string();
-    let text = crate::input::read_capped(path, crate::input::DATA_CAP)
-        .map_err(|e| err(&file, e.to_string()))?;
+    let (file, text) = read_data_file(path)?;
     read_format_str(&text, &file, model, format)
 }
 
