@@ -1,0 +1,48 @@
+//! `armcal accuracy` on a large data file: 80 000 position measurements of the paper cell,
+//! 20 000 commanded poses each approached 4 times (encoder jitter below the grouping
+//! tolerance), grouped into ISO 9283 poses and compared with the model.
+
+use armcal::accuracy::report::{accuracy_report, SAME_POSE};
+use armcal::cell::Cell;
+use armcal::model::random_configurations;
+use armcal::sim::{perturbed_truth, simulate, Perturbation};
+use criterion::{criterion_group, criterion_main, Criterion};
+
+use armcal::cell::builtin::PAPER_CELL as CELL;
+
+fn accuracy(c: &mut Criterion) {
+    let cell =
+        Cell::from_toml(CELL, "paper-cell.toml", std::path::Path::new(".")).expect("paper cell");
+    let model = &cell.model;
+    let truth = perturbed_truth(model, &Perturbation::default(), 1);
+    let commanded = random_configurations(model, 20_000, 2);
+    let jitter = random_configurations(model, 80_000, 3);
+    let qs: Vec<Vec<f64>> = (0..80_000)
+        .map(|k| {
+            commanded[k % commanded.len()]
+                .iter()
+                .zip(&model.joints)
+                .zip(&jitter[k])
+                .map(|((q, j), u)| {
+                    let d = 0.4 * SAME_POSE * ((u - j.lower) / (j.upper - j.lower) - 0.5);
+                    (q + d).clamp(j.lower, j.upper)
+                })
+                .collect()
+        })
+        .collect();
+    let data = simulate(model, &truth, &qs, Some(&cell.noise()), 4).expect("simulate");
+    let nominal = model.nominal();
+    let mut group = c.benchmark_group("accuracy");
+    group.sample_size(10);
+    group.bench_function("80 000 rows, 20 000 poses × 4", |b| {
+        b.iter(|| {
+            let report = accuracy_report(model, &nominal, &data);
+            assert_eq!(report.poses.len(), 20_000);
+            report
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, accuracy);
+criterion_main!(benches);

@@ -1,0 +1,202 @@
+//! The paths a fuzzed input flows through, one function per target (issue 15).
+//!
+//! Each function reads its input as armcal's CLI would and then drives the value read through
+//! what the CLI does with it. An `Err` is a correct answer to a bad input; a panic, a hang or an
+//! unbounded allocation is a finding. The round trips (`export` → read, `write` → read) assert
+//! armcal's own promise that every file it writes, it can read (issue 12).
+
+use armcal::cell::export::{export_model, ExportFormat};
+use armcal::cell::model_analysis::analyze_model;
+use armcal::design::assess::evaluate_design;
+use armcal::identify::IdentifySettings;
+use armcal::measure::csv;
+use armcal::model::complete::LinkForm;
+use armcal::model::identifiability::IdentifiabilitySettings;
+use armcal::model::{random_configurations, tool_pose};
+use armcal::progress::Silent;
+use armcal::report::{page, Document, Input, ReportContent};
+use armcal::{Cell, Model};
+use std::path::Path;
+use std::sync::OnceLock;
+
+/// Few configurations and iterations: a fuzz execution must stay in milliseconds.
+const POSES: usize = 8;
+
+/// The folder a fuzzed cell is read in: empty, so relative file names in it resolve to nothing.
+fn empty_dir() -> &'static Path {
+    static DIR: OnceLock<std::path::PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let d = std::env::temp_dir().join(format!("armcal-fuzz-{}", std::process::id()));
+        std::fs::create_dir_all(&d).expect("a temporary folder");
+        d
+    })
+}
+
+/// Cell TOML → cell → model analysis (identifiability, rank deficit) in one of the
+/// conventions, constraints and prediction at random poses, and one export read back as a
+/// cell. The input's length chooses the convention and the export (one of each keeps an
+/// execution fast; the fuzzer's mutations change the length, so every pair is reached).
+pub fn cell(text: &str) {
+    let Ok(cell) = Cell::from_toml(text, "fuzz.toml", empty_dir()) else {
+        return;
+    };
+    let settings = IdentifiabilitySettings {
+        poses: POSES,
+        ..cell.identifiability_settings()
+    };
+    let forms = [
+        None,
+        Some(LinkForm::Dh),
+        Some(LinkForm::Mdh),
+        Some(LinkForm::Zrp),
+    ];
+    let _ = analyze_model(&cell, &settings, forms[text.len() % forms.len()]);
+    let design = random_configurations(&cell.model, POSES, 1);
+    let _ = evaluate_design(&cell, &design, true);
+    let formats = ["dh", "mdh", "zrp", "cell", "json", "urdf"];
+    let format = ExportFormat::from_name(formats[text.len() / 4 % formats.len()]).expect("known");
+    let Ok(exported) = export_model(&cell.model.spec(), Some(&cell), format) else {
+        return;
+    };
+    if let ExportFormat::Cell(_) = format {
+        if let Err(e) = Cell::from_toml(&exported.content, "exported.toml", empty_dir()) {
+            panic!(
+                "armcal cannot read the cell it exported: {e}\n{}",
+                exported.content
+            );
+        }
+    }
+}
+
+/// The built-in cells a fuzzed data file is read for: the paper cell (armcal's own columns)
+/// and the UR10 cell (a vendor's `;`-separated, decimal-comma file through a `[data]` mapping).
+fn data_cells() -> &'static [Cell; 2] {
+    static CELLS: OnceLock<[Cell; 2]> = OnceLock::new();
+    CELLS.get_or_init(|| {
+        let read = |text: &str, name: &str| {
+            Cell::from_toml(text, name, Path::new(".")).expect("a built-in example cell")
+        };
+        [
+            read(armcal::cell::builtin::PAPER_CELL, "paper-cell.toml"),
+            read(
+                include_str!("../../examples/ur10-leica-cell.toml"),
+                "ur10-leica-cell.toml",
+            ),
+        ]
+    })
+}
+
+/// Data CSV → dataset (first byte chooses the cell) → a short identification, and the
+/// dataset written in armcal's format read back with the same rows.
+pub fn data_csv(bytes: &[u8]) {
+    let Some((&choice, rest)) = bytes.split_first() else {
+        return;
+    };
+    let Ok(text) = std::str::from_utf8(rest) else {
+        return;
+    };
+    let cell = &data_cells()[usize::from(choice & 1)];
+    let Ok((data, _)) = csv::read_format_str(text, "fuzz.csv", &cell.model, &cell.data_format())
+    else {
+        return;
+    };
+    let mut settings = IdentifySettings {
+        holdout: 0.0,
+        ..IdentifySettings::default()
+    };
+    settings.lm.tolerances.max_iterations = 3;
+    let _ = armcal::identify(cell, &data, &settings, &mut Silent);
+    let Ok(written) = csv::write_string(&data, &cell.model) else {
+        return;
+    };
+    let joints: Vec<String> = cell.model.joints.iter().map(csv::joint_column).collect();
+    match csv::read_str(&written, "written.csv", &cell.model, Some(&joints)) {
+        Ok((again, _)) => assert_eq!(
+            again.measurements.len(),
+            data.measurements.len(),
+            "a written data file reads back with another number of rows"
+        ),
+        Err(e) => panic!("armcal cannot read the data file it wrote: {e}\n{written}"),
+    }
+}
+
+/// URDF → model → forward kinematics → URDF → model: the same tool pose.
+pub fn urdf(text: &str) {
+    let Ok(spec) = armcal::model::urdf::from_urdf_str(text, None) else {
+        return;
+    };
+    let Ok(model) = Model::from_spec(&spec) else {
+        return;
+    };
+    let qs = random_configurations(&model, 3, 1);
+    let poses: Vec<_> = qs
+        .iter()
+        .map(|q| tool_pose(&model, &model.nominal(), q))
+        .collect();
+    let Ok(xml) = armcal::model::urdf::to_urdf(&spec) else {
+        return;
+    };
+    let again = armcal::model::urdf::from_urdf_str(&xml, None)
+        .and_then(|s| Model::from_spec(&s))
+        .unwrap_or_else(|e| panic!("armcal cannot read the URDF it wrote: {e}\n{xml}"));
+    for (q, before) in qs.iter().zip(&poses) {
+        let after = tool_pose(&again, &again.nominal(), q);
+        let scale = 1.0 + before.trans.norm();
+        assert!(
+            (after.trans - before.trans).norm() <= 1e-6 * scale || !before.trans.norm().is_finite(),
+            "the URDF round trip moved the tool: {:?} → {:?}",
+            before.trans,
+            after.trans
+        );
+    }
+}
+
+/// armcal JSON (estimate, design, study, demo summary) → the report page; an estimate also
+/// through every export and a prediction, a design through its evaluation.
+pub fn records(text: &str) {
+    let Ok(document) = Document::from_json(text, "fuzz.json") else {
+        return;
+    };
+    match &document {
+        Document::Estimate(e) => {
+            let _ = e.check_usable(&armcal::identify::Acceptance {
+                accepted: false,
+                accept: "accept",
+                raise_iterations: "raise",
+            });
+            for format in ["dh", "mdh", "zrp", "cell", "json", "urdf"] {
+                let format = ExportFormat::from_name(format).expect("a known format");
+                let _ = export_model(&e.model, None, format);
+            }
+            if let Ok(model) = Model::from_spec(&e.model) {
+                if let Ok(params) = e.params_for(&model) {
+                    let poses: Vec<(String, Vec<f64>)> = random_configurations(&model, 3, 1)
+                        .into_iter()
+                        .enumerate()
+                        .map(|(i, q)| (format!("p{i}"), q))
+                        .collect();
+                    let _ = armcal::sim::predict(&model, &params, &poses);
+                }
+            }
+        }
+        Document::Design(d) => {
+            let cell = &data_cells()[0];
+            if let Ok(design) = d.design_for(&cell.model) {
+                let _ = evaluate_design(cell, &design, true);
+            }
+        }
+        Document::Study(_) | Document::Demo(_) => {}
+    }
+    let inputs = [Input {
+        label: "fuzz".into(),
+        source: "fuzz.json".into(),
+        document,
+    }];
+    if let Ok(p) = page(&ReportContent {
+        title: "fuzz",
+        inputs: &inputs,
+        ..ReportContent::default()
+    }) {
+        let _ = p.render();
+    }
+}
