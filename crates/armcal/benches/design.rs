@@ -33,7 +33,7 @@ fn design(c: &mut Criterion) {
             "{name}: (1/3) tr C_s = {:.5} mm², feasible {}, efficiency {:.3}, refinement: {} ({} iterations)",
             r.value,
             r.feasible,
-            r.bound.as_ref().map_or(f64::NAN, |b| b.efficiency),
+            r.bound.as_ref().and_then(|b| b.efficiency).unwrap_or(f64::NAN),
             r.refine_status.as_deref().unwrap_or("skipped"),
             r.refine_iterations
         );

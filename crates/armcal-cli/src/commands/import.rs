@@ -24,12 +24,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let cell = load_cell(&a.cell)?;
     let import = armcal::measure::csv::import(&a.data, &cell.model, &cell.data_format())?;
     outputs.commit(&[(&a.out, &import.csv)])?;
-    if !import.report.ignored.is_empty() {
-        eprintln!(
-            "note: ignored columns: {}",
-            import.report.ignored.join(", ")
-        );
-    }
+    super::output::print_read_report(&import.report);
     println!(
         "read {} measurements at {} configurations from {} → {}",
         import.data.measurements.len(),

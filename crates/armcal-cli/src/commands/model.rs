@@ -16,9 +16,9 @@ pub struct Args {
     /// Measurement type for the identifiability analysis (default: the cell's).
     #[arg(long, value_parser = ["pose", "position", "distance"])]
     pub measurement: Option<String>,
-    /// Random configurations used by the analysis.
-    #[arg(long, default_value_t = 60)]
-    pub poses: usize,
+    /// Random configurations used by the analysis (at least 1).
+    #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(1..))]
+    pub poses: u32,
     /// Seed of the random configurations.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -40,7 +40,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         .unwrap_or(cell.measurement);
     let opts = IdentifiabilitySettings {
         measurement,
-        poses: a.poses,
+        poses: a.poses as usize,
         seed: a.seed,
         ..cell.identifiability_settings()
     };

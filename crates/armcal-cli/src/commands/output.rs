@@ -165,17 +165,36 @@ pub fn load_cell(name_or_path: &str) -> anyhow::Result<armcal::cell::Cell> {
     Ok(cell)
 }
 
-/// Reads a data file for a cell (its `[data]` column mapping), noting ignored columns on
-/// stderr.
+/// Reads a data file for a cell (its `[data]` column mapping), with the reader's remarks
+/// ([`print_read_report`]) and a note when the cell's noise model does not use the σ columns.
 pub fn load_data(
     cell: &armcal::cell::Cell,
     path: &Path,
 ) -> anyhow::Result<armcal::measure::Dataset> {
     let (data, report) = armcal::measure::csv::read_with(path, &cell.model, &cell.data_format())?;
+    print_read_report(&report);
+    if let Some(note) = cell.noise().unused_sigmas(&data) {
+        eprintln!("note: {note}");
+    }
+    Ok(data)
+}
+
+/// The reader's remarks on stderr: ignored columns, then rows read with a warning (the first
+/// few, and how many more).
+pub fn print_read_report(report: &armcal::measure::csv::ReadReport) {
+    const SHOWN: usize = 5;
     if !report.ignored.is_empty() {
         eprintln!("note: ignored columns: {}", report.ignored.join(", "));
     }
-    Ok(data)
+    for w in report.warnings.iter().take(SHOWN) {
+        eprintln!("warning: {w}");
+    }
+    if report.warnings.len() > SHOWN {
+        eprintln!(
+            "warning: … and {} more rows like these",
+            report.warnings.len() - SHOWN
+        );
+    }
 }
 
 /// `--accept-unconverged`, shared by the commands that use an estimate.

@@ -129,13 +129,17 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
             ))
             .unwrap_or_else(|| "none".into())
     );
-    if let Some(b) = &rep.bound {
-        println!(
-            "optimality bound: no {}-pose design can go below {:.6}; this design's efficiency {:.3}",
+    match rep.bound.as_ref().map(|b| (b, b.efficiency)) {
+        Some((b, Some(e))) => println!(
+            "optimality bound: no {}-pose design can go below {:.6}; this design's efficiency {e:.3}",
             rep.design.len(),
-            b.lower_bound,
-            b.efficiency
-        );
+            b.lower_bound
+        ),
+        Some(_) => println!(
+            "optimality bound: none (the bound found is not positive, so it says nothing about \
+             this design)"
+        ),
+        None => {}
     }
     if let Some(t) = record.assessment.tcp.first() {
         println!("(1/3) tr C_s at `{}`: {:.5} mm²", t.name, t.kpi);

@@ -5,6 +5,7 @@ mod common;
 mod browser;
 mod cli;
 mod compensate_cli;
+mod error_causes;
 mod estimate_checks;
 mod import_cli;
 mod outputs_cli;

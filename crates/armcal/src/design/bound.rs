@@ -26,8 +26,9 @@ pub struct OptimalityBound {
     /// Lower bound on the criterion of any N-pose design.
     pub lower_bound: f64,
     /// `lower_bound / value` (A, E, KPI: 1 is optimal); for log-scale criteria (D, O1, O3)
-    /// `exp(lower_bound − value)`.
-    pub efficiency: f64,
+    /// `exp(lower_bound − value)` ([`efficiency`]). `None` when the bound says nothing: a
+    /// criterion of positive values (A, E, KPI) with a bound ≤ 0.
+    pub efficiency: Option<f64>,
     /// Largest sensitivity found and where.
     pub max_sensitivity: f64,
     /// The configuration (joint values, internal units: rad, mm) where `max_sensitivity` was
@@ -41,6 +42,16 @@ pub fn has_bound(c: Criterion) -> bool {
         c,
         Criterion::A | Criterion::D | Criterion::E | Criterion::Kpi | Criterion::O1 | Criterion::O3
     )
+}
+
+/// A design's efficiency against the lower bound `lower` of its criterion `c`: `lower / value`
+/// for the criteria of positive values (A, E, KPI; `None` when `lower ≤ 0`, a bound that says
+/// nothing), `exp(lower − value)` for the log-scale ones (D, O1, O3).
+pub fn efficiency(c: Criterion, lower: f64, value: f64) -> Option<f64> {
+    match c {
+        Criterion::A | Criterion::E | Criterion::Kpi => (lower > 0.0).then(|| lower / value),
+        _ => Some((lower - value).exp()),
+    }
 }
 
 /// Sensitivity `d(x) = −⟨Φ, I(x)⟩ = −tr(J Φ Jᵀ)` and its gradient w.r.t. x.
@@ -140,15 +151,26 @@ pub fn optimality_bound(
     }
     let n = design.len() as f64;
     let lower = cv.value - inner - n * best.0;
-    let efficiency = match objective.criterion {
-        Criterion::A | Criterion::E | Criterion::Kpi => lower / cv.value,
-        _ => (lower - cv.value).exp(),
-    };
     Ok(OptimalityBound {
         value: cv.value,
         lower_bound: lower,
-        efficiency,
+        efficiency: efficiency(objective.criterion, lower, cv.value),
         max_sensitivity: best.0,
         argmax: best.1,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_bound_that_is_not_positive_gives_no_efficiency() {
+        assert_eq!(efficiency(Criterion::Kpi, 0.3, 0.6), Some(0.5));
+        assert_eq!(efficiency(Criterion::Kpi, -0.52, 0.6), None);
+        assert_eq!(efficiency(Criterion::A, 0.0, 0.6), None);
+        // Log-scale criteria: any real bound means something.
+        let e = efficiency(Criterion::D, -3.0, -2.0).unwrap();
+        assert!((e - (-1f64).exp()).abs() < 1e-15);
+    }
 }

@@ -97,6 +97,12 @@ fn value_of(
     Ok(evaluate(c, &triangular_factor(a), d)?.value)
 }
 
+/// The fewest poses that can identify the `n` free parameters of `d`: each gives `d.rows()`
+/// rows, and the `prior` rows of measured poses count.
+pub fn minimum_poses(d: &DesignModel, prior: &DMatrix<f64>) -> usize {
+    d.n().saturating_sub(prior.nrows()).div_ceil(d.rows())
+}
+
 /// Runs the exchange for `n_points` configurations from `pool` (with `prior` whitened rows of
 /// already-measured configurations).
 pub fn exchange(
@@ -117,32 +123,53 @@ pub fn exchange(
     }
     let rows = d.rows();
     let n = d.n();
+    // L for A-type criteria: φ = tr(L C Lᵀ). First, so that a criterion the cell cannot
+    // serve (KPI without a working pose) says so rather than failing every start below.
+    let l: Option<DMatrix<f64>> = match criterion {
+        Criterion::A => Some(DMatrix::identity(n, n) / (n as f64).sqrt()),
+        Criterion::Kpi => Some(kpi_matrix(d)?),
+        _ => None,
+    };
+    let needed = minimum_poses(d, prior);
+    if n_points < needed {
+        return Err(Error::Input(format!(
+            "{n_points} poses cannot identify the {n} free parameters: each pose gives {rows} \
+             measurement rows{}, so at least {needed} poses are needed",
+            if prior.nrows() > 0 {
+                format!(" and the measured poses give {}", prior.nrows())
+            } else {
+                String::new()
+            }
+        )));
+    }
     let jp = pool_jacobians(d, pool);
     // Start: a random subset that identifies every parameter (retry a few times).
     let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
     let mut idx: Vec<usize> = (0..pool.len()).collect();
     let mut chosen = Vec::new();
     let mut value = f64::INFINITY;
+    let mut last_failure = None;
     for _ in 0..20 {
         idx.shuffle(&mut rng);
         let trial: Vec<usize> = idx[..n_points].to_vec();
-        if let Ok(v) = value_of(d, criterion, &jp, prior, &trial) {
-            chosen = trial;
-            value = v;
-            break;
+        match value_of(d, criterion, &jp, prior, &trial) {
+            Ok(v) => {
+                chosen = trial;
+                value = v;
+                break;
+            }
+            Err(e) => last_failure = Some(e),
         }
     }
     if chosen.is_empty() {
         return Err(Error::Input(format!(
-            "no random set of {n_points} pool configurations identifies every free parameter; use more poses or a larger pool"
+            "no random set of {n_points} of the {} feasible pool configurations identifies every \
+             free parameter ({}); use more poses, a larger pool, or check which parameters the \
+             cell's measurements cannot identify (`armcal model`)",
+            pool.len(),
+            last_failure.map_or_else(|| "no start was tried".to_string(), |e| e.to_string())
         )));
     }
-    // L for A-type criteria: φ = tr(L C Lᵀ).
-    let l: Option<DMatrix<f64>> = match criterion {
-        Criterion::A => Some(DMatrix::identity(n, n) / (n as f64).sqrt()),
-        Criterion::Kpi => Some(kpi_matrix(d)?),
-        _ => None,
-    };
     let mut history = vec![value];
     let mut sweeps = 0;
     let mut exchanges = 0;

@@ -57,7 +57,7 @@ impl<'a> Problem<'a> {
     pub fn new(model: &'a Model, data: &'a Dataset, noise: &NoiseModel) -> Result<Self, Error> {
         let free = model.registry.free();
         for (c, q) in data.configurations.iter().enumerate() {
-            model.check_joints(q).map_err(|e| {
+            model.check_measured_joints(q).map_err(|e| {
                 Error::Input(format!("configuration `{}`: {e}", data.config_ids[c]))
             })?;
         }

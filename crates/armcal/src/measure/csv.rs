@@ -33,6 +33,9 @@ use std::path::Path;
 pub struct ReadReport {
     /// Header names of the columns the reader did not use.
     pub ignored: Vec<String>,
+    /// Rows read with a remark, each a sentence naming file, line and field: joint values a
+    /// little past the model's limits ([`crate::model::MEASURED_LIMIT_TOLERANCE`]).
+    pub warnings: Vec<String>,
 }
 
 fn err(file: &str, msg: String) -> Error {
@@ -129,6 +132,61 @@ impl Row<'_> {
 
     fn v3(&self, cols: &[Column; 3], what: &str) -> Result<Vector3<f64>, Error> {
         Ok(Vector3::from_iterator(self.values(cols, what)?))
+    }
+
+    /// Three standard deviations: each must be positive (a σ of 0 would give the row an
+    /// infinite weight, a negative one is no σ at all).
+    fn sigmas(&self, cols: &[Column; 3]) -> Result<Vector3<f64>, Error> {
+        let s = self.v3(cols, "σ")?;
+        if let Some((c, v)) = cols.iter().zip(s.iter()).find(|(_, v)| **v <= 0.0) {
+            return Err(err(
+                self.file,
+                format!(
+                    "line {}: `{}` = {} is not a standard deviation: a σ must be positive \
+                     (leave the σ columns of a row empty to use the cell's noise model)",
+                    self.line,
+                    self.header[c.index],
+                    v / c.factor
+                ),
+            ));
+        }
+        Ok(s)
+    }
+
+    /// Checks measured joint values against the model's limits: within them, `None`; past a
+    /// limit by at most [`crate::model::MEASURED_LIMIT_TOLERANCE`] (a real robot's limits are
+    /// not its datasheet's), a warning; further, an error naming the file, line and joint.
+    fn limit_check(&self, q: &[f64], model: &Model) -> Result<Option<String>, Error> {
+        let Some((j, excess)) = model.joints_past_limits(q) else {
+            return Ok(None);
+        };
+        let joint = &model.joints[j];
+        let unit = joint.kind.unit();
+        let f = unit.display_factor();
+        let says = format!(
+            "line {}: joint `{}` = {:.4} {u} is {:.4} {u} past its limits [{:.4}, {:.4}] {u}",
+            self.line,
+            joint.name,
+            q[j] * f,
+            excess * f,
+            joint.lower * f,
+            joint.upper * f,
+            u = unit.display_name(),
+        );
+        if excess <= crate::model::MEASURED_LIMIT_TOLERANCE.of(joint.kind) {
+            return Ok(Some(format!(
+                "{}: {says}; read, since a real robot's limits differ from its nominal ones",
+                self.file
+            )));
+        }
+        Err(err(
+            self.file,
+            format!(
+                "{says}: check the column's unit (the header's `_deg` / `_rad` / `_mm` suffix or \
+                 the cell's `[data]` joint_unit), or widen the cell's `[robot] limits` if the \
+                 robot reaches there"
+            ),
+        ))
     }
 
     /// The joint values (internal units).
@@ -274,6 +332,7 @@ pub fn read_format_str(
         ..Default::default()
     };
     let mut config_of: HashMap<String, usize> = HashMap::new();
+    let mut warnings = Vec::new();
     let targets: Vec<&str> = model.targets.iter().map(|t| t.spec.name.as_str()).collect();
     for (r, record) in rdr.records().enumerate() {
         let line = lines.get(r + 1).copied().unwrap_or(r + 2);
@@ -286,6 +345,9 @@ pub fn read_format_str(
             decimal: format.decimal,
         };
         let q = row.joints(&layout.joints, model)?;
+        if let Some(w) = row.limit_check(&q, model)? {
+            warnings.push(w);
+        }
         let id = layout
             .pose_id
             .map(|c| row.text(c).to_string())
@@ -339,7 +401,7 @@ pub fn read_format_str(
         };
         let position = row.v3(&layout.position, "position")?;
         let sigma = match &layout.sigma_position {
-            Some(c) if row.filled(c) => Some(row.v3(c, "σ")?),
+            Some(c) if row.filled(c) => Some(row.sigmas(c)?),
             _ => None,
         };
         let kind = match &layout.orientation {
@@ -351,7 +413,7 @@ pub fn read_format_str(
                 };
                 let sr = match &layout.sigma_orientation {
                     Some((c, of)) if row.filled(c) => {
-                        let s = row.v3(c, "σ")?;
+                        let s = row.sigmas(c)?;
                         Some(match of {
                             SigmaOf::RotationRows => s,
                             SigmaOf::Angles => {
@@ -401,6 +463,7 @@ pub fn read_format_str(
         data,
         ReadReport {
             ignored: layout.ignored,
+            warnings,
         },
     ))
 }

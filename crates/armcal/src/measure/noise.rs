@@ -42,22 +42,51 @@ impl Default for NoiseModel {
     }
 }
 
+/// σ the data file gives for a measurement, if any, one per residual row (zero-padded).
+fn stated_sigma(m: &Measurement) -> Option<[f64; 6]> {
+    match &m.kind {
+        MeasurementKind::Position { sigma, .. } => sigma.map(|s| [s[0], s[1], s[2], 0.0, 0.0, 0.0]),
+        MeasurementKind::Pose { sigma, .. } => *sigma,
+        MeasurementKind::Distance { sigma, .. }
+        | MeasurementKind::DistanceToPoint { sigma, .. }
+        | MeasurementKind::OnPlane { sigma, .. } => sigma.map(|s| [s, 0.0, 0.0, 0.0, 0.0, 0.0]),
+    }
+}
+
 impl NoiseModel {
+    /// A sentence for the user when `data` states σ for some rows but this noise model does
+    /// not use them (constant and range models weight every row by their own σ).
+    pub fn unused_sigmas(&self, data: &crate::measure::Dataset) -> Option<String> {
+        if matches!(self, NoiseModel::PerMeasurement { .. }) {
+            return None;
+        }
+        let stated = data
+            .measurements
+            .iter()
+            .filter(|m| stated_sigma(m).is_some())
+            .count();
+        (stated > 0).then(|| {
+            format!(
+                "{} of the {} measurements of {} state their σ, but the cell's noise model is \
+                 {}: the σ columns are not used (set the instrument's noise model to \
+                 `per-measurement` to weight each row by its own σ)",
+                stated,
+                data.measurements.len(),
+                data.source,
+                match self {
+                    NoiseModel::Constant { .. } => "constant",
+                    _ => "range-dependent",
+                }
+            )
+        })
+    }
+
     /// σ of each residual row of `m` (first `m.kind.rows()` entries). `range` is the
     /// distance of the observed point from the instrument (mm), for the range model.
     pub fn sigmas(&self, m: &Measurement, range: f64) -> Result<[f64; 6], Error> {
         let rows = m.kind.rows();
         let mut out = [0.0; 6];
-        // σ the data file gives for this measurement, if any.
-        let given: Option<[f64; 6]> = match &m.kind {
-            MeasurementKind::Position { sigma, .. } => {
-                sigma.map(|s| [s[0], s[1], s[2], 0.0, 0.0, 0.0])
-            }
-            MeasurementKind::Pose { sigma, .. } => *sigma,
-            MeasurementKind::Distance { sigma, .. }
-            | MeasurementKind::DistanceToPoint { sigma, .. }
-            | MeasurementKind::OnPlane { sigma, .. } => sigma.map(|s| [s, 0.0, 0.0, 0.0, 0.0, 0.0]),
-        };
+        let given = stated_sigma(m);
         match self {
             NoiseModel::Constant { sigma, sigma_angle } => match &m.kind {
                 MeasurementKind::Position { .. } => out[..3].copy_from_slice(sigma),

@@ -145,6 +145,33 @@ pub struct Model {
     pub(crate) target_steps: Vec<Vec<Step>>,
 }
 
+/// How far past a nominal joint limit a measured joint value may lie and still be read as a
+/// measurement (with a warning): a real robot's software limits are not its datasheet's, and
+/// datasheets round. Further than this, a value more likely has the wrong unit or column.
+#[derive(Clone, Copy, Debug)]
+pub struct LimitTolerance {
+    /// Revolute joints (rad).
+    pub revolute: f64,
+    /// Prismatic joints (mm).
+    pub prismatic: f64,
+}
+
+impl LimitTolerance {
+    /// The tolerance of a joint of `kind` (rad or mm).
+    pub fn of(&self, kind: JointKind) -> f64 {
+        match kind {
+            JointKind::Revolute => self.revolute,
+            JointKind::Prismatic => self.prismatic,
+        }
+    }
+}
+
+/// 5° and 5 mm ([`LimitTolerance`]).
+pub const MEASURED_LIMIT_TOLERANCE: LimitTolerance = LimitTolerance {
+    revolute: 5.0 * std::f64::consts::PI / 180.0,
+    prismatic: 5.0,
+};
+
 impl Model {
     /// Builds a model from its spec. Checks field counts, unique names, conventions that
     /// need or forbid a joint, non-zero ZRP axes and joint limits.
@@ -376,6 +403,17 @@ impl Model {
 
     /// Checks a joint vector's length and limits; the error names the joint and its range.
     pub fn check_joints(&self, q: &[f64]) -> Result<(), Error> {
+        self.check_joints_within(q, |_| 1e-9)
+    }
+
+    /// As [`Model::check_joints`] for measured joint values, which may lie up to
+    /// [`MEASURED_LIMIT_TOLERANCE`] past a limit (a real robot's limits differ from its
+    /// nominal ones; the data reader warns about them).
+    pub fn check_measured_joints(&self, q: &[f64]) -> Result<(), Error> {
+        self.check_joints_within(q, |kind| MEASURED_LIMIT_TOLERANCE.of(kind) + 1e-9)
+    }
+
+    fn check_joints_within(&self, q: &[f64], tol: impl Fn(JointKind) -> f64) -> Result<(), Error> {
         if q.len() != self.dof() {
             return Err(Error::Input(format!(
                 "model `{}` has {} joints, got {} values",
@@ -392,7 +430,7 @@ impl Model {
                     joint.name
                 )));
             }
-            let tol = 1e-9;
+            let tol = tol(joint.kind);
             if *v < joint.lower - tol || *v > joint.upper + tol {
                 let f = joint.kind.unit().display_factor();
                 return Err(Error::Input(format!(
@@ -406,6 +444,17 @@ impl Model {
             }
         }
         Ok(())
+    }
+
+    /// The joint furthest past its limits in `q` (finite values, one per joint) and by how
+    /// much (rad or mm); `None` if every joint is within its limits.
+    pub fn joints_past_limits(&self, q: &[f64]) -> Option<(usize, f64)> {
+        q.iter()
+            .zip(&self.joints)
+            .map(|(v, j)| (j.lower - v).max(v - j.upper))
+            .enumerate()
+            .filter(|(_, excess)| *excess > 1e-9)
+            .max_by(|a, b| a.1.total_cmp(&b.1))
     }
 
     /// Joint limits as (lower, upper) vectors.

@@ -287,7 +287,7 @@ pub fn analyze_at(
     opts: &IdentifiabilitySettings,
 ) -> Result<Identifiability, Error> {
     for q in qs {
-        model.check_joints(q)?;
+        model.check_measured_joints(q)?;
     }
     let mut candidates: Vec<usize> = model.registry.free();
     let fixed: Vec<String> = (0..model.param_count())

@@ -17,7 +17,7 @@ pub mod registry;
 pub mod sampling;
 pub mod urdf;
 
-pub use chain::{Link, LinkSpec, Model, ModelSpec};
+pub use chain::{LimitTolerance, Link, LinkSpec, Model, ModelSpec, MEASURED_LIMIT_TOLERANCE};
 pub use jacobian::{
     identification_jacobian, identification_jacobian_dq, joint_jacobian, observed_pose,
     observed_position, MixedWorkspace, Observed, Rows,

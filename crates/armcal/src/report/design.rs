@@ -75,13 +75,19 @@ pub fn design_section(id: &str, label: &str, d: &DesignRecord) -> Result<Section
         match &p.bound {
             Some(b) => rows.push((
                 "optimality bound",
-                format!(
-                    "no {}-pose design can go below {}; this design's value {}, efficiency {} (1 = optimal)",
-                    d.poses.len(),
-                    number(b.lower_bound),
-                    number(b.value),
-                    fixed(b.efficiency, 3)
-                ),
+                match b.efficiency {
+                    Some(e) => format!(
+                        "no {}-pose design can go below {}; this design's value {}, efficiency {} (1 = optimal)",
+                        d.poses.len(),
+                        number(b.lower_bound),
+                        number(b.value),
+                        fixed(e, 3)
+                    ),
+                    None => format!(
+                        "none: the bound found ({}) is not positive, so it says nothing about this design",
+                        number(b.lower_bound)
+                    ),
+                },
             )),
             None => rows.push((
                 "optimality bound",

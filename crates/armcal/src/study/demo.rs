@@ -285,7 +285,7 @@ pub fn run_demo(seed: u64, observer: &mut dyn Observer) -> Result<Demo, Error> {
         kpi: kpi_c,
         program_miss_nominal: miss_nominal,
         program_miss_compensated: miss_comp,
-        kpi_bound_efficiency: plan_report.bound.as_ref().map(|b| b.efficiency),
+        kpi_bound_efficiency: plan_report.bound.as_ref().and_then(|b| b.efficiency),
     };
     files.push((
         "summary.json".into(),

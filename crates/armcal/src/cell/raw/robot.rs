@@ -99,6 +99,8 @@ pub(super) fn robot(
             };
             j.lower = lo * f;
             j.upper = hi * f;
+            limit_order(j)
+                .map_err(|e| ctx.err(rspan.clone(), &format!("robot.limits.{jname}"), e))?;
             check_values(
                 ctx,
                 std::slice::from_ref(link),
@@ -113,6 +115,23 @@ pub(super) fn robot(
         robot.capsules.push(cap);
     }
     Ok(robot)
+}
+
+/// A joint's lower limit is not above its upper one (equal limits lock the joint); the error
+/// gives both in the cell's units.
+fn limit_order(j: &Joint) -> Result<(), String> {
+    if j.lower <= j.upper {
+        return Ok(());
+    }
+    let unit = j.kind.unit();
+    let f = unit.display_factor();
+    Err(format!(
+        "joint `{}`: the lower limit {} {u} is above the upper limit {} {u} (write `[lower, upper]`)",
+        j.name,
+        j.lower * f,
+        j.upper * f,
+        u = unit.display_name()
+    ))
 }
 
 /// Every value of `links` within the range a model holds
@@ -239,12 +258,14 @@ fn inline_link(t: &toml::Table, index: usize) -> Result<LinkSpec, String> {
             let jname = string_field(t, "joint_name")?
                 .map(str::to_string)
                 .unwrap_or_else(|| format!("q{index}"));
-            Some(Joint {
+            let joint = Joint {
                 name: jname,
                 kind: k,
                 lower: num(&lim[0])? * f,
                 upper: num(&lim[1])? * f,
-            })
+            };
+            limit_order(&joint)?;
+            Some(joint)
         }
     };
     let mut valid: Vec<String> = convention

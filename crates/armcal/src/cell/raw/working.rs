@@ -25,13 +25,25 @@ pub(super) fn working(
         } else {
             ("joints_rad", 1.0)
         };
-        let arr = t.get(key).and_then(|v| v.as_array()).ok_or_else(|| {
-            ctx.err(
+        let arr = match t.get(key) {
+            None => return Err(ctx.err(
                 w.span(),
                 &field,
                 "missing `joints_deg` (deg for revolute, mm for prismatic joints) or `joints_rad`",
-            )
-        })?;
+            )),
+            Some(v) => v.as_array().ok_or_else(|| {
+                ctx.err(
+                    w.span(),
+                    &format!("{field}.{key}"),
+                    format!(
+                        "must be an array of {} numbers, e.g. `{key} = [{}]`; it is a {}",
+                        model.dof(),
+                        vec!["0"; model.dof()].join(", "),
+                        v.type_str()
+                    ),
+                )
+            })?,
+        };
         let q: Vec<f64> = arr
             .iter()
             .zip(&model.joints)

@@ -51,6 +51,16 @@ pub fn from_urdf_robot(robot: &urdf_rs::Robot, tip: Option<&str>) -> Result<Mode
             return Err(err(format!("link `{}` is defined twice", l.name)));
         }
     }
+    let mut joint_names = HashSet::new();
+    for j in &robot.joints {
+        if !joint_names.insert(j.name.as_str()) {
+            return Err(err(format!(
+                "two joints are named `{}`: a URDF's joint names are unique (data files and \
+                 limits name joints), rename one",
+                j.name
+            )));
+        }
+    }
     // parent joint of every child link, and the joints leaving every link
     let mut parent_joint: HashMap<&str, &urdf_rs::Joint> = HashMap::new();
     let mut has_children: HashSet<&str> = HashSet::new();

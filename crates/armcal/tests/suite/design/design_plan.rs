@@ -60,7 +60,7 @@ fn planner_beats_the_heuristic_with_and_without_collisions() {
             kpi.refine_status,
             kpi.time.as_secs_f64(),
             kpi.bound.as_ref().unwrap().lower_bound,
-            kpi.bound.as_ref().unwrap().efficiency,
+            kpi.bound.as_ref().unwrap().efficiency.unwrap(),
             kpi.min_margin
         );
         assert!(kpi.feasible && a.feasible);
