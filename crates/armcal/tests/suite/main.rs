@@ -28,7 +28,9 @@ mod design {
     mod design_gradients;
     mod design_monte_carlo;
     mod design_plan;
+    mod clearance;
     mod design_refine;
+    mod measurable;
     mod paper_cell_geometry;
 }
 mod compensate {

@@ -1,5 +1,6 @@
 //! Values `g(q)` and exact joint gradients of a [`ConstraintSet`] at a configuration (see
-//! the [module documentation](super) for the formulas).
+//! the [module documentation](super) for the formulas), and which constraints do not
+//! depend on the configuration.
 
 use super::*;
 
@@ -151,7 +152,19 @@ impl ConstraintSet {
         }
     }
 
-    /// Whether `q` lies within the joint limits (inclusive).
+    /// The incidence angle β (rad) of an incidence constraint value `v = cos β − cos β_max`
+    /// (paper eq. 4).
+    pub fn incidence_angle(&self, v: f64) -> f64 {
+        (v + self.cos_max).clamp(-1.0, 1.0).acos()
+    }
+
+    /// The cell's incidence limit β_max (rad), if the set checks the incidence.
+    pub fn max_incidence(&self) -> Option<f64> {
+        (self.count(ConstraintKind::Incidence) > 0).then(|| self.cos_max.acos())
+    }
+
+    /// Whether `q` lies within the joint bounds (inclusive; the limits shrunk by the joint
+    /// margin, see [`ConstraintSet::joint_bounds`]).
     pub fn within_limits(&self, q: &[f64]) -> bool {
         q.iter()
             .zip(self.lower.iter().zip(&self.upper))
@@ -187,7 +200,8 @@ impl ConstraintSet {
         self.min_margin(&ws.values)
     }
 
-    /// `q` within the joint limits and every constraint ≥ 0 (paper eq. 24b). Stops at the
+    /// `q` within the joint bounds and every constraint at least its
+    /// [`ConstraintSet::required`] value (paper eq. 24b, with the cell's clearance). Stops at the
     /// first violated constraint (random draws are mostly rejected by one of the first few),
     /// so `ws.values` is not filled; use [`ConstraintSet::min_margin_at`] for the values.
     pub fn feasible(&self, ws: &mut ConstraintWorkspace, params: &[f64], q: &[f64]) -> bool {
@@ -197,7 +211,7 @@ impl ConstraintSet {
         assert_eq!(params.len(), self.model.param_count(), "parameter count");
         assert_eq!(q.len(), self.dof(), "joint count");
         self.place(ws, params, q);
-        (0..self.len()).all(|row| self.evaluate_row(ws, row, None) >= 0.0)
+        (0..self.len()).all(|row| self.evaluate_row(ws, row, None) >= self.required[row])
     }
 }
 
@@ -244,4 +258,33 @@ fn beam_gradient(
         }
         *gj = v;
     }
+}
+
+/// Which constraints of `set` have the same value (within 1e-9) at 16 configurations spread
+/// over the joint ranges (mid-range and a fixed low-discrepancy sequence), at the nominal
+/// parameters — a KUKA base column on joint 1 standing on the floor, a point on the joint-1
+/// axis against the wall. No q-dependent constraint agrees that closely at 16 spread
+/// configurations by chance.
+pub(super) fn constant_constraints(set: &ConstraintSet) -> Vec<bool> {
+    let (lower, upper) = set.model.joint_limits();
+    let params = set.model.nominal();
+    let mut ws = set.workspace();
+    let m = set.len();
+    let mut lo = vec![f64::INFINITY; m];
+    let mut hi = vec![f64::NEG_INFINITY; m];
+    let mut values = vec![0.0; m];
+    let mut q = vec![0.0; lower.len()];
+    for k in 0..16 {
+        for (j, x) in q.iter_mut().enumerate() {
+            // Fractional parts of 0.5 + k·√(j + 2).
+            let t = (0.5 + k as f64 * (j as f64 + 2.0).sqrt()).fract();
+            *x = lower[j] + t * (upper[j] - lower[j]);
+        }
+        set.evaluate(&mut ws, &params, &q, &mut values, None);
+        for c in 0..m {
+            lo[c] = lo[c].min(values[c]);
+            hi[c] = hi[c].max(values[c]);
+        }
+    }
+    lo.iter().zip(&hi).map(|(a, b)| b - a < 1e-9).collect()
 }

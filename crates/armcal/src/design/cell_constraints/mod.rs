@@ -64,10 +64,20 @@
 //! Constraints that need the tracker (incidence, line of sight) are left out when the model
 //! has no instrument frame; incidence also needs `instrument.max_incidence` in the cell.
 //!
+//! **Clearance and joint margin** (the cell's `[design]`, [`DesignClearance`]). A set built
+//! with [`ConstraintSettings::clearance`] `c` requires `g(q) ≥ c` of every distance
+//! constraint (self collision, obstacle, half-space, line of sight) and keeps every revolute
+//! joint [`ConstraintSettings::joint_margin`] inside its limits; [`ConstraintSet::evaluate`]
+//! still returns the distances themselves, [`ConstraintSet::required`] the least value each
+//! must keep. A constraint whose value no configuration changes (a base column standing on
+//! the floor: 0 mm for every q) is exempt from the clearance — no design can widen it, and
+//! the cell says it is allowed ([`ConstraintSet::is_constant`]).
+//!
 //! This file assembles the set from a cell ([`ConstraintSet::new`]); `evaluate.rs` computes
-//! values and gradients at a configuration.
+//! values and gradients at a configuration; `measurable.rs` lists what makes a pose
+//! unmeasurable.
 
-use crate::cell::{half_space_unit_normal, Cell, Obstacle};
+use crate::cell::{half_space_unit_normal, Cell, DesignClearance, Obstacle};
 use crate::geometry::{point_segment_distance, segment_distance};
 use crate::model::{forward_kinematics, Data, Model, Twist};
 use crate::Error;
@@ -103,6 +113,22 @@ pub struct ConstraintSettings {
     /// Name of the reflector target; `None`: the model's first target (the tool origin if
     /// there is none).
     pub reflector: Option<String>,
+    /// Least value (mm) every q-dependent distance constraint must keep (0: touching is
+    /// allowed, as in paper eq. 24b).
+    pub clearance: f64,
+    /// Distance (rad) every revolute joint keeps from its limits (0: the limits themselves).
+    pub joint_margin: f64,
+}
+
+impl ConstraintSettings {
+    /// These settings with the cell's `[design]` clearance and joint margin.
+    pub fn with_clearance(self, design: &DesignClearance) -> Self {
+        ConstraintSettings {
+            clearance: design.clearance,
+            joint_margin: design.joint_margin,
+            ..self
+        }
+    }
 }
 
 impl Default for ConstraintSettings {
@@ -113,6 +139,8 @@ impl Default for ConstraintSettings {
             line_of_sight: true,
             beam_radius: 5.0,
             reflector: None,
+            clearance: 0.0,
+            joint_margin: 0.0,
         }
     }
 }
@@ -250,8 +278,13 @@ pub struct ConstraintSet {
     reflector: Reflector,
     cos_max: f64,
     beam_radius: f64,
+    /// Joint bounds: the limits, revolute joints shrunk by the joint margin.
     lower: Vec<f64>,
     upper: Vec<f64>,
+    /// Least value of each constraint (the clearance for q-dependent distances, else 0).
+    required: Vec<f64>,
+    /// Constraints whose value does not depend on q (`evaluate.rs`, `constant_constraints`).
+    constant: Vec<bool>,
 }
 
 /// Reusable buffers for [`ConstraintSet::evaluate`].
@@ -273,6 +306,16 @@ impl ConstraintSet {
                 "beam radius must be a finite length ≥ 0 mm, got {}",
                 options.beam_radius
             )));
+        }
+        for (what, v) in [
+            ("clearance", options.clearance),
+            ("joint margin", options.joint_margin),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(Error::Input(format!(
+                    "the {what} must be finite and ≥ 0, got {v}"
+                )));
+            }
         }
         let model = cell.model.clone();
         let dof = model.dof();
@@ -381,9 +424,23 @@ impl ConstraintSet {
                 names.push(format!("beam / {name}"));
             }
         }
-        let (lower, upper) = model.joint_limits();
+        let (mut lower, mut upper) = model.joint_limits();
         debug_assert_eq!(lower.len(), dof);
-        Ok(ConstraintSet {
+        for (j, joint) in model.joints.iter().enumerate() {
+            if joint.kind == crate::model::JointKind::Revolute {
+                lower[j] += options.joint_margin;
+                upper[j] -= options.joint_margin;
+            }
+        }
+        if let Some(j) = (0..dof).find(|&j| lower[j] > upper[j]) {
+            return Err(Error::Input(format!(
+                "a joint margin of {:.3}° leaves joint `{}` no range",
+                options.joint_margin.to_degrees(),
+                model.joints[j].name
+            )));
+        }
+        let n = items.len();
+        let mut set = ConstraintSet {
             model,
             capsules,
             obstacles,
@@ -395,8 +452,36 @@ impl ConstraintSet {
             beam_radius: options.beam_radius,
             lower,
             upper,
-        })
+            required: vec![0.0; n],
+            constant: vec![false; n],
+        };
+        set.constant = constant_constraints(&set);
+        for i in 0..n {
+            if set.kind(i) != ConstraintKind::Incidence && !set.constant[i] {
+                set.required[i] = options.clearance;
+            }
+        }
+        Ok(set)
     }
+
+    /// The least value constraint `i` must keep: the clearance for a q-dependent distance,
+    /// 0 for the incidence and for a constant constraint.
+    pub fn required(&self, i: usize) -> f64 {
+        self.required[i]
+    }
+
+    /// Whether constraint `i` has the same value at every configuration (see
+    /// `constant_constraints` in `evaluate.rs`).
+    pub fn is_constant(&self, i: usize) -> bool {
+        self.constant[i]
+    }
+
+    /// The joint bounds a configuration must keep (internal units): the limits, revolute
+    /// joints shrunk by the joint margin.
+    pub fn joint_bounds(&self) -> (&[f64], &[f64]) {
+        (&self.lower, &self.upper)
+    }
+
 
     /// Number of constraints.
     pub fn len(&self) -> usize {
@@ -502,5 +587,9 @@ fn reflector_carriers(
 }
 
 mod evaluate;
+mod measurable;
+use evaluate::constant_constraints;
 #[cfg(test)]
 mod tests;
+
+pub use measurable::{unmeasurable_poses, Unmeasurable, Violation};
