@@ -7,5 +7,6 @@ mod cli;
 mod compensate_cli;
 mod estimate_checks;
 mod import_cli;
+mod measurable_cli;
 mod outputs_cli;
 mod workflow;
