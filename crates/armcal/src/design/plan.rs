@@ -247,14 +247,15 @@ const DISTANCE_MARGIN: f64 = 0.05;
 
 impl CellConstraints<'_> {
     /// Where the refinement keeps constraint `i`: its required value (the cell's clearance,
-    /// [`ConstraintSet::required`]) plus the margin from that boundary (none from a constant
-    /// constraint: no move can widen it, and a feasible pool configuration already
-    /// satisfies it).
+    /// [`ConstraintSet::required`]) plus the margin from that boundary — none from a
+    /// constant constraint that needs no clearance: no move can widen it, and a feasible pool
+    /// configuration already satisfies it.
     fn margin(&self, i: usize) -> f64 {
-        if self.set.is_constant(i) {
-            return self.set.required(i);
+        let required = self.set.required(i);
+        if self.set.is_constant(i) && required == 0.0 {
+            return 0.0;
         }
-        self.set.required(i)
+        required
             + match self.set.kind(i) {
                 crate::design::ConstraintKind::Incidence => INCIDENCE_MARGIN,
                 _ => DISTANCE_MARGIN,

@@ -41,8 +41,10 @@ pub struct KindMargin {
     /// The least margin the cell's `[design]` asks for (clearance_mm for distances,
     /// joint_margin_deg for revolute joints, 0 for the incidence and prismatic joints).
     pub required: f64,
-    /// Whether `value ≥ required` (a constraint no configuration changes, such as a base
-    /// column standing on the floor, meets any clearance at its constant value ≥ 0).
+    /// Whether every constraint of the kind keeps its required value (a distance no
+    /// configuration changes, such as a base column standing on the floor, is exempt from
+    /// the clearance and needs only ≥ 0; see
+    /// [`ConstraintSet::required`](crate::design::ConstraintSet::required)).
     pub meets: bool,
     /// The constraint (or joint) with the smallest margin, and its pose (1-based).
     pub constraint: String,
@@ -166,7 +168,8 @@ pub fn kind_margins(
         .collect();
     let units = joint_units(&cell.model);
     for unit in ["deg", "mm"] {
-        // The joint margin is for revolute joints (deg) only; the bounds are met to rounding.
+        // The joint margin is for revolute joints (deg) only; met to the tolerance of a
+        // pose read back from a design CSV.
         let required = if unit == "deg" {
             cell.design.joint_margin.to_degrees()
         } else {
@@ -186,7 +189,10 @@ pub fn kind_margins(
                         per_pose: units.iter().filter(|x| x.1 == unit).count(),
                         value,
                         required,
-                        meets: value >= required - 1e-9,
+                        meets: value
+                            >= required
+                                - crate::design::cell_constraints::JOINT_MARGIN_TOLERANCE
+                                    .to_degrees(),
                         constraint: joint.name.clone(),
                         pose: p + 1,
                     });

@@ -164,11 +164,12 @@ impl ConstraintSet {
     }
 
     /// Whether `q` lies within the joint bounds (inclusive; the limits shrunk by the joint
-    /// margin, see [`ConstraintSet::joint_bounds`]).
+    /// margin, see [`ConstraintSet::joint_bounds`], less [`JOINT_MARGIN_TOLERANCE`]).
     pub fn within_limits(&self, q: &[f64]) -> bool {
+        let tol = self.joint_tolerance;
         q.iter()
             .zip(self.lower.iter().zip(&self.upper))
-            .all(|(v, (lo, hi))| *v >= *lo && *v <= *hi)
+            .all(|(v, (lo, hi))| *v >= *lo - tol && *v <= *hi + tol)
     }
 
     /// The smallest of `values` (one per constraint) with its index, name and kind; `None`
@@ -260,31 +261,36 @@ fn beam_gradient(
     }
 }
 
-/// Which constraints of `set` have the same value (within 1e-9) at 16 configurations spread
-/// over the joint ranges (mid-range and a fixed low-discrepancy sequence), at the nominal
-/// parameters — a KUKA base column on joint 1 standing on the floor, a point on the joint-1
-/// axis against the wall. No q-dependent constraint agrees that closely at 16 spread
-/// configurations by chance.
-pub(super) fn constant_constraints(set: &ConstraintSet) -> Vec<bool> {
+/// The range `(min, max)` of every constraint of `set` over `samples` configurations spread
+/// over the joint ranges (mid-range and a fixed low-discrepancy sequence: the fractional parts
+/// of `0.5 + k·√(j + 2)` for joint j), at the nominal parameters. A constraint whose range is
+/// below 1e-9 does not depend on q there — a KUKA base column on joint 1 standing on the
+/// floor, a point on the joint-1 axis against the wall — or is flat over the sampled region:
+/// the distance from a point on a joint axis to a capsule turning about that axis stays the
+/// same until another point of the capsule comes closest (the paper robot's upper arm and
+/// forearm at 16 samples), so 16 samples flag such a constraint and 256 rarely do.
+pub(super) fn constraint_ranges(set: &ConstraintSet, samples: usize) -> Vec<(f64, f64)> {
     let (lower, upper) = set.model.joint_limits();
     let params = set.model.nominal();
     let mut ws = set.workspace();
     let m = set.len();
-    let mut lo = vec![f64::INFINITY; m];
-    let mut hi = vec![f64::NEG_INFINITY; m];
+    let mut range = vec![(f64::INFINITY, f64::NEG_INFINITY); m];
     let mut values = vec![0.0; m];
     let mut q = vec![0.0; lower.len()];
-    for k in 0..16 {
+    for k in 0..samples {
         for (j, x) in q.iter_mut().enumerate() {
-            // Fractional parts of 0.5 + k·√(j + 2).
             let t = (0.5 + k as f64 * (j as f64 + 2.0).sqrt()).fract();
             *x = lower[j] + t * (upper[j] - lower[j]);
         }
         set.evaluate(&mut ws, &params, &q, &mut values, None);
-        for c in 0..m {
-            lo[c] = lo[c].min(values[c]);
-            hi[c] = hi[c].max(values[c]);
+        for (r, v) in range.iter_mut().zip(&values) {
+            *r = (r.0.min(*v), r.1.max(*v));
         }
     }
-    lo.iter().zip(&hi).map(|(a, b)| b - a < 1e-9).collect()
+    range
+}
+
+/// Whether a range of [`constraint_ranges`] is constant (within 1e-9).
+pub(super) fn is_flat(range: (f64, f64)) -> bool {
+    range.1 - range.0 < 1e-9
 }

@@ -69,9 +69,10 @@
 //! constraint (self collision, obstacle, half-space, line of sight) and keeps every revolute
 //! joint [`ConstraintSettings::joint_margin`] inside its limits; [`ConstraintSet::evaluate`]
 //! still returns the distances themselves, [`ConstraintSet::required`] the least value each
-//! must keep. A constraint whose value no configuration changes (a base column standing on
-//! the floor: 0 mm for every q) is exempt from the clearance — no design can widen it, and
-//! the cell says it is allowed ([`ConstraintSet::is_constant`]).
+//! must keep. A distance that no configuration changes and that lies below the clearance (a
+//! base column standing on the floor: 0 mm for every q) is exempt — no design can widen it,
+//! and the cell says it is allowed; "no configuration changes" is checked at 256 spread
+//! configurations.
 //!
 //! This file assembles the set from a cell ([`ConstraintSet::new`]); `evaluate.rs` computes
 //! values and gradients at a configuration; `measurable.rs` lists what makes a pose
@@ -283,9 +284,18 @@ pub struct ConstraintSet {
     upper: Vec<f64>,
     /// Least value of each constraint (the clearance for q-dependent distances, else 0).
     required: Vec<f64>,
-    /// Constraints whose value does not depend on q (`evaluate.rs`, `constant_constraints`).
+    /// Constraints whose value is the same at 16 spread configurations (`evaluate.rs`,
+    /// `constraint_ranges`).
     constant: Vec<bool>,
+    /// How far a configuration may sit inside the joint margin and still count as within
+    /// the bounds ([`JOINT_MARGIN_TOLERANCE`] with a margin, 0 without).
+    joint_tolerance: f64,
 }
+
+/// A pose read back from a design CSV (6 decimals of a degree, ±5e-7° = 8.7e-9 rad) may sit
+/// that much inside the joint margin it was planned on; 1e-7 rad (6e-6°) covers it. It
+/// applies to the margin only: without one the bounds are the joint limits, checked exactly.
+pub const JOINT_MARGIN_TOLERANCE: f64 = 1e-7;
 
 /// Reusable buffers for [`ConstraintSet::evaluate`].
 #[derive(Clone, Debug)]
@@ -454,24 +464,38 @@ impl ConstraintSet {
             upper,
             required: vec![0.0; n],
             constant: vec![false; n],
+            joint_tolerance: 0.0,
         };
-        set.constant = constant_constraints(&set);
-        for i in 0..n {
-            if set.kind(i) != ConstraintKind::Incidence && !set.constant[i] {
-                set.required[i] = options.clearance;
+        // 16 samples: the constraints the refinement keeps no margin from (see
+        // `CellConstraints` in plan.rs).
+        set.constant = constraint_ranges(&set, 16).into_iter().map(is_flat).collect();
+        if options.clearance > 0.0 {
+            // Exempt from the clearance: constant over 256 samples and below it everywhere.
+            let dense = constraint_ranges(&set, 256);
+            for (i, r) in dense.into_iter().enumerate() {
+                let exempt = is_flat(r) && r.1 < options.clearance;
+                if set.kind(i) != ConstraintKind::Incidence && !exempt {
+                    set.required[i] = options.clearance;
+                }
             }
         }
+        set.joint_tolerance = if options.joint_margin > 0.0 {
+            JOINT_MARGIN_TOLERANCE
+        } else {
+            0.0
+        };
         Ok(set)
     }
 
-    /// The least value constraint `i` must keep: the clearance for a q-dependent distance,
-    /// 0 for the incidence and for a constant constraint.
+    /// The least value constraint `i` must keep: the clearance for a distance, 0 for the
+    /// incidence and for a distance that is the same at every configuration and below the
+    /// clearance (exempt, see the module documentation).
     pub fn required(&self, i: usize) -> f64 {
         self.required[i]
     }
 
-    /// Whether constraint `i` has the same value at every configuration (see
-    /// `constant_constraints` in `evaluate.rs`).
+    /// Whether constraint `i` has the same value at 16 configurations spread over the joint
+    /// ranges (`constraint_ranges` in `evaluate.rs`): constant, or flat where sampled.
     pub fn is_constant(&self, i: usize) -> bool {
         self.constant[i]
     }
@@ -588,7 +612,7 @@ fn reflector_carriers(
 
 mod evaluate;
 mod measurable;
-use evaluate::constant_constraints;
+use evaluate::{constraint_ranges, is_flat};
 #[cfg(test)]
 mod tests;
 
