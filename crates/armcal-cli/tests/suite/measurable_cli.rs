@@ -22,7 +22,9 @@ fn simulate_refuses_the_old_random_poses_and_lists_them() {
     // "N of 60 poses … cannot be measured", then one line per pose with its constraint.
     let head = err
         .lines()
-        .find(|l| l.contains("of 60 poses in examples/paper-poses-random-60.csv cannot be measured"))
+        .find(|l| {
+            l.contains("of 60 poses in examples/paper-poses-random-60.csv cannot be measured")
+        })
         .unwrap_or_else(|| panic!("{err}"));
     let n: usize = head
         .trim_start_matches("error: ")
@@ -31,10 +33,7 @@ fn simulate_refuses_the_old_random_poses_and_lists_them() {
         .unwrap()
         .parse()
         .unwrap();
-    let listed: Vec<&str> = err
-        .lines()
-        .filter(|l| l.starts_with("  pose "))
-        .collect();
+    let listed: Vec<&str> = err.lines().filter(|l| l.starts_with("  pose ")).collect();
     assert_eq!(listed.len(), n, "{err}");
     assert!(n > 40, "{err}");
     // Pose ids as the file gives them, each with a named constraint and its value.

@@ -181,7 +181,12 @@ pub fn design_section(id: &str, label: &str, d: &DesignRecord) -> Result<Section
                     m.per_pose.to_string(),
                     format!("{} {}", fixed(m.value, 2), escape(&m.unit)),
                     format!("{} {}", fixed(m.required, 2), escape(&m.unit)),
-                    if m.meets { "yes" } else { "<strong>no</strong>" }.to_string(),
+                    if m.meets {
+                        "yes"
+                    } else {
+                        "<strong>no</strong>"
+                    }
+                    .to_string(),
                     escape(&m.constraint),
                     m.pose.to_string(),
                 ]

@@ -468,7 +468,10 @@ impl ConstraintSet {
         };
         // 16 samples: the constraints the refinement keeps no margin from (see
         // `CellConstraints` in plan.rs).
-        set.constant = constraint_ranges(&set, 16).into_iter().map(is_flat).collect();
+        set.constant = constraint_ranges(&set, 16)
+            .into_iter()
+            .map(is_flat)
+            .collect();
         if options.clearance > 0.0 {
             // Exempt from the clearance: constant over 256 samples and below it everywhere.
             let dense = constraint_ranges(&set, 256);
@@ -505,7 +508,6 @@ impl ConstraintSet {
     pub fn joint_bounds(&self) -> (&[f64], &[f64]) {
         (&self.lower, &self.upper)
     }
-
 
     /// Number of constraints.
     pub fn len(&self) -> usize {

@@ -20,7 +20,10 @@ const BEAM_RADIUS: f64 = 5.0;
 
 fn obstacle_cell_with(clearance: &str, margin: &str) -> Cell {
     let text = armcal::cell::builtin::PAPER_CELL_OBSTACLES
-        .replace("clearance_mm = 0\n", &format!("clearance_mm = {clearance}\n"))
+        .replace(
+            "clearance_mm = 0\n",
+            &format!("clearance_mm = {clearance}\n"),
+        )
         .replace(
             "joint_margin_deg = 0\n",
             &format!("joint_margin_deg = {margin}\n"),
@@ -44,11 +47,7 @@ fn distance(c1: &Capsule, c2: &Capsule) -> f64 {
 fn margins_at(cell: &Cell, data: &mut Data<f64>, q: &[f64]) -> [f64; 5] {
     let model = &cell.model;
     forward_kinematics(model, data, &model.nominal(), q);
-    let first_joint = model
-        .links
-        .iter()
-        .position(|l| l.joint.is_some())
-        .unwrap();
+    let first_joint = model.links.iter().position(|l| l.joint.is_some()).unwrap();
     // Capsule-carrying frames in chain order, and each capsule placed in the world.
     let mut frames: Vec<usize> = cell
         .capsules
@@ -140,7 +139,10 @@ fn a_planned_design_keeps_the_cells_clearance_and_joint_margin() {
         least[0], least[1], least[2], least[3], least[4]
     );
     // parry's GJK distance is accurate to ≈ 1e-7 relative.
-    for (what, v) in ["self", "obstacle", "half-space", "beam"].iter().zip(&least) {
+    for (what, v) in ["self", "obstacle", "half-space", "beam"]
+        .iter()
+        .zip(&least)
+    {
         assert!(*v >= 10.0 - 1e-6 * (1.0 + v), "{what}: {v} mm < 10 mm");
     }
     assert!(least[4] >= 1.0 - 1e-9, "joints: {}° < 1°", least[4]);
@@ -190,12 +192,32 @@ fn design_section_errors_name_file_and_field() {
     let base = example_cell("paper-cell-obstacles.toml");
     assert_eq!(base.design.clearance, 0.0);
     for (from, to, says) in [
-        ("clearance_mm = 0\n", "clearance_mm = -1\n", "design.clearance_mm"),
-        ("clearance_mm = 0\n", "clearance_mm = 5000\n", "design.clearance_mm"),
+        (
+            "clearance_mm = 0\n",
+            "clearance_mm = -1\n",
+            "design.clearance_mm",
+        ),
+        (
+            "clearance_mm = 0\n",
+            "clearance_mm = 5000\n",
+            "design.clearance_mm",
+        ),
         ("clearance_mm = 0\n", "clearance_mm = nan\n", "finite"),
-        ("clearance_mm = 0\n", "clearence_mm = 5\n", "unknown field `clearence_mm`"),
-        ("joint_margin_deg = 0\n", "joint_margin_deg = 100\n", "design.joint_margin_deg"),
-        ("joint_margin_deg = 0\n", "joint_margin_deg = 0\njoint_margin_rad = 0\n", "twice"),
+        (
+            "clearance_mm = 0\n",
+            "clearence_mm = 5\n",
+            "unknown field `clearence_mm`",
+        ),
+        (
+            "joint_margin_deg = 0\n",
+            "joint_margin_deg = 100\n",
+            "design.joint_margin_deg",
+        ),
+        (
+            "joint_margin_deg = 0\n",
+            "joint_margin_deg = 0\njoint_margin_rad = 0\n",
+            "twice",
+        ),
     ] {
         let text = armcal::cell::builtin::PAPER_CELL_OBSTACLES.replace(from, to);
         let e = Cell::from_toml(&text, "c.toml", Path::new("."))
@@ -247,5 +269,8 @@ fn only_a_distance_no_pose_changes_is_exempt_from_the_clearance() {
             assert_eq!(set.required(i), 10.0, "{}", set.name(i));
         }
     }
-    assert!(exempt > 0, "the shoulder capsule's end stays 5 mm off the wall");
+    assert!(
+        exempt > 0,
+        "the shoulder capsule's end stays 5 mm off the wall"
+    );
 }

@@ -19,8 +19,8 @@ fn example(name: &str) -> std::path::PathBuf {
 #[test]
 fn the_random_example_poses_are_mostly_unmeasurable() {
     let cell = example_cell("paper-cell.toml");
-    let poses = read_configurations(&example("paper-poses-random-60.csv"), &cell.model, None)
-        .unwrap();
+    let poses =
+        read_configurations(&example("paper-poses-random-60.csv"), &cell.model, None).unwrap();
     let found = unmeasurable_poses(&cell, &poses).unwrap();
     let model = &cell.model;
     let mut data = Data::new(model);
@@ -63,15 +63,17 @@ fn the_planned_example_poses_are_measurable() {
     for cell in ["paper-cell.toml", "paper-cell-obstacles.toml"] {
         let cell = example_cell(cell);
         let poses =
-            read_configurations(&example("paper-poses-planned-60.csv"), &cell.model, None)
-                .unwrap();
+            read_configurations(&example("paper-poses-planned-60.csv"), &cell.model, None).unwrap();
         let found = unmeasurable_poses(&cell, &poses).unwrap();
         if cell.obstacles.is_empty() {
             assert!(found.is_empty(), "{:?}", found);
         } else {
             // Planned without the car: some poses reach into it or behind it, and are named.
             for u in &found {
-                assert!(u.violations.iter().all(|v| v.kind != ConstraintKind::Incidence));
+                assert!(u
+                    .violations
+                    .iter()
+                    .all(|v| v.kind != ConstraintKind::Incidence));
             }
         }
     }
