@@ -4,7 +4,31 @@
 
 use super::*;
 
+/// A pose read back from a design CSV (6 decimals of a degree, ±5e-7° = 8.7e-9 rad) may sit
+/// that much inside the joint margin it was planned on; 1e-7 rad (6e-6°) covers it. It
+/// applies to the margin only: without one the bounds are the joint limits, checked exactly.
+pub const JOINT_MARGIN_TOLERANCE: f64 = 1e-7;
+
 impl ConstraintSet {
+    /// The least value constraint `i` must keep: the clearance for a distance, 0 for the
+    /// incidence and for a distance that is the same at every configuration and below the
+    /// clearance (exempt, see the module documentation).
+    pub fn required(&self, i: usize) -> f64 {
+        self.required[i]
+    }
+
+    /// Whether constraint `i` has the same value at 16 configurations spread over the joint
+    /// ranges (`constraint_ranges` in `evaluate.rs`): constant, or flat where sampled.
+    pub fn is_constant(&self, i: usize) -> bool {
+        self.constant[i]
+    }
+
+    /// The joint bounds a configuration must keep (internal units): the limits, revolute
+    /// joints shrunk by the joint margin.
+    pub fn joint_bounds(&self) -> (&[f64], &[f64]) {
+        (&self.lower, &self.upper)
+    }
+
     /// Evaluates every constraint at parameters `params` (internal units, the model's full
     /// parameter vector) and joints `q`: `values[i] = g_i(q)` (≥ 0 is feasible) and, if given,
     /// `jacobian[i · dof + j] = ∂g_i/∂q_j` (row major, `len × dof`). Allocates nothing.

@@ -292,11 +292,6 @@ pub struct ConstraintSet {
     joint_tolerance: f64,
 }
 
-/// A pose read back from a design CSV (6 decimals of a degree, ±5e-7° = 8.7e-9 rad) may sit
-/// that much inside the joint margin it was planned on; 1e-7 rad (6e-6°) covers it. It
-/// applies to the margin only: without one the bounds are the joint limits, checked exactly.
-pub const JOINT_MARGIN_TOLERANCE: f64 = 1e-7;
-
 /// Reusable buffers for [`ConstraintSet::evaluate`].
 #[derive(Clone, Debug)]
 pub struct ConstraintWorkspace {
@@ -490,25 +485,6 @@ impl ConstraintSet {
         Ok(set)
     }
 
-    /// The least value constraint `i` must keep: the clearance for a distance, 0 for the
-    /// incidence and for a distance that is the same at every configuration and below the
-    /// clearance (exempt, see the module documentation).
-    pub fn required(&self, i: usize) -> f64 {
-        self.required[i]
-    }
-
-    /// Whether constraint `i` has the same value at 16 configurations spread over the joint
-    /// ranges (`constraint_ranges` in `evaluate.rs`): constant, or flat where sampled.
-    pub fn is_constant(&self, i: usize) -> bool {
-        self.constant[i]
-    }
-
-    /// The joint bounds a configuration must keep (internal units): the limits, revolute
-    /// joints shrunk by the joint margin.
-    pub fn joint_bounds(&self) -> (&[f64], &[f64]) {
-        (&self.lower, &self.upper)
-    }
-
     /// Number of constraints.
     pub fn len(&self) -> usize {
         self.items.len()
@@ -614,6 +590,7 @@ fn reflector_carriers(
 
 mod evaluate;
 mod measurable;
+pub use evaluate::JOINT_MARGIN_TOLERANCE;
 use evaluate::{constraint_ranges, is_flat};
 #[cfg(test)]
 mod tests;
