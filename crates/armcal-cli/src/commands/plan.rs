@@ -209,5 +209,20 @@ pub fn run_evaluate(a: &EvaluateArgs) -> anyhow::Result<()> {
         ),
         (None, false) => println!("{} poses outside the joint limits", infeasible.len()),
     }
+    if !ev.margins.is_empty() {
+        println!("least margin per constraint kind (required: the cell's [design]):");
+        for m in &ev.margins {
+            println!(
+                "  {:<15} {:>10.3} {:<3}  required {:>7.3}  {}  (`{}` at pose {})",
+                m.kind,
+                m.value,
+                m.unit,
+                m.required,
+                if m.meets { "met" } else { "NOT MET" },
+                m.constraint,
+                m.pose
+            );
+        }
+    }
     Ok(())
 }

@@ -1,6 +1,8 @@
 //! `armcal simulate`: measure joint configurations on a perturbed virtual robot.
 
 use super::output::{load_cell, Outputs};
+use anyhow::bail;
+use armcal::design::cell_constraints::unmeasurable_poses;
 use armcal::measure::csv;
 use armcal::sim::{simulate_poses, Perturbation};
 use std::path::{Path, PathBuf};
@@ -34,6 +36,10 @@ pub struct Args {
     /// Also write the true parameters (JSON).
     #[arg(long)]
     pub truth_out: Option<PathBuf>,
+    /// Simulate poses the instrument cannot measure (incidence, line of sight, collisions)
+    /// too, instead of refusing them; stderr says how many there were.
+    #[arg(long)]
+    pub allow_unmeasurable: bool,
     /// Overwrite existing output files.
     #[arg(long)]
     pub force: bool,
@@ -46,6 +52,23 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
     let poses = csv::read_configurations(&a.poses, model, None)?;
+    let unmeasurable = unmeasurable_poses(&cell, &poses)?;
+    if !unmeasurable.is_empty() {
+        let (n, total) = (unmeasurable.len(), poses.len());
+        if !a.allow_unmeasurable {
+            let list: Vec<String> = unmeasurable.iter().map(|u| format!("  {u}")).collect();
+            bail!(
+                "{n} of {total} poses in {} cannot be measured in `{}`:\n{}\nuse poses planned for this cell (`armcal plan`), or pass --allow-unmeasurable to simulate them anyway",
+                a.poses.display(),
+                cell.name,
+                list.join("\n")
+            );
+        }
+        eprintln!(
+            "warning: {n} of {total} poses cannot be measured in `{}` (incidence, line of sight or collision); simulated anyway (--allow-unmeasurable)",
+            cell.name
+        );
+    }
     let pert = Perturbation {
         length: a.perturb_mm,
         angle: a.perturb_deg.to_radians(),

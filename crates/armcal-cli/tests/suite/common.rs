@@ -26,15 +26,15 @@ pub fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-/// `armcal simulate` of the paper cell at the 60 random example poses with noise `seed`,
-/// written to `out`.
+/// `armcal simulate` of the paper cell at the 60 planned example poses (measurable) with
+/// noise `seed`, written to `out`.
 pub fn simulate_paper_cell<'a>(seed: &'a str, out: &'a str) -> [&'a str; 9] {
     [
         "simulate",
         "--cell",
         "examples/paper-cell.toml",
         "--poses",
-        "examples/paper-poses-random-60.csv",
+        "examples/paper-poses-planned-60.csv",
         "--seed",
         seed,
         "--out",

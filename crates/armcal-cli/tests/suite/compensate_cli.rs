@@ -55,8 +55,16 @@ fn compensate_reports_bad_rows_and_applies_the_nonparametric_correction() {
     let text = std::fs::read_to_string(&out_file).unwrap();
     assert!(row(&text, "good").contains(",converged,"), "{text}");
     let limit = row(&text, "limit");
+    // The calibrated solution needs q5 near the asked 100° (the calibration moves it by
+    // a fraction of a degree), beyond the 87° limit.
+    let q5: f64 = limit
+        .split(",joint-limits: q5 = ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("{limit}"));
     assert!(
-        limit.contains(",joint-limits: q5 = 99.9") && limit.contains(" > 87.000 deg,"),
+        (q5 - 100.0).abs() < 1.0 && limit.contains(" > 87.000 deg,"),
         "{limit}"
     );
 

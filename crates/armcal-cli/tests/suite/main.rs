@@ -8,5 +8,6 @@ mod compensate_cli;
 mod error_causes;
 mod estimate_checks;
 mod import_cli;
+mod measurable_cli;
 mod outputs_cli;
 mod workflow;

@@ -144,3 +144,30 @@ fn demo_refuses_a_users_file() {
     assert!(t0.elapsed().as_secs_f64() < 5.0);
     assert_eq!(listing(&dir), ["cell.toml"]);
 }
+
+#[test]
+fn a_relative_output_in_a_new_folder_is_made() {
+    // `--out out/data.csv` run where no `out/` exists (the README's first command): every
+    // folder of the relative path is new.
+    let dir = scratch("outputs-relative");
+    let examples = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_armcal"))
+        .args([
+            "simulate",
+            "--cell",
+            &format!("{examples}/paper-cell.toml"),
+            "--poses",
+            &format!("{examples}/paper-poses-planned-60.csv"),
+            "--out",
+            "out/data.csv",
+        ])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(dir.join("out/data.csv").exists());
+}

@@ -190,6 +190,8 @@ fn axes_from_one_joint_sweeps() {
             "examples/paper-cell.toml",
             "--poses",
             "examples/paper-sweeps.csv",
+            // The reflector faces away from the tracker in these sweeps.
+            "--allow-unmeasurable",
             "--out",
         ];
         let data = s(data);
@@ -461,8 +463,9 @@ fn identify_validates_on_a_test_file_and_checks_the_holdout_flag() {
     let test_s = s(&test);
     assert!(armcal(&simulate_paper_cell("4", &data)).0);
     // Same robot (seed), other poses: the joint sweeps.
-    let mut sweeps = simulate_paper_cell("4", &test_s);
+    let mut sweeps = simulate_paper_cell("4", &test_s).to_vec();
     sweeps[4] = "examples/paper-sweeps.csv";
+    sweeps.push("--allow-unmeasurable");
     let (ok, _, err) = armcal(&sweeps);
     assert!(ok, "{err}");
     // The user's own test file, with its own pose ids.

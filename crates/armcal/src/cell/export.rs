@@ -1,7 +1,8 @@
 //! A cell file of a (calibrated) model that the commands accept unchanged: the model's links
 //! (in whatever convention the export chose) together with everything else of the cell it
 //! was identified in — the instrument's kind, noise model and incidence limit, targets,
-//! capsules (re-expressed in the exported frames), working poses, obstacles, joint limits,
+//! capsules (re-expressed in the exported frames), working poses, obstacles, the design
+//! clearances, joint limits,
 //! the data columns, the measurement type, what the cell fixed or gave a prior, and
 //! `free = "auto"`.
 
@@ -79,6 +80,12 @@ pub fn to_cell_toml(cell: &Cell, identified: &Model, spec: &ModelSpec) -> Result
             ),
         };
     }
+    let _ = writeln!(
+        s.tail,
+        "\n[design]\nclearance_mm = {:?}\njoint_margin_deg = {:?}",
+        cell.design.clearance,
+        cell.design.joint_margin.to_degrees()
+    );
     if let Some(d) = &cell.data_columns {
         let _ = writeln!(s.tail, "\n[data]\n{}", d.format.to_toml());
     }

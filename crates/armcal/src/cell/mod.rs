@@ -83,6 +83,41 @@ pub fn half_space_unit_normal(
     Ok(n / norm)
 }
 
+/// The safety margins a planned pose keeps (`[design]` of the cell file): every distance
+/// constraint of the design (robot capsule to robot capsule, to an obstacle or half-space,
+/// the laser beam to either) at least `clearance`, every revolute joint at least
+/// `joint_margin` inside its limits.
+///
+/// **Defaults: 5 mm and 1°.** A design is planned on the *nominal* model, and the real robot
+/// is not where the nominal model puts it: with armcal's default simulated robot (lengths off
+/// by σ = 0.5 mm, angles by σ = 0.1°, the size of an uncalibrated industrial robot's
+/// geometric error) the nominal model misses the paper robot's reflector by 2.8 mm RMS and
+/// 4.4 mm at most once the tracker is placed (README, held-out validation "nominal + frames
+/// fitted"). A robot point nearer the base moves less than the reflector, so 5 mm — the RMS
+/// error plus about 2 mm, above the largest miss — keeps a capsule that the nominal model
+/// puts at the clearance off the obstacle. It does not cover obstacles placed wrongly in the
+/// cell: draw their capsules generously, or raise the clearance. 1° keeps a pose off the
+/// hard stops that a controller's soft limits (typically a degree or so inside the data-sheet
+/// limits) would refuse. Prismatic joints get no margin. The paper's cells set both to 0:
+/// the paper's constraints (eq. 24b) have no clearance.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DesignClearance {
+    /// Least distance (mm) of every distance constraint; `[design] clearance_mm`.
+    pub clearance: f64,
+    /// Least distance (rad) of every revolute joint from its limits;
+    /// `[design] joint_margin_deg`.
+    pub joint_margin: f64,
+}
+
+impl Default for DesignClearance {
+    fn default() -> Self {
+        DesignClearance {
+            clearance: 5.0,
+            joint_margin: 1f64.to_radians(),
+        }
+    }
+}
+
 /// Which columns of a data file feed which joints, and the unit of each.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DataColumns {
@@ -111,6 +146,8 @@ pub struct Cell {
     pub obstacles: Vec<Obstacle>,
     /// Capsules of the robot and of the tool (in chain frames).
     pub capsules: Vec<Capsule>,
+    /// The safety margins planned poses keep (`[design]`, defaults without it).
+    pub design: DesignClearance,
     /// What the instrument measures (`[parameters] measurement`; default pose if every
     /// target is a frame, else position).
     pub measurement: Measurement,
@@ -184,6 +221,7 @@ impl Cell {
             instrument: None,
             working: Vec::new(),
             obstacles: Vec::new(),
+            design: DesignClearance::default(),
             measurement: Measurement::Pose,
             auto_free: false,
             declared_free,

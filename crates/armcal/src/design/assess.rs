@@ -5,6 +5,7 @@
 
 use crate::cell::Cell;
 use crate::design::plan::{constraint_set, CellConstraints, DesignMargin};
+use crate::design::record::{kind_margins, KindMargin};
 use crate::design::{Criterion, DesignModel, DesignObjective, InformationWorkspace};
 use crate::identify::uncertainty::{self, Observability, TcpCovariance};
 use crate::Error;
@@ -80,10 +81,14 @@ pub struct DesignEvaluation {
     pub poses: usize,
     /// The predicted precision ([`assess`]).
     pub assessment: DesignAssessment,
-    /// The poses (1-based) outside the joint limits or violating a constraint.
+    /// The poses (1-based) outside the joint bounds (the limits less the cell's joint
+    /// margin) or below a constraint's required value (the cell's clearance).
     pub infeasible_poses: Vec<usize>,
     /// The smallest constraint margin over the design (none without constraints).
     pub min_margin: Option<DesignMargin>,
+    /// The smallest margin of every kind of constraint against the cell's `[design]`
+    /// clearance and joint margin ([`kind_margins`]).
+    pub margins: Vec<KindMargin>,
 }
 
 impl DesignEvaluation {
@@ -93,8 +98,9 @@ impl DesignEvaluation {
     }
 }
 
-/// The assessment of `design` (internal units) for `cell`, its infeasible poses and its
-/// smallest margin, with or without the collision and line-of-sight constraints.
+/// The assessment of `design` (internal units) for `cell`, its infeasible poses, its
+/// smallest margin and the margins per constraint kind, with or without the collision and
+/// line-of-sight constraints.
 pub fn evaluate_design(
     cell: &Cell,
     design: &[Vec<f64>],
@@ -113,5 +119,6 @@ pub fn evaluate_design(
             .map(|i| i + 1)
             .collect(),
         min_margin: cons.design_margin(design),
+        margins: kind_margins(cell, design, collisions)?,
     })
 }

@@ -134,10 +134,11 @@ fn infeasible_report(
         set.evaluate(&mut ws, &d.params, q, &mut values, None);
         let mut worst = f64::INFINITY;
         for (i, v) in values.iter().enumerate() {
-            if *v < 0.0 {
+            let slack = v - set.required(i);
+            if slack < 0.0 {
                 counts[i] += 1;
             }
-            worst = worst.min(*v);
+            worst = worst.min(slack);
         }
         scored.push((worst, k));
     }
@@ -202,20 +203,15 @@ pub struct CellConstraints<'a> {
     /// Model parameters at which they are evaluated (internal units: mm, rad).
     pub params: &'a [f64],
     ws: RefCell<ConstraintWorkspace>,
-    /// Constraints whose value does not depend on q (see [`constant_constraints`]).
-    constant: Vec<bool>,
 }
 
 impl<'a> CellConstraints<'a> {
-    /// `set` at `params`, with the constraints whose value does not depend on q found once.
+    /// `set` at `params`.
     pub fn new(set: &'a ConstraintSet, params: &'a [f64]) -> Self {
-        let mut ws = set.workspace();
-        let constant = constant_constraints(set, &mut ws, params);
         CellConstraints {
             set,
             params,
-            ws: RefCell::new(ws),
-            constant,
+            ws: RefCell::new(set.workspace()),
         }
     }
 
@@ -250,16 +246,20 @@ const INCIDENCE_MARGIN: f64 = 1e-4;
 const DISTANCE_MARGIN: f64 = 0.05;
 
 impl CellConstraints<'_> {
-    /// The margin kept from constraint `i`'s boundary (none from a constant one: no move can
-    /// widen it, and a feasible pool configuration already satisfies it).
+    /// Where the refinement keeps constraint `i`: its required value (the cell's clearance,
+    /// [`ConstraintSet::required`]) plus the margin from that boundary — none from a
+    /// constant constraint that needs no clearance: no move can widen it, and a feasible pool
+    /// configuration already satisfies it.
     fn margin(&self, i: usize) -> f64 {
-        if self.constant[i] {
+        let required = self.set.required(i);
+        if self.set.is_constant(i) && required == 0.0 {
             return 0.0;
         }
-        match self.set.kind(i) {
-            crate::design::ConstraintKind::Incidence => INCIDENCE_MARGIN,
-            _ => DISTANCE_MARGIN,
-        }
+        required
+            + match self.set.kind(i) {
+                crate::design::ConstraintKind::Incidence => INCIDENCE_MARGIN,
+                _ => DISTANCE_MARGIN,
+            }
     }
 }
 
@@ -297,37 +297,8 @@ impl ConfigurationConstraints for CellConstraints<'_> {
     }
 }
 
-/// Which constraints of `set` have the same value (within 1e-9) at 16 configurations spread
-/// over the joint ranges (mid-range and a fixed low-discrepancy sequence) — a KUKA base
-/// column on joint 1 standing on the floor, a point on the joint-1 axis against the wall. No
-/// q-dependent constraint agrees that closely at 16 spread configurations by chance.
-fn constant_constraints(
-    set: &ConstraintSet,
-    ws: &mut ConstraintWorkspace,
-    params: &[f64],
-) -> Vec<bool> {
-    let (lower, upper) = set.model().joint_limits();
-    let m = set.len();
-    let mut lo = vec![f64::INFINITY; m];
-    let mut hi = vec![f64::NEG_INFINITY; m];
-    let mut values = vec![0.0; m];
-    let mut q = vec![0.0; lower.len()];
-    for k in 0..16 {
-        for (j, x) in q.iter_mut().enumerate() {
-            // Fractional parts of 0.5 + k·√(j + 2).
-            let t = (0.5 + k as f64 * (j as f64 + 2.0).sqrt()).fract();
-            *x = lower[j] + t * (upper[j] - lower[j]);
-        }
-        set.evaluate(ws, params, &q, &mut values, None);
-        for c in 0..m {
-            lo[c] = lo[c].min(values[c]);
-            hi[c] = hi[c].max(values[c]);
-        }
-    }
-    lo.iter().zip(&hi).map(|(a, b)| b - a < 1e-9).collect()
-}
-
-/// The constraint set of a cell for planning.
+/// The constraint set of a cell for planning, with the cell's `[design]` clearance and
+/// joint margin.
 pub fn constraint_set(cell: &Cell, collisions: bool) -> Result<ConstraintSet, Error> {
     ConstraintSet::new(
         cell,
@@ -340,7 +311,8 @@ pub fn constraint_set(cell: &Cell, collisions: bool) -> Result<ConstraintSet, Er
             collisions,
             line_of_sight: collisions,
             ..ConstraintSettings::default()
-        },
+        }
+        .with_clearance(&cell.design),
     )
 }
 
@@ -422,7 +394,7 @@ pub fn design_from_pool(
     observer: &mut dyn Observer,
 ) -> Result<PoolDesign, Error> {
     let prior_rows = DesignObjective::new(d, settings.criterion, measured).prior_rows;
-    let (lo, hi) = d.model.joint_limits();
+    let (lo, hi) = set.joint_bounds();
     let starts = settings.starts.max(1);
     observer.start("planning starts", Some(starts));
     let shared = Shared::new(observer);
@@ -465,8 +437,8 @@ pub fn design_from_pool(
             let r = refine(
                 &obj,
                 &start,
-                &lo,
-                &hi,
+                lo,
+                hi,
                 (!set.is_empty()).then_some(&cons as &dyn ConfigurationConstraints),
                 &settings.refine,
                 &mut observer,

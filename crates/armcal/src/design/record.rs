@@ -38,6 +38,14 @@ pub struct KindMargin {
     pub per_pose: usize,
     /// Smallest margin over the design (negative: violated).
     pub value: f64,
+    /// The least margin the cell's `[design]` asks for (clearance_mm for distances,
+    /// joint_margin_deg for revolute joints, 0 for the incidence and prismatic joints).
+    pub required: f64,
+    /// Whether every constraint of the kind keeps its required value (a distance no
+    /// configuration changes, such as a base column standing on the floor, is exempt from
+    /// the clearance and needs only ≥ 0; see
+    /// [`ConstraintSet::required`](crate::design::ConstraintSet::required)).
+    pub meets: bool,
     /// The constraint (or joint) with the smallest margin, and its pose (1-based).
     pub constraint: String,
     /// The pose of that constraint (1-based).
@@ -97,9 +105,11 @@ const KINDS: [ConstraintKind; 5] = [
 ];
 
 /// The smallest margin per constraint kind over `design` (internal units), at the nominal
-/// parameters. Incidence margins are angles: with `v = cos β − cos β_max` (paper eq. 4),
-/// the margin is `β_max − β` in degrees. Joint-limit margins are `min(q − q_lo, q_hi − q)`,
-/// one entry per display unit.
+/// parameters, against what the cell's `[design]` requires. Incidence margins are angles:
+/// with `v = cos β − cos β_max` (paper eq. 4), the margin is `β_max − β` in degrees.
+/// Joint-limit margins are `min(q − q_lo, q_hi − q)`, one entry per display unit. A kind
+/// meets its requirement when every constraint of it does (its value at least
+/// [`ConstraintSet::required`](crate::design::ConstraintSet::required)).
 pub fn kind_margins(
     cell: &Cell,
     design: &[Vec<f64>],
@@ -110,7 +120,8 @@ pub fn kind_margins(
     let mut ws = set.workspace();
     let mut values = vec![0.0; set.len()];
     let mut best: Vec<Option<KindMargin>> = vec![None; KINDS.len()];
-    let max_incidence = cell.instrument.as_ref().and_then(|i| i.max_incidence);
+    let mut meets = [true; KINDS.len()];
+    let max_incidence = set.max_incidence();
     for (p, q) in design.iter().enumerate() {
         cell.model
             .check_joints(q)
@@ -122,11 +133,9 @@ pub fn kind_margins(
                 .iter()
                 .position(|x| *x == kind)
                 .expect("every kind listed");
+            meets[k] &= *v >= set.required(i);
             let value = match (kind, max_incidence) {
-                (ConstraintKind::Incidence, Some(m)) => {
-                    let beta = (v + m.cos()).clamp(-1.0, 1.0).acos();
-                    (m - beta).to_degrees()
-                }
+                (ConstraintKind::Incidence, Some(m)) => (m - set.incidence_angle(*v)).to_degrees(),
                 _ => *v,
             };
             if best[k].as_ref().is_none_or(|b| value < b.value) {
@@ -140,15 +149,32 @@ pub fn kind_margins(
                     .into(),
                     per_pose: set.count(kind),
                     value,
+                    required: if kind == ConstraintKind::Incidence {
+                        0.0
+                    } else {
+                        cell.design.clearance
+                    },
+                    meets: true,
                     constraint: set.name(i).to_string(),
                     pose: p + 1,
                 });
             }
         }
     }
-    let mut out: Vec<KindMargin> = best.into_iter().flatten().collect();
+    let mut out: Vec<KindMargin> = best
+        .into_iter()
+        .zip(meets)
+        .filter_map(|(m, meets)| m.map(|m| KindMargin { meets, ..m }))
+        .collect();
     let units = joint_units(&cell.model);
     for unit in ["deg", "mm"] {
+        // The joint margin is for revolute joints (deg) only; met to the tolerance of a
+        // pose read back from a design CSV.
+        let required = if unit == "deg" {
+            cell.design.joint_margin.to_degrees()
+        } else {
+            0.0
+        };
         let mut m: Option<KindMargin> = None;
         for (p, q) in design.iter().enumerate() {
             for (j, (joint, (f, u))) in cell.model.joints.iter().zip(&units).enumerate() {
@@ -162,6 +188,11 @@ pub fn kind_margins(
                         unit: unit.into(),
                         per_pose: units.iter().filter(|x| x.1 == unit).count(),
                         value,
+                        required,
+                        meets: value
+                            >= required
+                                - crate::design::cell_constraints::JOINT_MARGIN_TOLERANCE
+                                    .to_degrees(),
                         constraint: joint.name.clone(),
                         pose: p + 1,
                     });

@@ -165,7 +165,7 @@ pub fn design_section(id: &str, label: &str, d: &DesignRecord) -> Result<Section
     );
 
     if !d.margins.is_empty() {
-        s.html("<h3>Constraint margins</h3>\n<p class=\"note\">The smallest margin of each kind of constraint over all poses, and where it occurs. Distances (mm) are clearances between robot capsules, obstacles, half-spaces and the laser beam; the incidence margin is the angle left before the reflector's acceptance limit (deg); the joint-limit margin is the distance of the closest joint from its limit. A negative margin is a violation. The smallest clearance is highlighted.</p>\n");
+        s.html("<h3>Constraint margins</h3>\n<p class=\"note\">The smallest margin of each kind of constraint over all poses, and where it occurs. Distances (mm) are clearances between robot capsules, obstacles, half-spaces and the laser beam; the incidence margin is the angle left before the reflector's acceptance limit (deg); the joint-limit margin is the distance of the closest joint from its limit. A negative margin is a violation. <em>Required</em> is what the cell's <code>[design]</code> asks for (<code>clearance_mm</code> for distances, <code>joint_margin_deg</code> for joints); a constraint no pose can change (a base standing on the floor) is exempt. The smallest clearance is highlighted.</p>\n");
         let mm: Vec<usize> = (0..d.margins.len())
             .filter(|&i| d.margins[i].unit == "mm" && d.margins[i].kind != "joint limits")
             .collect();
@@ -186,6 +186,13 @@ pub fn design_section(id: &str, label: &str, d: &DesignRecord) -> Result<Section
                     ),
                     m.per_pose.to_string(),
                     format!("{} {}", fixed(m.value, 2), escape(&m.unit)),
+                    format!("{} {}", fixed(m.required, 2), escape(&m.unit)),
+                    if m.meets {
+                        "yes"
+                    } else {
+                        "<strong>no</strong>"
+                    }
+                    .to_string(),
                     escape(&m.constraint),
                     m.pose.to_string(),
                 ]
@@ -196,11 +203,13 @@ pub fn design_section(id: &str, label: &str, d: &DesignRecord) -> Result<Section
                 "constraint kind",
                 "per pose",
                 "smallest margin",
+                "required",
+                "meets",
                 "constraint",
                 "pose",
             ],
             &mrows,
-            &[1, 2, 4],
+            &[1, 2, 3, 6],
         ));
         if !mm.is_empty() {
             let cats: Vec<String> = mm.iter().map(|&i| d.margins[i].kind.clone()).collect();
@@ -216,7 +225,7 @@ pub fn design_section(id: &str, label: &str, d: &DesignRecord) -> Result<Section
                     true,
                 )?,
                 format!(
-                    "Smallest clearance of each distance constraint kind over the {} poses of <em>{}</em> (mm; logarithmic axis when every clearance is positive); the tightest is marked. An optimised design typically rests on some constraints (clearances near the planner's 0.05 mm safety margin).",
+                    "Smallest clearance of each distance constraint kind over the {} poses of <em>{}</em> (mm; logarithmic axis when every clearance is positive); the tightest is marked. An optimised design typically rests on some constraints (clearances near the cell's required clearance plus the planner's 0.05 mm margin).",
                     d.poses.len(),
                     escape(label)
                 ),

@@ -23,12 +23,14 @@ mod identify {
     mod priors_and_noise;
 }
 mod design {
+    mod clearance;
     mod design_bound;
     mod design_exchange;
     mod design_gradients;
     mod design_monte_carlo;
     mod design_plan;
     mod design_refine;
+    mod measurable;
     mod paper_cell_geometry;
 }
 mod compensate {

@@ -1,8 +1,8 @@
 //! The TOML layer of the cell file: raw structures with spans, unit suffixes, and errors
 //! that give file, line and field. [`parse`] reads the file section by section, one module
 //! per section: [`robot`] (`[robot]`, `[[tool_capsules]]`), [`instrument`], [`frames`]
-//! (`[base]`, `[tool]`, `[[targets]]`), [`parameters`], [`working`], [`obstacles`] and
-//! [`data`]; [`fields`] holds the field readers they share.
+//! (`[base]`, `[tool]`, `[[targets]]`), [`parameters`], [`working`], [`obstacles`],
+//! [`design`] and [`data`]; [`fields`] holds the field readers they share.
 
 use super::*;
 use crate::model::complete::LinkForm;
@@ -13,6 +13,7 @@ use std::collections::BTreeMap;
 use toml::Spanned;
 
 mod data;
+mod design;
 mod fields;
 mod frames;
 mod instrument;
@@ -38,6 +39,7 @@ struct RawCell {
     obstacles: Vec<Spanned<toml::Table>>,
     #[serde(default)]
     tool_capsules: Vec<Spanned<toml::Table>>,
+    design: Option<Spanned<toml::Table>>,
     data: Option<Spanned<data::RawData>>,
 }
 
@@ -144,6 +146,8 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
         parameters::parameters(&ctx, raw.parameters.as_ref(), &mut model)?;
     let (working, warnings) = working::working(&ctx, &raw.working, &model)?;
     let obstacles = obstacles::obstacles(&ctx, &raw.obstacles)?;
+    let design = design::design(&ctx, raw.design.as_ref())?;
+    design::check_joint_margin(&ctx, raw.design.as_ref(), &design, &model)?;
     let mut capsules = robot.capsules.clone();
     capsules.extend(tool_capsules);
     for (i, c) in capsules.iter().enumerate() {
@@ -167,6 +171,7 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
         working,
         obstacles,
         capsules,
+        design,
         measurement,
         auto_free,
         declared_free: Vec::new(),

@@ -1,9 +1,34 @@
 //! Values `g(q)` and exact joint gradients of a [`ConstraintSet`] at a configuration (see
-//! the [module documentation](super) for the formulas).
+//! the [module documentation](super) for the formulas), and which constraints do not
+//! depend on the configuration.
 
 use super::*;
 
+/// A pose read back from a design CSV (6 decimals of a degree, ±5e-7° = 8.7e-9 rad) may sit
+/// that much inside the joint margin it was planned on; 1e-7 rad (6e-6°) covers it. It
+/// applies to the margin only: without one the bounds are the joint limits, checked exactly.
+pub const JOINT_MARGIN_TOLERANCE: f64 = 1e-7;
+
 impl ConstraintSet {
+    /// The least value constraint `i` must keep: the clearance for a distance, 0 for the
+    /// incidence and for a distance that is the same at every configuration and below the
+    /// clearance (exempt, see the module documentation).
+    pub fn required(&self, i: usize) -> f64 {
+        self.required[i]
+    }
+
+    /// Whether constraint `i` has the same value at 16 configurations spread over the joint
+    /// ranges (`constraint_ranges` in `evaluate.rs`): constant, or flat where sampled.
+    pub fn is_constant(&self, i: usize) -> bool {
+        self.constant[i]
+    }
+
+    /// The joint bounds a configuration must keep (internal units): the limits, revolute
+    /// joints shrunk by the joint margin.
+    pub fn joint_bounds(&self) -> (&[f64], &[f64]) {
+        (&self.lower, &self.upper)
+    }
+
     /// Evaluates every constraint at parameters `params` (internal units, the model's full
     /// parameter vector) and joints `q`: `values[i] = g_i(q)` (≥ 0 is feasible) and, if given,
     /// `jacobian[i · dof + j] = ∂g_i/∂q_j` (row major, `len × dof`). Allocates nothing.
@@ -151,11 +176,24 @@ impl ConstraintSet {
         }
     }
 
-    /// Whether `q` lies within the joint limits (inclusive).
+    /// The incidence angle β (rad) of an incidence constraint value `v = cos β − cos β_max`
+    /// (paper eq. 4).
+    pub fn incidence_angle(&self, v: f64) -> f64 {
+        (v + self.cos_max).clamp(-1.0, 1.0).acos()
+    }
+
+    /// The cell's incidence limit β_max (rad), if the set checks the incidence.
+    pub fn max_incidence(&self) -> Option<f64> {
+        (self.count(ConstraintKind::Incidence) > 0).then(|| self.cos_max.acos())
+    }
+
+    /// Whether `q` lies within the joint bounds (inclusive; the limits shrunk by the joint
+    /// margin, see [`ConstraintSet::joint_bounds`], less [`JOINT_MARGIN_TOLERANCE`]).
     pub fn within_limits(&self, q: &[f64]) -> bool {
+        let tol = self.joint_tolerance;
         q.iter()
             .zip(self.lower.iter().zip(&self.upper))
-            .all(|(v, (lo, hi))| *v >= *lo && *v <= *hi)
+            .all(|(v, (lo, hi))| *v >= *lo - tol && *v <= *hi + tol)
     }
 
     /// The smallest of `values` (one per constraint) with its index, name and kind; `None`
@@ -187,7 +225,8 @@ impl ConstraintSet {
         self.min_margin(&ws.values)
     }
 
-    /// `q` within the joint limits and every constraint ≥ 0 (paper eq. 24b). Stops at the
+    /// `q` within the joint bounds and every constraint at least its
+    /// [`ConstraintSet::required`] value (paper eq. 24b, with the cell's clearance). Stops at the
     /// first violated constraint (random draws are mostly rejected by one of the first few),
     /// so `ws.values` is not filled; use [`ConstraintSet::min_margin_at`] for the values.
     pub fn feasible(&self, ws: &mut ConstraintWorkspace, params: &[f64], q: &[f64]) -> bool {
@@ -197,7 +236,7 @@ impl ConstraintSet {
         assert_eq!(params.len(), self.model.param_count(), "parameter count");
         assert_eq!(q.len(), self.dof(), "joint count");
         self.place(ws, params, q);
-        (0..self.len()).all(|row| self.evaluate_row(ws, row, None) >= 0.0)
+        (0..self.len()).all(|row| self.evaluate_row(ws, row, None) >= self.required[row])
     }
 }
 
@@ -244,4 +283,38 @@ fn beam_gradient(
         }
         *gj = v;
     }
+}
+
+/// The range `(min, max)` of every constraint of `set` over `samples` configurations spread
+/// over the joint ranges (mid-range and a fixed low-discrepancy sequence: the fractional parts
+/// of `0.5 + k·√(j + 2)` for joint j), at the nominal parameters. A constraint whose range is
+/// below 1e-9 does not depend on q there — a KUKA base column on joint 1 standing on the
+/// floor, a point on the joint-1 axis against the wall — or is flat over the sampled region:
+/// the distance from a point on a joint axis to a capsule turning about that axis stays the
+/// same until another point of the capsule comes closest (the paper robot's upper arm and
+/// forearm at 16 samples), so 16 samples flag such a constraint and 256 rarely do.
+pub(super) fn constraint_ranges(set: &ConstraintSet, samples: usize) -> Vec<(f64, f64)> {
+    let (lower, upper) = set.model.joint_limits();
+    let params = set.model.nominal();
+    let mut ws = set.workspace();
+    let m = set.len();
+    let mut range = vec![(f64::INFINITY, f64::NEG_INFINITY); m];
+    let mut values = vec![0.0; m];
+    let mut q = vec![0.0; lower.len()];
+    for k in 0..samples {
+        for (j, x) in q.iter_mut().enumerate() {
+            let t = (0.5 + k as f64 * (j as f64 + 2.0).sqrt()).fract();
+            *x = lower[j] + t * (upper[j] - lower[j]);
+        }
+        set.evaluate(&mut ws, &params, &q, &mut values, None);
+        for (r, v) in range.iter_mut().zip(&values) {
+            *r = (r.0.min(*v), r.1.max(*v));
+        }
+    }
+    range
+}
+
+/// Whether a range of [`constraint_ranges`] is constant (within 1e-9).
+pub(super) fn is_flat(range: (f64, f64)) -> bool {
+    range.1 - range.0 < 1e-9
 }

@@ -64,10 +64,21 @@
 //! Constraints that need the tracker (incidence, line of sight) are left out when the model
 //! has no instrument frame; incidence also needs `instrument.max_incidence` in the cell.
 //!
+//! **Clearance and joint margin** (the cell's `[design]`, [`DesignClearance`]). A set built
+//! with [`ConstraintSettings::clearance`] `c` requires `g(q) ≥ c` of every distance
+//! constraint (self collision, obstacle, half-space, line of sight) and keeps every revolute
+//! joint [`ConstraintSettings::joint_margin`] inside its limits; [`ConstraintSet::evaluate`]
+//! still returns the distances themselves, [`ConstraintSet::required`] the least value each
+//! must keep. A distance that no configuration changes and that lies below the clearance (a
+//! base column standing on the floor: 0 mm for every q) is exempt — no design can widen it,
+//! and the cell says it is allowed; "no configuration changes" is checked at 256 spread
+//! configurations.
+//!
 //! This file assembles the set from a cell ([`ConstraintSet::new`]); `evaluate.rs` computes
-//! values and gradients at a configuration.
+//! values and gradients at a configuration; `measurable.rs` lists what makes a pose
+//! unmeasurable.
 
-use crate::cell::{half_space_unit_normal, Cell, Obstacle};
+use crate::cell::{half_space_unit_normal, Cell, DesignClearance, Obstacle};
 use crate::geometry::{point_segment_distance, segment_distance};
 use crate::model::{forward_kinematics, Data, Model, Twist};
 use crate::Error;
@@ -103,6 +114,22 @@ pub struct ConstraintSettings {
     /// Name of the reflector target; `None`: the model's first target (the tool origin if
     /// there is none).
     pub reflector: Option<String>,
+    /// Least value (mm) every q-dependent distance constraint must keep (0: touching is
+    /// allowed, as in paper eq. 24b).
+    pub clearance: f64,
+    /// Distance (rad) every revolute joint keeps from its limits (0: the limits themselves).
+    pub joint_margin: f64,
+}
+
+impl ConstraintSettings {
+    /// These settings with the cell's `[design]` clearance and joint margin.
+    pub fn with_clearance(self, design: &DesignClearance) -> Self {
+        ConstraintSettings {
+            clearance: design.clearance,
+            joint_margin: design.joint_margin,
+            ..self
+        }
+    }
 }
 
 impl Default for ConstraintSettings {
@@ -113,6 +140,8 @@ impl Default for ConstraintSettings {
             line_of_sight: true,
             beam_radius: 5.0,
             reflector: None,
+            clearance: 0.0,
+            joint_margin: 0.0,
         }
     }
 }
@@ -250,8 +279,17 @@ pub struct ConstraintSet {
     reflector: Reflector,
     cos_max: f64,
     beam_radius: f64,
+    /// Joint bounds: the limits, revolute joints shrunk by the joint margin.
     lower: Vec<f64>,
     upper: Vec<f64>,
+    /// Least value of each constraint (the clearance for q-dependent distances, else 0).
+    required: Vec<f64>,
+    /// Constraints whose value is the same at 16 spread configurations (`evaluate.rs`,
+    /// `constraint_ranges`).
+    constant: Vec<bool>,
+    /// How far a configuration may sit inside the joint margin and still count as within
+    /// the bounds ([`JOINT_MARGIN_TOLERANCE`] with a margin, 0 without).
+    joint_tolerance: f64,
 }
 
 /// Reusable buffers for [`ConstraintSet::evaluate`].
@@ -273,6 +311,16 @@ impl ConstraintSet {
                 "beam radius must be a finite length ≥ 0 mm, got {}",
                 options.beam_radius
             )));
+        }
+        for (what, v) in [
+            ("clearance", options.clearance),
+            ("joint margin", options.joint_margin),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(Error::Input(format!(
+                    "the {what} must be finite and ≥ 0, got {v}"
+                )));
+            }
         }
         let model = cell.model.clone();
         let dof = model.dof();
@@ -381,9 +429,23 @@ impl ConstraintSet {
                 names.push(format!("beam / {name}"));
             }
         }
-        let (lower, upper) = model.joint_limits();
+        let (mut lower, mut upper) = model.joint_limits();
         debug_assert_eq!(lower.len(), dof);
-        Ok(ConstraintSet {
+        for (j, joint) in model.joints.iter().enumerate() {
+            if joint.kind == crate::model::JointKind::Revolute {
+                lower[j] += options.joint_margin;
+                upper[j] -= options.joint_margin;
+            }
+        }
+        if let Some(j) = (0..dof).find(|&j| lower[j] > upper[j]) {
+            return Err(Error::Input(format!(
+                "a joint margin of {:.3}° leaves joint `{}` no range",
+                options.joint_margin.to_degrees(),
+                model.joints[j].name
+            )));
+        }
+        let n = items.len();
+        let mut set = ConstraintSet {
             model,
             capsules,
             obstacles,
@@ -395,7 +457,32 @@ impl ConstraintSet {
             beam_radius: options.beam_radius,
             lower,
             upper,
-        })
+            required: vec![0.0; n],
+            constant: vec![false; n],
+            joint_tolerance: 0.0,
+        };
+        // 16 samples: the constraints the refinement keeps no margin from (see
+        // `CellConstraints` in plan.rs).
+        set.constant = constraint_ranges(&set, 16)
+            .into_iter()
+            .map(is_flat)
+            .collect();
+        if options.clearance > 0.0 {
+            // Exempt from the clearance: constant over 256 samples and below it everywhere.
+            let dense = constraint_ranges(&set, 256);
+            for (i, r) in dense.into_iter().enumerate() {
+                let exempt = is_flat(r) && r.1 < options.clearance;
+                if set.kind(i) != ConstraintKind::Incidence && !exempt {
+                    set.required[i] = options.clearance;
+                }
+            }
+        }
+        set.joint_tolerance = if options.joint_margin > 0.0 {
+            JOINT_MARGIN_TOLERANCE
+        } else {
+            0.0
+        };
+        Ok(set)
     }
 
     /// Number of constraints.
@@ -502,5 +589,10 @@ fn reflector_carriers(
 }
 
 mod evaluate;
+mod measurable;
+pub use evaluate::JOINT_MARGIN_TOLERANCE;
+use evaluate::{constraint_ranges, is_flat};
 #[cfg(test)]
 mod tests;
+
+pub use measurable::{unmeasurable_poses, Unmeasurable, Violation};
