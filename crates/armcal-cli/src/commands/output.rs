@@ -75,7 +75,8 @@ impl Outputs {
             let dir = parent(path);
             let mut missing: Vec<PathBuf> = dir
                 .ancestors()
-                .take_while(|d| !d.exists())
+                // A relative path's last ancestor is the empty path: the working directory.
+                .take_while(|d| !d.as_os_str().is_empty() && !d.exists())
                 .map(Path::to_path_buf)
                 .collect();
             missing.reverse();

@@ -144,3 +144,32 @@ fn demo_refuses_a_users_file() {
     assert!(t0.elapsed().as_secs_f64() < 5.0);
     assert_eq!(listing(&dir), ["cell.toml"]);
 }
+
+#[test]
+fn a_relative_output_in_a_new_folder_is_written() {
+    let dir = scratch("outputs-relative");
+    let cell = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/paper-cell.toml"
+    );
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_armcal"))
+        .args([
+            "plan",
+            "--cell",
+            cell,
+            "--poses",
+            "12",
+            "--out",
+            "out/design.csv",
+            "--quiet",
+        ])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(listing(&dir), ["out", "out/design.csv", "out/design.json"]);
+}
