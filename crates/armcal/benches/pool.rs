@@ -45,12 +45,6 @@ fn pool(c: &mut Criterion) {
         greedy_then_exchange(&d, DesignCriterion::D, &pool, &prior, 60, &mut Silent)
             .expect("reference")
     };
-    let t = std::time::Instant::now();
-    let jp = pool_jacobians(&d, &pool);
-    eprintln!("jacobians {:.4}", t.elapsed().as_secs_f64());
-    let t = std::time::Instant::now();
-    armcal::design::selection::greedy_d(&jp, 3, &prior, 60, 1e-6).unwrap();
-    eprintln!("greedy {:.4}", t.elapsed().as_secs_f64());
     let a = ours();
     let b = reference();
     // The D criterion is log det C / n = −log det M / n.

@@ -139,11 +139,16 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         (&report_path, &serde_json::to_string_pretty(&record)?),
     ])?;
     println!(
-        "{} poses for `{}`, criterion {:?}: value {:.6} (exchange {:.6}; refinement {}) in {:.2} s",
+        "{} poses for `{}`, criterion {:?}: value {:.6} ({} {:.6}; refinement {}) in {:.2} s",
         rep.design.len(),
         cell.name,
         rep.criterion,
         rep.value,
+        if record.pool.is_some() {
+            "pool selection"
+        } else {
+            "exchange"
+        },
         rep.exchange_value,
         rep.refine_status.as_deref().unwrap_or("skipped"),
         rep.time.as_secs_f64()
@@ -205,6 +210,21 @@ fn print_pool(pool: &PoolReport) {
         pool.feasible,
         pool.infeasible.len()
     );
+    let mut by_constraint: Vec<(&str, usize)> = Vec::new();
+    for r in &pool.infeasible {
+        match by_constraint.iter_mut().find(|(c, _)| *c == r.constraint) {
+            Some(entry) => entry.1 += 1,
+            None => by_constraint.push((&r.constraint, 1)),
+        }
+    }
+    by_constraint.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(b.0)));
+    if !by_constraint.is_empty() {
+        let counts: Vec<String> = by_constraint
+            .iter()
+            .map(|(c, n)| format!("{c} {n}"))
+            .collect();
+        eprintln!("  violated: {}", counts.join(", "));
+    }
     for r in pool.infeasible.iter().take(10) {
         eprintln!(
             "  row {} (`{}`): {} margin {:.3} {}",
@@ -217,7 +237,7 @@ fn print_pool(pool: &PoolReport) {
     eprintln!("selection: {}", pool.selection);
     if let Some(r) = pool.refine_radius {
         eprintln!(
-            "refined within {r} (deg, mm) of the pool poses: largest joint move {:.4}",
+            "refined within ±{r} deg per joint (mm for a prismatic joint) of the pool poses: largest joint move {:.4}",
             pool.largest_move
         );
     }

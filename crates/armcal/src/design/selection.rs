@@ -108,12 +108,22 @@ impl<'a> LowRank<'a> {
         self.c = ch.inverse();
         self.u.gemm(1.0, self.jp, &self.c, 0.0);
         let r = self.rows;
-        for x in 0..self.candidates() {
-            for a in 0..r {
-                for b in 0..=a {
-                    let v = self.u.row(x * r + a).dot(&self.jp.row(x * r + b));
-                    self.dx[x * r * r + a * r + b] = v;
-                    self.dx[x * r * r + b * r + a] = v;
+        self.dx.fill(0.0);
+        // Column-major storage: column p of U and of J_pool, every candidate's rows at once.
+        let rows_total = self.jp.nrows();
+        let (u, jp) = (self.u.as_slice(), self.jp.as_slice());
+        for p in 0..self.jp.ncols() {
+            let (up, jpp) = (
+                &u[p * rows_total..(p + 1) * rows_total],
+                &jp[p * rows_total..(p + 1) * rows_total],
+            );
+            for x in 0..self.candidates() {
+                let dx = &mut self.dx[x * r * r..(x + 1) * r * r];
+                for a in 0..r {
+                    let ua = up[x * r + a];
+                    for b in 0..r {
+                        dx[a * r + b] += ua * jpp[x * r + b];
+                    }
                 }
             }
         }
@@ -148,11 +158,20 @@ impl<'a> LowRank<'a> {
         let ek = &self.e * &k;
         self.u.gemm(-1.0, &ek, &b, 1.0);
         self.c -= b.transpose() * &k * &b;
-        for y in 0..self.candidates() {
-            for a in 0..r {
-                for c in 0..r {
-                    let v = ek.row(y * r + a).dot(&self.e.row(y * r + c));
-                    self.dx[y * r * r + a * r + c] -= v;
+        let rows_total = self.jp.nrows();
+        let (eks, es) = (ek.as_slice(), self.e.as_slice());
+        for k in 0..r {
+            let (ekk, ek_) = (
+                &eks[k * rows_total..(k + 1) * rows_total],
+                &es[k * rows_total..(k + 1) * rows_total],
+            );
+            for y in 0..self.candidates() {
+                let dx = &mut self.dx[y * r * r..(y + 1) * r * r];
+                for a in 0..r {
+                    let v = ekk[y * r + a];
+                    for c in 0..r {
+                        dx[a * r + c] -= v * ek_[y * r + c];
+                    }
                 }
             }
         }
@@ -315,10 +334,12 @@ pub fn select_d(
             let ji = jp.rows(i * rows, rows);
             state.e.gemm(1.0, &state.u, &ji.transpose(), 0.0);
             let mut best: Option<(f64, usize)> = None;
+            let total_rows = jp.nrows();
+            let es = state.e.as_slice();
             for x in (0..p).filter(|&x| !in_design[x]) {
                 for r in 0..rows {
                     for c in 0..rows {
-                        e_x[r * rows + c] = state.e[(x * rows + r, c)];
+                        e_x[r * rows + c] = es[c * total_rows + x * rows + r];
                     }
                 }
                 for r in 0..rows {

@@ -43,8 +43,8 @@ pub fn pool(
         .take(blind)
         .collect();
     assert_eq!(bad.len(), blind);
-    for k in 0..outside {
-        let mut q = good[k].clone();
+    for (k, q0) in good.iter().take(outside).enumerate() {
+        let mut q = q0.clone();
         let j = k % q.len();
         q[j] = d.model.joints[j].upper + 0.1;
         bad.push(q);
