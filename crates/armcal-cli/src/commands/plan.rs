@@ -6,6 +6,7 @@ use super::progress::Progress;
 use anyhow::bail;
 use armcal::design::assess::evaluate_design;
 use armcal::design::plan::PlanSettings;
+use armcal::design::user_pool::{PoolReport, PoolSettings};
 use armcal::design::Criterion;
 use armcal::design::DesignRecord;
 use armcal::measure::csv;
@@ -25,11 +26,22 @@ pub struct PlanArgs {
     /// Collision and line-of-sight constraints.
     #[arg(long, default_value = "on", value_parser = ["on", "off"])]
     pub collisions: String,
-    /// Independent exchange + refinement starts (run in parallel).
-    #[arg(long, default_value_t = 2)]
+    /// Independent exchange + refinement starts (run in parallel; not with --pool, whose
+    /// selection is deterministic).
+    #[arg(long, default_value_t = 2, conflicts_with = "pool")]
     pub starts: usize,
-    #[arg(long, default_value_t = 1)]
+    /// Seed of the random candidate pool and the exchange starts (not with --pool).
+    #[arg(long, default_value_t = 1, conflicts_with = "pool")]
     pub seed: u64,
+    /// Choose the poses from this pool of joint configurations (CSV as a design file:
+    /// pose_id, q1_deg, …) instead of random candidates; rows that violate a joint limit or
+    /// a constraint are listed in the report and never chosen.
+    #[arg(long, value_name = "POOL.csv")]
+    pub pool: Option<PathBuf>,
+    /// With --pool: refine the chosen poses continuously, each joint moving at most this far
+    /// from its pool pose (deg; mm for a prismatic joint). Without it the design is pool rows.
+    #[arg(long, requires = "pool", value_name = "DEG")]
+    pub refine_radius: Option<f64>,
     /// Poses already measured (CSV); the design augments them.
     #[arg(long)]
     pub measured: Option<PathBuf>,
@@ -68,6 +80,7 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         .unwrap_or_else(|| a.out.with_extension("json"));
     let mut inputs = vec![Path::new(&a.cell)];
     inputs.extend(a.measured.as_deref());
+    inputs.extend(a.pool.as_deref());
     let outputs = Outputs::plan(a.force, &inputs, &[&a.out, &report_path])?;
     let cell = load_cell(&a.cell)?;
     let measured: Vec<Vec<f64>> = match &a.measured {
@@ -77,36 +90,65 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
             .collect(),
         None => Vec::new(),
     };
-    let settings = PlanSettings {
-        poses: a.poses,
-        criterion: Criterion::from_name(&a.criterion).expect("clap checked"),
-        collisions: a.collisions == "on",
-        starts: a.starts,
-        seed: a.seed,
-        ..PlanSettings::default()
+    let criterion = Criterion::from_name(&a.criterion).expect("clap checked");
+    let record = match &a.pool {
+        Some(pool) => DesignRecord::from_pool(
+            &cell,
+            Some(&a.cell),
+            &format!(
+                "armcal plan, criterion {}, from the pose pool {}",
+                a.criterion,
+                pool.display()
+            ),
+            pool,
+            &PoolSettings {
+                poses: a.poses,
+                criterion,
+                collisions: a.collisions == "on",
+                refine_radius: a.refine_radius,
+                ..PoolSettings::default()
+            },
+            &measured,
+            &mut Progress::new(a.quiet),
+        )?,
+        None => DesignRecord::planned(
+            &cell,
+            Some(&a.cell),
+            &format!(
+                "armcal plan, criterion {}, {} start(s), seed {}",
+                a.criterion, a.starts, a.seed
+            ),
+            &PlanSettings {
+                poses: a.poses,
+                criterion,
+                collisions: a.collisions == "on",
+                starts: a.starts,
+                seed: a.seed,
+                ..PlanSettings::default()
+            },
+            &measured,
+            &mut Progress::new(a.quiet),
+        )?,
     };
-    let record = DesignRecord::planned(
-        &cell,
-        Some(&a.cell),
-        &format!(
-            "armcal plan, criterion {}, {} start(s), seed {}",
-            a.criterion, a.starts, a.seed
-        ),
-        &settings,
-        &measured,
-        &mut Progress::new(a.quiet),
-    )?;
+    if let Some(pool) = &record.pool {
+        print_pool(pool);
+    }
     let rep = record.plan.as_ref().expect("a planned design");
     outputs.commit(&[
         (&a.out, &csv::write_configurations(&cell.model, &rep.design)),
         (&report_path, &serde_json::to_string_pretty(&record)?),
     ])?;
     println!(
-        "{} poses for `{}`, criterion {:?}: value {:.6} (exchange {:.6}; refinement {}) in {:.2} s",
+        "{} poses for `{}`, criterion {:?}: value {:.6} ({} {:.6}; refinement {}) in {:.2} s",
         rep.design.len(),
         cell.name,
         rep.criterion,
         rep.value,
+        if record.pool.is_some() {
+            "pool selection"
+        } else {
+            "exchange"
+        },
         rep.exchange_value,
         rep.refine_status.as_deref().unwrap_or("skipped"),
         rep.time.as_secs_f64()
@@ -160,6 +202,49 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         bail!("the design violates constraints; see the report");
     }
     Ok(())
+}
+
+/// The pool's rows on stderr: how many are infeasible (the first ten of them), which were
+/// chosen is in the report.
+fn print_pool(pool: &PoolReport) {
+    eprintln!(
+        "pool {}: {} rows, {} feasible, {} infeasible (never chosen; all listed in the report)",
+        pool.file,
+        pool.rows,
+        pool.feasible,
+        pool.infeasible.len()
+    );
+    let mut by_constraint: Vec<(&str, usize)> = Vec::new();
+    for r in &pool.infeasible {
+        match by_constraint.iter_mut().find(|(c, _)| *c == r.constraint) {
+            Some(entry) => entry.1 += 1,
+            None => by_constraint.push((&r.constraint, 1)),
+        }
+    }
+    by_constraint.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(b.0)));
+    if !by_constraint.is_empty() {
+        let counts: Vec<String> = by_constraint
+            .iter()
+            .map(|(c, n)| format!("{c} {n}"))
+            .collect();
+        eprintln!("  violated: {}", counts.join(", "));
+    }
+    for r in pool.infeasible.iter().take(10) {
+        eprintln!(
+            "  row {} (`{}`): {} margin {:.3} {}",
+            r.pose.row, r.pose.id, r.constraint, r.margin, r.unit
+        );
+    }
+    if pool.infeasible.len() > 10 {
+        eprintln!("  … and {} more", pool.infeasible.len() - 10);
+    }
+    eprintln!("selection: {}", pool.selection);
+    if let Some(r) = pool.refine_radius {
+        eprintln!(
+            "refined within ±{r} deg per joint (mm for a prismatic joint) of the pool poses: largest joint move {:.4}",
+            pool.largest_move
+        );
+    }
 }
 
 pub fn run_evaluate(a: &EvaluateArgs) -> anyhow::Result<()> {

@@ -10,4 +10,5 @@ mod estimate_checks;
 mod import_cli;
 mod measurable_cli;
 mod outputs_cli;
+mod pool_cli;
 mod workflow;

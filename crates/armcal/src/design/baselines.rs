@@ -2,10 +2,17 @@
 //! and the book's observation strategies 1–4 (book §4.5.2, Table 4.6): 1 moves every joint
 //! by constant increments simultaneously; 2 moves one joint at a time with the others at
 //! mid-range; 3 holds one joint at mid-range and moves the others simultaneously; 4 is
-//! uniform random (Monte Carlo).
+//! uniform random (Monte Carlo). And the reference for choosing N poses of a candidate
+//! pool: the greedy D-optimal selection followed by the Fedorov exchange.
 
+use crate::design::exchange::{exchange, pool_jacobians, ExchangeResult, ExchangeSettings};
+use crate::design::information::DesignModel;
+use crate::design::selection::{greedy_d, SelectionSettings};
+use crate::design::Criterion;
 use crate::model::Model;
+use crate::progress::Observer;
 use crate::Error;
+use nalgebra::DMatrix;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -96,4 +103,38 @@ pub fn random_feasible(
         )));
     }
     Ok((out, draws))
+}
+
+/// The textbook way to choose `n_points` of `pool` for `criterion` (with `prior` whitened
+/// rows of measured poses): the greedy D-optimal selection ([`greedy_d`]), then the Fedorov
+/// exchange on `criterion` from it ([`exchange`], which recomputes the covariance for every
+/// design point it removes). The benchmark's reference for
+/// [`select_d`](crate::design::selection::select_d).
+pub fn greedy_then_exchange(
+    d: &DesignModel,
+    criterion: Criterion,
+    pool: &[Vec<f64>],
+    prior: &DMatrix<f64>,
+    n_points: usize,
+    observer: &mut dyn Observer,
+) -> Result<ExchangeResult, Error> {
+    let start = greedy_d(
+        &pool_jacobians(d, pool),
+        d.rows(),
+        prior,
+        n_points,
+        SelectionSettings::default().regularisation,
+    )?;
+    exchange(
+        d,
+        criterion,
+        pool,
+        prior,
+        n_points,
+        &ExchangeSettings {
+            start: Some(start),
+            ..ExchangeSettings::default()
+        },
+        observer,
+    )
 }

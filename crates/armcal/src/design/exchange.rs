@@ -1,5 +1,5 @@
 //! Candidate-pool exchange (Fedorov 1972; Mitchell's DETMAX style): start from N pool
-//! configurations, then repeatedly remove one design point and put back the pool
+//! configurations (a seeded random set, or one given, e.g. a greedy D-optimal selection), then repeatedly remove one design point and put back the pool
 //! configuration that improves the criterion most, until no exchange helps.
 //!
 //! The removal is a rank-r downdate of the covariance and every candidate is scored with a
@@ -34,6 +34,8 @@ pub struct ExchangeSettings {
     pub tolerance: f64,
     /// Candidates scored exactly per removal for criteria without a rank update.
     pub exact_shortlist: usize,
+    /// The start: N distinct pool indices (`None`: the seeded random start).
+    pub start: Option<Vec<usize>>,
 }
 
 impl Default for ExchangeSettings {
@@ -43,6 +45,7 @@ impl Default for ExchangeSettings {
             seed: 1,
             tolerance: 1e-9,
             exact_shortlist: 12,
+            start: None,
         }
     }
 }
@@ -79,8 +82,8 @@ pub fn pool_jacobians(d: &DesignModel, pool: &[Vec<f64>]) -> DMatrix<f64> {
     out
 }
 
-/// The criterion of a set of pool points (plus prior rows).
-fn value_of(
+/// The criterion of a set of pool points (rows of `jp`, [`pool_jacobians`]) plus prior rows.
+pub(crate) fn value_of(
     d: &DesignModel,
     c: Criterion,
     jp: &DMatrix<f64>,
@@ -143,13 +146,34 @@ pub fn exchange(
         )));
     }
     let jp = pool_jacobians(d, pool);
-    // Start: a random subset that identifies every parameter (retry a few times).
+    // Start: the given set, or a random subset that identifies every parameter (retry a
+    // few times).
     let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
     let mut idx: Vec<usize> = (0..pool.len()).collect();
     let mut chosen = Vec::new();
     let mut value = f64::INFINITY;
     let mut last_failure = None;
-    for _ in 0..20 {
+    if let Some(start) = &settings.start {
+        let mut seen = vec![false; pool.len()];
+        for &i in start {
+            if i >= pool.len() || std::mem::replace(&mut seen[i], true) {
+                return Err(Error::Input(format!(
+                    "the exchange's start names pool configuration {i} twice or past the pool's {}",
+                    pool.len()
+                )));
+            }
+        }
+        if start.len() != n_points {
+            return Err(Error::Input(format!(
+                "the exchange's start has {} configurations, not the {n_points} asked for",
+                start.len()
+            )));
+        }
+        chosen = start.clone();
+        value = value_of(d, criterion, &jp, prior, &chosen)?;
+    }
+    let random_tries = if settings.start.is_some() { 0 } else { 20 };
+    for _ in 0..random_tries {
         idx.shuffle(&mut rng);
         let trial: Vec<usize> = idx[..n_points].to_vec();
         match value_of(d, criterion, &jp, prior, &trial) {

@@ -14,7 +14,9 @@ pub mod order;
 pub mod plan;
 pub mod record;
 pub mod refine;
+pub mod selection;
 pub mod small_cholesky;
+pub mod user_pool;
 
 pub use cell_constraints::{
     ConstraintKind, ConstraintSet, ConstraintSettings, ConstraintWorkspace, Margin,

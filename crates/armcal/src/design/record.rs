@@ -6,6 +6,7 @@
 use crate::cell::Cell;
 use crate::design::assess::{assess, DesignAssessment};
 use crate::design::plan::{constraint_set, plan, PlanResult, PlanSettings};
+use crate::design::user_pool::{plan_from_pool, PoolReport, PoolSettings};
 use crate::design::ConstraintKind;
 use crate::model::Model;
 use crate::progress::Observer;
@@ -75,6 +76,10 @@ pub struct DesignRecord {
     pub assessment: DesignAssessment,
     /// The smallest margin of every kind of constraint ([`kind_margins`]).
     pub margins: Vec<KindMargin>,
+    /// For a design chosen from the user's pose pool: the pool file, its size, its
+    /// infeasible rows and the row of every pose.
+    #[serde(default)]
+    pub pool: Option<PoolReport>,
 }
 
 /// Display factor (internal → display) and unit name of each joint of a model.
@@ -240,7 +245,42 @@ impl DesignRecord {
             assessment: assess(cell, design)?,
             margins: kind_margins(cell, design, collisions)?,
             plan,
+            pool: None,
         })
+    }
+
+    /// Chooses a design for `cell` from the pose pool in the file `pool` (a joint CSV as
+    /// [`read_configurations`](crate::measure::csv::read_configurations) reads it;
+    /// [`plan_from_pool`], augmenting the `measured` poses) and makes its record.
+    pub fn from_pool(
+        cell: &Cell,
+        cell_source: Option<&str>,
+        method: &str,
+        pool: &std::path::Path,
+        settings: &PoolSettings,
+        measured: &[Vec<f64>],
+        observer: &mut dyn Observer,
+    ) -> Result<DesignRecord, Error> {
+        let rows = crate::measure::csv::read_configurations(pool, &cell.model, None)?;
+        let planned = plan_from_pool(
+            cell,
+            &rows,
+            &pool.display().to_string(),
+            settings,
+            measured,
+            observer,
+        )?;
+        let design = planned.plan.design.clone();
+        let mut record = DesignRecord::new(
+            cell,
+            cell_source,
+            method,
+            &design,
+            Some(planned.plan),
+            settings.collisions,
+        )?;
+        record.pool = Some(planned.pool);
+        Ok(record)
     }
 
     /// Plans a design for `cell` ([`plan`], augmenting the `measured` poses) and makes its

@@ -145,7 +145,8 @@ const LIPSCHITZ_SAFETY: f64 = 2.0;
 /// and re-anchored; so is one with more than a third of its constraints possibly near.
 const REANCHOR_DISTANCE: f64 = 0.2;
 
-/// The feasible set of the design: a product over configurations of the joint box and
+/// The feasible set of the design: a product over configurations of each configuration's
+/// joint box (the joint limits, or a smaller box around a pose of the user's pool) and
 /// `{q : g(q) ≥ 0}`. Its projection (the proximal step of PANOC) clamps each configuration
 /// into the box and then applies minimum-norm Gauss–Newton corrections on the violated
 /// constraints `v`, `Δq = J_vᵀ (J_v J_vᵀ)⁻¹ (−g_v)` — the Euclidean projection to first
@@ -160,6 +161,9 @@ const REANCHOR_DISTANCE: f64 = 0.2;
 /// iterate is projected once more with every constraint evaluated ([`FeasibleSet::reset`]),
 /// and the planner checks the result strictly.
 struct FeasibleSet<'a> {
+    /// Joints per configuration.
+    k: usize,
+    /// Box of every configuration, configuration after configuration (N·k values each).
     lower: &'a [f64],
     upper: &'a [f64],
     constraints: Option<&'a dyn ConfigurationConstraints>,
@@ -190,8 +194,15 @@ struct ProjectionBuffers {
 }
 
 impl FeasibleSet<'_> {
-    fn clamp(&self, q: &mut [f64]) {
-        for ((x, lo), hi) in q.iter_mut().zip(self.lower).zip(self.upper) {
+    /// The box of configuration `index`.
+    fn bounds(&self, index: usize) -> (&[f64], &[f64]) {
+        let r = index * self.k..(index + 1) * self.k;
+        (&self.lower[r.clone()], &self.upper[r])
+    }
+
+    fn clamp(&self, index: usize, q: &mut [f64]) {
+        let (lower, upper) = self.bounds(index);
+        for ((x, lo), hi) in q.iter_mut().zip(lower).zip(upper) {
             *x = x.clamp(*lo, *hi);
         }
     }
@@ -206,7 +217,7 @@ impl FeasibleSet<'_> {
         let Some(cons) = self.constraints else {
             return;
         };
-        let k = self.lower.len();
+        let k = self.k;
         let b = &mut *self.buffers.borrow_mut();
         let m = b.values.len();
         b.lipschitz.fill(0.0);
@@ -238,15 +249,16 @@ impl FeasibleSet<'_> {
         q: &mut [f64],
     ) {
         let b = &mut *self.buffers.borrow_mut();
-        self.clamp(q);
+        let (lower, upper) = self.bounds(index);
+        self.clamp(index, q);
         for _ in 0..MAX_CORRECTIONS {
             if !b.violated_at(cons, index, q) {
                 return;
             }
-            if !b.correct(q, self.lower, self.upper) {
+            if !b.correct(q, lower, upper) {
                 break;
             }
-            self.clamp(q);
+            self.clamp(index, q);
         }
         if b.has_safe[index] {
             b.retreat(cons, index, q);
@@ -413,11 +425,10 @@ impl ProjectionBuffers {
 
 impl Constraint for FeasibleSet<'_> {
     fn project(&self, x: &mut [f64]) -> FunctionCallResult {
-        let k = self.lower.len();
-        for (index, q) in x.chunks_mut(k).enumerate() {
+        for (index, q) in x.chunks_mut(self.k).enumerate() {
             match self.constraints {
                 Some(c) => self.project_configuration(c, index, q),
-                None => self.clamp(q),
+                None => self.clamp(index, q),
             }
         }
         Ok(())
@@ -428,7 +439,8 @@ impl Constraint for FeasibleSet<'_> {
     }
 }
 
-/// Refines the design `start` (N configurations).
+/// Refines the design `start` (N configurations) within the joint limits `lower`, `upper`
+/// (one value per joint).
 pub fn refine(
     objective: &DesignObjective,
     start: &[Vec<f64>],
@@ -438,12 +450,45 @@ pub fn refine(
     settings: &RefineSettings,
     observer: &mut dyn Observer,
 ) -> Result<RefineResult, Error> {
+    let n = start.len();
+    refine_in_boxes(
+        objective,
+        start,
+        &lower.repeat(n),
+        &upper.repeat(n),
+        constraints,
+        settings,
+        observer,
+    )
+}
+
+/// Refines the design `start` (N configurations of k joints) with configuration `i` kept in
+/// its own box `lower[i·k..(i+1)·k]`, `upper[i·k..(i+1)·k]` (N·k values each; e.g. the joint
+/// limits intersected with a radius around a pool pose). Every start configuration should
+/// lie in its box (it is clamped into it first).
+pub fn refine_in_boxes(
+    objective: &DesignObjective,
+    start: &[Vec<f64>],
+    lower: &[f64],
+    upper: &[f64],
+    constraints: Option<&dyn ConfigurationConstraints>,
+    settings: &RefineSettings,
+    observer: &mut dyn Observer,
+) -> Result<RefineResult, Error> {
     let t0 = Instant::now();
-    let k = lower.len();
+    let k = objective.design.dof();
     let nconf = start.len();
     let nu = k * nconf;
+    if lower.len() != nu || upper.len() != nu {
+        return Err(Error::Input(format!(
+            "pose refinement: {nconf} configurations of {k} joints need {nu} bounds each, got {} and {}",
+            lower.len(),
+            upper.len()
+        )));
+    }
     let m = constraints.map_or(0, |c| c.len());
     let set = FeasibleSet {
+        k,
         lower,
         upper,
         constraints: constraints.filter(|c| !c.is_empty()),

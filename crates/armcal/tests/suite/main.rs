@@ -29,6 +29,7 @@ mod design {
     mod design_gradients;
     mod design_monte_carlo;
     mod design_plan;
+    mod design_pool;
     mod design_refine;
     mod measurable;
     mod paper_cell_geometry;
