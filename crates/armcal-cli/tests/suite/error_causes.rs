@@ -129,7 +129,7 @@ fn sigma_columns_are_checked_and_a_noise_model_that_ignores_them_says_so() {
     let (ok, err) = identify(&dir, "bad.csv");
     assert!(!ok);
     assert!(
-        err.contains("bad.csv: line 4: `sigma_y_mm` = -0.1") && err.contains("must be positive"),
+        err.contains("bad.csv: line 4: `sigma_y_mm` = -0.1") && err.contains("cannot be negative"),
         "{err}"
     );
     // The paper cell's noise model is constant: the σ columns are read but not used, and

@@ -257,7 +257,7 @@ pub fn compensate_program(
         robot_only.instrument = None;
         robot_only.targets.clear();
         let robot = Model::from_spec(&robot_only)?;
-        let (data, _) = csv::read_str(text, file, &robot, None)?;
+        let data = csv::read_targets_str(text, file, &robot)?;
         let poses: Vec<Pose<f64>> = data
             .measurements
             .iter()

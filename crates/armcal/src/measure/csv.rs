@@ -1,5 +1,8 @@
 //! Data files: CSV with a header, one measurement per row.
 //!
+//! (Over 600 lines: the reader, the checks of its rows and the writer of one format stay in
+//! one file, so that the format is defined in one place.)
+//!
 //! Columns (unit suffixes in the names; defaults in brackets):
 //! * `pose_id` — configuration id; rows with the same id share a configuration [row number];
 //! * one column per joint: `q1_deg`, `q2_rad`, `q3_mm`, … [deg for revolute, mm for
@@ -134,15 +137,16 @@ impl Row<'_> {
         Ok(Vector3::from_iterator(self.values(cols, what)?))
     }
 
-    /// Three standard deviations: each must be positive (a σ of 0 would give the row an
-    /// infinite weight, a negative one is no σ at all).
+    /// Three standard deviations: none may be negative. A σ of 0 is read (instruments
+    /// state it for an axis they do not resolve, e.g. the Motoman set's `u_y_m`); the
+    /// per-measurement noise model raises it to its floor.
     fn sigmas(&self, cols: &[Column; 3]) -> Result<Vector3<f64>, Error> {
         let s = self.v3(cols, "σ")?;
-        if let Some((c, v)) = cols.iter().zip(s.iter()).find(|(_, v)| **v <= 0.0) {
+        if let Some((c, v)) = cols.iter().zip(s.iter()).find(|(_, v)| **v < 0.0) {
             return Err(err(
                 self.file,
                 format!(
-                    "line {}: `{}` = {} is not a standard deviation: a σ must be positive \
+                    "line {}: `{}` = {} is not a standard deviation: a σ cannot be negative \
                      (leave the σ columns of a row empty to use the cell's noise model)",
                     self.line,
                     self.header[c.index],
@@ -325,6 +329,29 @@ pub fn read_format_str(
     model: &Model,
     format: &DataFormat,
 ) -> Result<(Dataset, ReadReport), Error> {
+    read_rows(text, file, model, format, Limits::Checked)
+}
+
+/// Cartesian targets in armcal's data format (a program of tool poses): the joint columns
+/// are IK seeds, not measured joint values, so they are not checked against the limits.
+pub fn read_targets_str(text: &str, file: &str, model: &Model) -> Result<Dataset, Error> {
+    read_rows(text, file, model, &DataFormat::armcal(), Limits::Unchecked).map(|(d, _)| d)
+}
+
+/// Whether the joint values of a file are measured ones, checked against the model's limits.
+#[derive(Clone, Copy, PartialEq)]
+enum Limits {
+    Checked,
+    Unchecked,
+}
+
+fn read_rows(
+    text: &str,
+    file: &str,
+    model: &Model,
+    format: &DataFormat,
+    limits: Limits,
+) -> Result<(Dataset, ReadReport), Error> {
     let (mut rdr, header, lines) = reader(text, file, format)?;
     let layout = format.layout(&header, model, file)?;
     let mut data = Dataset {
@@ -345,8 +372,8 @@ pub fn read_format_str(
             decimal: format.decimal,
         };
         let q = row.joints(&layout.joints, model)?;
-        if let Some(w) = row.limit_check(&q, model)? {
-            warnings.push(w);
+        if limits == Limits::Checked {
+            warnings.extend(row.limit_check(&q, model)?);
         }
         let id = layout
             .pose_id

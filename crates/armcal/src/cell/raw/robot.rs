@@ -99,14 +99,15 @@ pub(super) fn robot(
             };
             j.lower = lo * f;
             j.upper = hi * f;
-            limit_order(j)
-                .map_err(|e| ctx.err(rspan.clone(), &format!("robot.limits.{jname}"), e))?;
             check_values(
                 ctx,
                 std::slice::from_ref(link),
                 rspan.clone(),
                 &format!("robot.limits.{jname}"),
             )?;
+            let j = link.joint.as_ref().expect("found by joint");
+            limit_order(j)
+                .map_err(|e| ctx.err(rspan.clone(), &format!("robot.limits.{jname}"), e))?;
         }
     }
     for (i, c) in rr.capsules.iter().enumerate() {
