@@ -16,8 +16,8 @@ pub mod uncertainty;
 pub mod verdicts;
 
 pub use estimate::{
-    Acceptance, Estimate, MeasurementResidual, ParameterEstimate, ResidualReport, SolverReport,
-    Usability, Validation,
+    Acceptance, AxisErrors, Estimate, HeldOutAxes, MeasurementResidual, ParameterEstimate,
+    ResidualReport, SolverReport, Usability, Validation,
 };
 pub use fingerprint::ModelFingerprint;
 pub use gauss_newton::gauss_newton;
@@ -351,7 +351,20 @@ impl Split {
         let frames = frames_first_start(model, &self.train, noise, opts)?;
         let eval = Problem::new(model, test, noise)?;
         let mut ws = eval.workspace();
+        let mut axes = |params: &[f64]| {
+            let xyz: Vec<[f64; 3]> = position_components(&eval, &mut ws, params)
+                .into_iter()
+                .flatten()
+                .collect();
+            AxisErrors::of(&xyz)
+        };
+        let per_axis = HeldOutAxes {
+            nominal: axes(&model.nominal()),
+            frames_only: axes(&frames),
+            calibrated: axes(calibrated),
+        };
         Ok(Some(Validation {
+            per_axis: Some(per_axis),
             test_data: source.clone(),
             train_configurations: self.train.configurations.len(),
             test_configurations: test.configurations.len(),
@@ -364,32 +377,44 @@ impl Split {
     }
 }
 
+/// The position residual `model − measured` of every measurement at `params` (mm, the
+/// whitening and robust weights undone); `None` for distance and plane measurements.
+fn position_components(
+    problem: &Problem,
+    ws: &mut problem::Workspace,
+    params: &[f64],
+) -> Vec<Option<[f64; 3]>> {
+    let mut r = DVector::zeros(problem.rows());
+    problem.evaluate(ws, params, &mut r, None);
+    problem
+        .data
+        .measurements
+        .iter()
+        .enumerate()
+        .map(|(i, m)| match m.kind {
+            MeasurementKind::Position { .. } | MeasurementKind::Pose { .. } => {
+                let row = problem.row_of[i];
+                let un = |k: usize| {
+                    let w = problem.row_weights[row + k].sqrt() / problem.sigmas[row + k];
+                    r[row + k] / w
+                };
+                Some([un(0), un(1), un(2)])
+            }
+            _ => None,
+        })
+        .collect()
+}
+
 /// Residuals of the fit; `file_configs[c]` is the data-file index of the fitted data's
 /// configuration `c` (pose numbers are reported in the file's numbering).
 fn residual_report(problem: &Problem, params: &[f64], file_configs: &[usize]) -> ResidualReport {
     let mut ws = problem.workspace();
-    let n = problem.rows();
-    let mut r = DVector::zeros(n);
-    problem.evaluate(&mut ws, params, &mut r, None);
+    let components = position_components(problem, &mut ws, params);
     let norms = problem.errors(&mut ws, params);
-    let (mut x, mut y, mut z) = (Vec::new(), Vec::new(), Vec::new());
+    let xyz: Vec<[f64; 3]> = components.iter().flatten().copied().collect();
+    let axes = AxisErrors::of(&xyz);
     let mut per_measurement = Vec::with_capacity(norms.len());
-    for (i, m) in problem.data.measurements.iter().enumerate() {
-        let xyz = if let MeasurementKind::Position { .. } | MeasurementKind::Pose { .. } = m.kind {
-            let row = problem.row_of[i];
-            // Undo whitening (and robust weights) to get mm.
-            let un = |k: usize| {
-                let w = problem.row_weights[row + k].sqrt() / problem.sigmas[row + k];
-                r[row + k] / w
-            };
-            let v = [un(0), un(1), un(2)];
-            x.push(v[0]);
-            y.push(v[1]);
-            z.push(v[2]);
-            Some(v)
-        } else {
-            None
-        };
+    for (i, (m, xyz)) in problem.data.measurements.iter().zip(components).enumerate() {
         per_measurement.push(MeasurementResidual {
             pose: file_configs[m.config] + 1,
             pose_id: problem
@@ -403,9 +428,9 @@ fn residual_report(problem: &Problem, params: &[f64], file_configs: &[usize]) ->
         });
     }
     ResidualReport {
-        x: ErrorStats::of(&x),
-        y: ErrorStats::of(&y),
-        z: ErrorStats::of(&z),
+        x: axes.x,
+        y: axes.y,
+        z: axes.z,
         norm: ErrorStats::of(&norms),
         per_measurement,
     }
@@ -452,7 +477,11 @@ pub fn identify(
         (Vec::new(), Vec::new())
     } else {
         let g = uncertainty::tcp_jacobian(model, &sol.params, &problem.free, &working);
-        let cs = uncertainty::tcp_covariance(&g, &unc.covariance, &wnames);
+        let cs = uncertainty::with_base_frame(
+            uncertainty::tcp_covariance(&g, &unc.covariance, &wnames),
+            &uncertainty::tcp_jacobian_world(model, &sol.params, &problem.free, &working),
+            &unc.covariance,
+        );
         let cc = uncertainty::tcp_covariance_constrained(&sol.jacobian, &g)?;
         let blocks = (0..working.len())
             .map(|i| cc.fixed_view::<3, 3>(3 * i, 3 * i).into_owned())
