@@ -42,7 +42,7 @@ fn value(x: f64, unit: &str) -> String {
 }
 
 /// Text between backticks (parameter names in the identifiability reasons) as code.
-fn code_spans(escaped: &str) -> String {
+pub(super) fn code_spans(escaped: &str) -> String {
     let mut out = String::with_capacity(escaped.len() + 16);
     for (i, part) in escaped.split('`').enumerate() {
         if i % 2 == 1 {

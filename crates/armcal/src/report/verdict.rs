@@ -5,6 +5,7 @@
 //! records ([`Estimate::verdicts`], [`Estimate::validation`], the design's assessment and
 //! margins); nothing is fitted again.
 
+use super::estimate::code_spans;
 use super::html::{escape, facts, fixed, number, Section};
 use crate::design::DesignRecord;
 use crate::identify::{Chi2Outcome, Estimate, Method};
@@ -78,7 +79,7 @@ fn estimate_lines(e: &Estimate) -> Vec<Line> {
     lines.push(match &e.verdicts {
         Some(v) if v.solver.is_converged() => Line {
             key: "status",
-            html: format!("converged ({}): {}", escape(&v.solver.to_string()), solver),
+            html: format!("{}: {}", escape(&v.solver.to_string()), solver),
             grade: Grade::Good,
         },
         Some(v) => Line {
@@ -175,9 +176,20 @@ fn estimate_lines(e: &Estimate) -> Vec<Line> {
             let why: Vec<String> = e
                 .fixed_reasons
                 .iter()
-                .map(|(n, r)| format!("<code>{}</code>: {}", escape(n), escape(r)))
+                .map(|(n, r)| {
+                    format!(
+                        "<li><code>{}</code>: {}</li>",
+                        escape(n),
+                        code_spans(&escape(r))
+                    )
+                })
                 .collect();
-            html.push_str(&format!("<br>not identifiable: {}", why.join("; ")));
+            html.push_str(&format!(
+                "<details><summary>{} parameter{} not identifiable, and why</summary><ul>{}</ul></details>",
+                why.len(),
+                if why.len() == 1 { "" } else { "s" },
+                why.concat()
+            ));
         }
         if !e.strong_correlations.is_empty() {
             html.push_str(&format!(
