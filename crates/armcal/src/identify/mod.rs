@@ -10,6 +10,7 @@ pub mod gauss_newton;
 pub mod kalman;
 pub mod lm;
 pub mod problem;
+pub mod residuals;
 pub mod robust;
 pub mod solver;
 pub mod uncertainty;
@@ -36,7 +37,6 @@ use crate::model::identifiability::{Identifiability, IdentifiabilitySettings, Me
 use crate::model::{Model, Segment, Status as ParamStatus};
 use crate::progress::{Observer, Silent};
 use crate::Error;
-use nalgebra::DVector;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -352,7 +352,7 @@ impl Split {
         let eval = Problem::new(model, test, noise)?;
         let mut ws = eval.workspace();
         let mut axes = |params: &[f64]| {
-            let xyz: Vec<[f64; 3]> = position_components(&eval, &mut ws, params)
+            let xyz: Vec<[f64; 3]> = residuals::position_components(&eval, &mut ws, params)
                 .into_iter()
                 .flatten()
                 .collect();
@@ -374,65 +374,6 @@ impl Split {
             frames_only: ErrorStats::of(&eval.errors(&mut ws, &frames)),
             calibrated: ErrorStats::of(&eval.errors(&mut ws, calibrated)),
         }))
-    }
-}
-
-/// The position residual `model − measured` of every measurement at `params` (mm, the
-/// whitening and robust weights undone); `None` for distance and plane measurements.
-fn position_components(
-    problem: &Problem,
-    ws: &mut problem::Workspace,
-    params: &[f64],
-) -> Vec<Option<[f64; 3]>> {
-    let mut r = DVector::zeros(problem.rows());
-    problem.evaluate(ws, params, &mut r, None);
-    problem
-        .data
-        .measurements
-        .iter()
-        .enumerate()
-        .map(|(i, m)| match m.kind {
-            MeasurementKind::Position { .. } | MeasurementKind::Pose { .. } => {
-                let row = problem.row_of[i];
-                let un = |k: usize| {
-                    let w = problem.row_weights[row + k].sqrt() / problem.sigmas[row + k];
-                    r[row + k] / w
-                };
-                Some([un(0), un(1), un(2)])
-            }
-            _ => None,
-        })
-        .collect()
-}
-
-/// Residuals of the fit; `file_configs[c]` is the data-file index of the fitted data's
-/// configuration `c` (pose numbers are reported in the file's numbering).
-fn residual_report(problem: &Problem, params: &[f64], file_configs: &[usize]) -> ResidualReport {
-    let mut ws = problem.workspace();
-    let components = position_components(problem, &mut ws, params);
-    let norms = problem.errors(&mut ws, params);
-    let xyz: Vec<[f64; 3]> = components.iter().flatten().copied().collect();
-    let axes = AxisErrors::of(&xyz);
-    let mut per_measurement = Vec::with_capacity(norms.len());
-    for (i, (m, xyz)) in problem.data.measurements.iter().zip(components).enumerate() {
-        per_measurement.push(MeasurementResidual {
-            pose: file_configs[m.config] + 1,
-            pose_id: problem
-                .data
-                .config_ids
-                .get(m.config)
-                .cloned()
-                .unwrap_or_default(),
-            xyz,
-            norm: norms[i],
-        });
-    }
-    ResidualReport {
-        x: axes.x,
-        y: axes.y,
-        z: axes.z,
-        norm: ErrorStats::of(&norms),
-        per_measurement,
     }
 }
 
@@ -490,7 +431,7 @@ pub fn identify(
     };
     let data_rows = sol.jacobian.nrows() - problem.priors.len();
     let observability = uncertainty::observability(&sol.jacobian.rows(0, data_rows).into_owned());
-    let residuals = residual_report(&problem, &sol.params, &split.train_configs);
+    let residuals = residuals::residual_report(&problem, &sol.params, &split.train_configs);
     let validation = split.validate(model, &sol.params, opts, &noise)?;
     let free_set: std::collections::HashSet<usize> = problem.free.iter().copied().collect();
     let parameters = (0..model.param_count())
