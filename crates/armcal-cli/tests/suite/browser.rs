@@ -1,6 +1,7 @@
 //! The demo's HTML report in a real browser: headless Chromium loads `report.html` from
-//! `armcal demo`, runs its scripts, and the test checks that the figures and the 3D cell view
-//! drew (from the DOM after the scripts ran) and that screenshots are not blank.
+//! `armcal demo`, runs its scripts, and the test checks that the verdict panels, the figures
+//! and the 3D cell view drew (from the DOM after the scripts ran) and that screenshots are
+//! not blank.
 //!
 //! Chromium is taken from `ARMCAL_CHROMIUM` or from `chromium`, `chromium-browser`,
 //! `google-chrome` on PATH. Without one the test is skipped with a message, unless
@@ -211,6 +212,44 @@ fn demo_report_draws_in_headless_chromium() {
     assert_eq!(figures, declared, "SVG figures in the DOM");
     assert!(declared >= MIN_FIGURES, "{declared} figures");
     eprintln!("{figures} SVG figures drawn, {declared} declared");
+
+    // The verdict panels come first, one per estimate (and per design) of the demo.
+    let first = dom.find("<section id=\"").expect("sections");
+    assert!(
+        dom[first..].starts_with("<section id=\"verdict\""),
+        "the report must open with its verdict"
+    );
+    for kind in ["Estimate", "Design"] {
+        let panels = dom.matches(&format!("data-kind=\"{kind}\"")).count();
+        assert_eq!(panels, 2, "{kind} verdict panels");
+    }
+    // The new figures drew: each kind is an SVG with its marks (bars, cells, outlines).
+    for (kind, count, mark, fewest) in [
+        ("change-sigma", 2, "<rect", 20),
+        ("correlation", 2, "<rect", 20 * 20),
+        ("held-out-axes", 2, "<rect", 9),
+        ("truth-error", 2, "<rect", 20),
+        ("joint-corrections", 1, "<rect", 5),
+        ("ellipse-instrument", 3, "<polyline", 4),
+        ("ellipse-base", 3, "<polyline", 4),
+    ] {
+        let tag = format!("<svg data-figure=\"{kind}\"");
+        let found: Vec<&str> = dom
+            .match_indices(&tag)
+            .map(|(i, _)| &dom[i..i + dom[i..].find("</svg>").expect("svg closes")])
+            .collect();
+        assert_eq!(found.len(), count, "{kind} figures");
+        for svg in found {
+            let marks = svg.matches(mark).count();
+            assert!(marks >= fewest, "{kind}: {marks} {mark} elements");
+        }
+    }
+    // Every table scrolls sideways in its wrapper instead of widening the page.
+    assert_eq!(
+        dom.matches("<table").count(),
+        dom.matches("<div class=\"table-wrap\"><table").count(),
+        "tables outside a scrolling wrapper"
+    );
 
     // A screenshot of the page's top. The 3D view's pixels are checked through the DOM above:
     // with a URL fragment headless Chromium's --screenshot comes out blank (Chromium 148),

@@ -408,10 +408,12 @@ fn report_from_identify_and_plan_files() {
     );
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     let figures = html.matches("<svg").count();
-    // TCP ellipses (3), design joints and clearances (2), residual histograms, per-pose
-    // residuals and held-out bars (3).
-    assert_eq!(figures, 8, "{stdout}");
-    assert!(html.contains("<meta name=\"armcal-figures\" content=\"8\">"));
+    // TCP ellipses (3 in the instrument frame, 3 in the base frame), design joints and
+    // clearances (2), residual histograms, per-pose residuals and held-out bars (3), held-out
+    // error per axis, change / σ and the correlation heatmap (3).
+    assert_eq!(figures, 14, "{stdout}");
+    assert!(html.contains("<meta name=\"armcal-figures\" content=\"14\">"));
+    assert!(html.contains("<section id=\"verdict\">"));
     assert!(!html.contains("http://") && !html.contains("https://"));
     for needle in [
         "Estimate: est",

@@ -115,6 +115,67 @@ pub fn filter_joint_program_corrected(
         .collect()
 }
 
+/// A compensated joint program as a record (the demo's summary holds one, the report draws
+/// its joint corrections): every row's joints before and after compensation, in the joints'
+/// display units (deg, mm for a prismatic joint).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ProgramRecord {
+    /// The joints' names, the order of every row's values.
+    pub joints: Vec<String>,
+    /// Each joint's display unit (`deg` or `mm`).
+    pub units: Vec<String>,
+    /// The rows in program order.
+    pub rows: Vec<ProgramRecordRow>,
+}
+
+/// One row of a [`ProgramRecord`].
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ProgramRecordRow {
+    /// The row's `pose_id`.
+    pub id: String,
+    /// The program's joints (nominal model; display units).
+    pub nominal: Vec<f64>,
+    /// The compensated joints (display units).
+    pub compensated: Vec<f64>,
+    /// Whether the calibrated solve converged.
+    pub converged: bool,
+    /// The solve's status in words ([`IkResult::describe`]).
+    pub status: String,
+    /// Remaining position error of the calibrated solve (mm).
+    pub position_error_mm: f64,
+}
+
+impl ProgramRecord {
+    /// The record of the filtered rows `rows` of `model`.
+    pub fn of(model: &Model, rows: &[FilteredRow]) -> ProgramRecord {
+        let display = |q: &[f64]| -> Vec<f64> {
+            q.iter()
+                .zip(&model.joints)
+                .map(|(v, j)| csv::joint_display(j, *v))
+                .collect()
+        };
+        ProgramRecord {
+            joints: model.joints.iter().map(|j| j.name.clone()).collect(),
+            units: model
+                .joints
+                .iter()
+                .map(|j| j.kind.unit().display_name().to_string())
+                .collect(),
+            rows: rows
+                .iter()
+                .map(|r| ProgramRecordRow {
+                    id: r.id.clone(),
+                    nominal: display(&r.q_nominal),
+                    compensated: display(&r.result.q),
+                    converged: r.result.status.status().is_converged(),
+                    status: r.result.describe(model),
+                    position_error_mm: r.result.position_error,
+                })
+                .collect(),
+        }
+    }
+}
+
 /// One corrected Cartesian target.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CorrectedTarget {

@@ -50,7 +50,12 @@ pub fn assess(cell: &Cell, design: &[Vec<f64>]) -> Result<DesignAssessment, Erro
         .collect();
     let unc = uncertainty::parameter_uncertainty(&j, &DVector::zeros(j.nrows()), &names)?;
     let wnames: Vec<String> = cell.working.iter().map(|w| w.name.clone()).collect();
-    let tcp = uncertainty::tcp_covariance(&d.kpi_rows, &unc.covariance, &wnames);
+    let working: Vec<Vec<f64>> = cell.working.iter().map(|w| w.q.clone()).collect();
+    let tcp = uncertainty::with_base_frame(
+        uncertainty::tcp_covariance(&d.kpi_rows, &unc.covariance, &wnames),
+        &uncertainty::tcp_jacobian_world(&d.model, &d.params, &d.free, &working),
+        &unc.covariance,
+    );
     let mut criteria = Vec::new();
     for c in Criterion::ALL {
         if c == Criterion::Kpi && cell.working.is_empty() {

@@ -104,6 +104,45 @@ pub struct Validation {
     pub frames_only: ErrorStats,
     /// Full calibration.
     pub calibrated: ErrorStats,
+    /// The same three models' errors per axis of the instrument frame (position
+    /// measurements only); `None` in files of an older armcal.
+    #[serde(default)]
+    pub per_axis: Option<HeldOutAxes>,
+}
+
+/// Held-out error per axis before and after calibration ([`Validation::per_axis`]).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct HeldOutAxes {
+    /// Nominal model, nothing fitted.
+    pub nominal: AxisErrors,
+    /// Only the frames fitted.
+    pub frames_only: AxisErrors,
+    /// Full calibration.
+    pub calibrated: AxisErrors,
+}
+
+/// Statistics of the x, y and z components of position errors `model − measured` in the
+/// instrument frame (mm).
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct AxisErrors {
+    /// x components (mm).
+    pub x: ErrorStats,
+    /// y components (mm).
+    pub y: ErrorStats,
+    /// z components (mm).
+    pub z: ErrorStats,
+}
+
+impl AxisErrors {
+    /// The statistics of each axis over the position errors `xyz`.
+    pub fn of(xyz: &[[f64; 3]]) -> AxisErrors {
+        let axis = |k: usize| ErrorStats::of(&xyz.iter().map(|v| v[k]).collect::<Vec<f64>>());
+        AxisErrors {
+            x: axis(0),
+            y: axis(1),
+            z: axis(2),
+        }
+    }
 }
 
 /// Everything an identification produced: what `estimate.json` holds.

@@ -10,14 +10,15 @@ pub mod gauss_newton;
 pub mod kalman;
 pub mod lm;
 pub mod problem;
+pub mod residuals;
 pub mod robust;
 pub mod solver;
 pub mod uncertainty;
 pub mod verdicts;
 
 pub use estimate::{
-    Acceptance, Estimate, MeasurementResidual, ParameterEstimate, ResidualReport, SolverReport,
-    Usability, Validation,
+    Acceptance, AxisErrors, Estimate, HeldOutAxes, MeasurementResidual, ParameterEstimate,
+    ResidualReport, SolverReport, Usability, Validation,
 };
 pub use fingerprint::ModelFingerprint;
 pub use gauss_newton::gauss_newton;
@@ -36,7 +37,6 @@ use crate::model::identifiability::{Identifiability, IdentifiabilitySettings, Me
 use crate::model::{Model, Segment, Status as ParamStatus};
 use crate::progress::{Observer, Silent};
 use crate::Error;
-use nalgebra::DVector;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -351,7 +351,20 @@ impl Split {
         let frames = frames_first_start(model, &self.train, noise, opts)?;
         let eval = Problem::new(model, test, noise)?;
         let mut ws = eval.workspace();
+        let mut axes = |params: &[f64]| {
+            let xyz: Vec<[f64; 3]> = residuals::position_components(&eval, &mut ws, params)
+                .into_iter()
+                .flatten()
+                .collect();
+            AxisErrors::of(&xyz)
+        };
+        let per_axis = HeldOutAxes {
+            nominal: axes(&model.nominal()),
+            frames_only: axes(&frames),
+            calibrated: axes(calibrated),
+        };
         Ok(Some(Validation {
+            per_axis: Some(per_axis),
             test_data: source.clone(),
             train_configurations: self.train.configurations.len(),
             test_configurations: test.configurations.len(),
@@ -361,53 +374,6 @@ impl Split {
             frames_only: ErrorStats::of(&eval.errors(&mut ws, &frames)),
             calibrated: ErrorStats::of(&eval.errors(&mut ws, calibrated)),
         }))
-    }
-}
-
-/// Residuals of the fit; `file_configs[c]` is the data-file index of the fitted data's
-/// configuration `c` (pose numbers are reported in the file's numbering).
-fn residual_report(problem: &Problem, params: &[f64], file_configs: &[usize]) -> ResidualReport {
-    let mut ws = problem.workspace();
-    let n = problem.rows();
-    let mut r = DVector::zeros(n);
-    problem.evaluate(&mut ws, params, &mut r, None);
-    let norms = problem.errors(&mut ws, params);
-    let (mut x, mut y, mut z) = (Vec::new(), Vec::new(), Vec::new());
-    let mut per_measurement = Vec::with_capacity(norms.len());
-    for (i, m) in problem.data.measurements.iter().enumerate() {
-        let xyz = if let MeasurementKind::Position { .. } | MeasurementKind::Pose { .. } = m.kind {
-            let row = problem.row_of[i];
-            // Undo whitening (and robust weights) to get mm.
-            let un = |k: usize| {
-                let w = problem.row_weights[row + k].sqrt() / problem.sigmas[row + k];
-                r[row + k] / w
-            };
-            let v = [un(0), un(1), un(2)];
-            x.push(v[0]);
-            y.push(v[1]);
-            z.push(v[2]);
-            Some(v)
-        } else {
-            None
-        };
-        per_measurement.push(MeasurementResidual {
-            pose: file_configs[m.config] + 1,
-            pose_id: problem
-                .data
-                .config_ids
-                .get(m.config)
-                .cloned()
-                .unwrap_or_default(),
-            xyz,
-            norm: norms[i],
-        });
-    }
-    ResidualReport {
-        x: ErrorStats::of(&x),
-        y: ErrorStats::of(&y),
-        z: ErrorStats::of(&z),
-        norm: ErrorStats::of(&norms),
-        per_measurement,
     }
 }
 
@@ -452,7 +418,11 @@ pub fn identify(
         (Vec::new(), Vec::new())
     } else {
         let g = uncertainty::tcp_jacobian(model, &sol.params, &problem.free, &working);
-        let cs = uncertainty::tcp_covariance(&g, &unc.covariance, &wnames);
+        let cs = uncertainty::with_base_frame(
+            uncertainty::tcp_covariance(&g, &unc.covariance, &wnames),
+            &uncertainty::tcp_jacobian_world(model, &sol.params, &problem.free, &working),
+            &unc.covariance,
+        );
         let cc = uncertainty::tcp_covariance_constrained(&sol.jacobian, &g)?;
         let blocks = (0..working.len())
             .map(|i| cc.fixed_view::<3, 3>(3 * i, 3 * i).into_owned())
@@ -461,7 +431,7 @@ pub fn identify(
     };
     let data_rows = sol.jacobian.nrows() - problem.priors.len();
     let observability = uncertainty::observability(&sol.jacobian.rows(0, data_rows).into_owned());
-    let residuals = residual_report(&problem, &sol.params, &split.train_configs);
+    let residuals = residuals::residual_report(&problem, &sol.params, &split.train_configs);
     let validation = split.validate(model, &sol.params, opts, &noise)?;
     let free_set: std::collections::HashSet<usize> = problem.free.iter().copied().collect();
     let parameters = (0..model.param_count())

@@ -2,7 +2,9 @@
 //! variance factor with its χ² test, and the TCP covariance C_s at working configurations —
 //! by the constrained formulation (paper eq. 19) and by `C_s = G C_p Gᵀ` (paper appendix).
 
-use crate::model::{forward_kinematics, identification_jacobian, Data, Model, Observed, Rows};
+use crate::model::{
+    forward_kinematics, identification_jacobian, Data, Model, Observed, Rows, Segment,
+};
 use crate::Error;
 use nalgebra::{DMatrix, DVector, Matrix3};
 use serde::{Deserialize, Serialize};
@@ -169,6 +171,51 @@ pub struct TcpCovariance {
     pub covariance: Matrix3<f64>,
     /// (1/3) tr(C_s) (mm²): the paper's KPI criterion φ_A(C_s).
     pub kpi: f64,
+    /// The covariance of the TCP position in the robot base (world) frame, `G_w C_p G_wᵀ`
+    /// ([`tcp_jacobian_world`]): where the robot's TCP is, without the uncertainty of the
+    /// instrument's own pose that the instrument-frame C_s includes; `None` in files of an
+    /// older armcal.
+    #[serde(default)]
+    pub covariance_base: Option<Matrix3<f64>>,
+}
+
+/// `G_w` rows (3 per working configuration) of the TCP position in the world (robot base)
+/// frame w.r.t. the free parameters: a chain parameter moves the tool origin p by its world
+/// twist's point velocity `ω × p + v`; the instrument's and the targets' parameters do not
+/// move it.
+pub fn tcp_jacobian_world(
+    model: &Model,
+    params: &[f64],
+    free: &[usize],
+    working: &[Vec<f64>],
+) -> DMatrix<f64> {
+    let mut g = DMatrix::zeros(3 * working.len(), free.len());
+    let mut data = Data::new(model);
+    for (i, q) in working.iter().enumerate() {
+        forward_kinematics(model, &mut data, params, q);
+        let p = data.tool().trans;
+        for (c, &j) in free.iter().enumerate() {
+            if model.registry.get(j).segment == Segment::Chain {
+                let v = data.param_twists[j].point_velocity(&p);
+                g.view_mut((3 * i, c), (3, 1)).copy_from(&v);
+            }
+        }
+    }
+    g
+}
+
+/// `cs` with their base-frame covariances `G_w C_p G_wᵀ` set (`g_world` from
+/// [`tcp_jacobian_world`], same working configurations and columns as `cp`).
+pub fn with_base_frame(
+    mut cs: Vec<TcpCovariance>,
+    g_world: &DMatrix<f64>,
+    cp: &DMatrix<f64>,
+) -> Vec<TcpCovariance> {
+    let cw = g_world * cp * g_world.transpose();
+    for (i, c) in cs.iter_mut().enumerate() {
+        c.covariance_base = Some(cw.fixed_view::<3, 3>(3 * i, 3 * i).into_owned());
+    }
+    cs
 }
 
 /// `G` rows (3 per working configuration) of the TCP position w.r.t. the free parameters.
@@ -207,6 +254,7 @@ pub fn tcp_covariance(g: &DMatrix<f64>, cp: &DMatrix<f64>, names: &[String]) -> 
                 name: name.clone(),
                 kpi: c.trace() / 3.0,
                 covariance: c,
+                covariance_base: None,
             }
         })
         .collect()

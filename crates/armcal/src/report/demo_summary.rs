@@ -1,13 +1,18 @@
 //! The summary section of `armcal demo`: KPI vs heuristic design, predicted vs achieved TCP
 //! precision, held-out accuracy before and after calibration, the compensated program.
 
-use super::figures::cdf_figure;
+use super::figures::{cdf_figure_coloured, NOMINAL};
 use super::html::{facts, fixed, table, Section};
 use crate::study::demo::DemoSummary;
 use crate::Error;
 
-/// The section for the demo's numbers.
-pub fn demo_section(id: &str, s: &DemoSummary) -> Result<Section, Error> {
+/// The section for the demo's numbers; `colour_of` gives the palette index of a design by
+/// its name (`heuristic`, `kpi`), the colour it has in every figure.
+pub fn demo_section(
+    id: &str,
+    s: &DemoSummary,
+    colour_of: &dyn Fn(&str) -> usize,
+) -> Result<Section, Error> {
     let mut sec = Section::new(id, "Summary: KPI design vs heuristic design");
     sec.html(format!(
         "<p>A simulated calibration of the paper's cell (KUKA-like robot with λ = 650 mm, μ = 600 mm, laser tracker with σ = 1 mm, car body and wall as obstacles). Two designs of {} poses each — a KPI-optimal design planned with collision avoidance and a random feasible (heuristic) design — were measured on the same perturbed \"true\" robot, the model identified from each, and both checked on 100 feasible poses that neither design used (seed {}).</p>\n",
@@ -71,7 +76,7 @@ pub fn demo_section(id: &str, s: &DemoSummary) -> Result<Section, Error> {
     sec.html(facts(&rows));
     sec.html("<p class=\"note\">“Predicted” is √((1/3) tr C_s) from the identification's covariance; “achieved” is the distance between the identified and the true TCP at the working pose in this one simulated campaign, a single draw from that distribution.</p>\n");
     sec.figure(
-        cdf_figure(
+        cdf_figure_coloured(
             "Held-out position error before and after calibration",
             "position error of the TCP reflector on held-out poses (mm)",
             &[
@@ -84,6 +89,11 @@ pub fn demo_section(id: &str, s: &DemoSummary) -> Result<Section, Error> {
                     "calibrated from the KPI design".into(),
                     s.kpi.held_out_errors.clone(),
                 ),
+            ],
+            &[
+                NOMINAL,
+                colour_of(&s.heuristic.design),
+                colour_of(&s.kpi.design),
             ],
         )?,
         format!(

@@ -1,9 +1,11 @@
 //! The inputs of a report: armcal's JSON files, recognised by their content — an estimate
 //! (`armcal identify`, `armcal demo`), a design (`armcal plan`, `armcal demo`), a study
-//! (`armcal study paper`) or the demo's summary.
+//! (`armcal study paper`), the demo's summary or a simulation's truth record (`armcal
+//! simulate`'s truth file).
 
 use crate::design::DesignRecord;
 use crate::identify::Estimate;
+use crate::sim::TruthRecord;
 use crate::study::demo::DemoSummary;
 use crate::study::paper::StudyRecord;
 use crate::Error;
@@ -20,11 +22,13 @@ pub enum Document {
     Study(StudyRecord),
     /// The `summary.json` of `armcal demo`.
     Demo(Box<DemoSummary>),
+    /// The true parameters of a simulation: estimates of its cell are compared with them.
+    Truth(TruthRecord),
 }
 
 const EXPECTED: &str = "expected an armcal estimate (from `armcal identify`), design (the .json \
-    `armcal plan` writes beside the design CSV), study result (`armcal study paper`) or demo \
-    summary (`armcal demo`)";
+    `armcal plan` writes beside the design CSV), study result (`armcal study paper`), demo \
+    summary (`armcal demo`) or truth record (the truth file of `armcal simulate`)";
 
 impl Document {
     /// Recognises and reads an armcal JSON document; `file` names it in errors.
@@ -74,6 +78,16 @@ impl Document {
                 serde_json::from_value(value).map_err(read("demo summary"))?,
             )));
         }
+        let is_truth = obj
+            .get("parameters")
+            .and_then(|p| p.as_array())
+            .and_then(|p| p.first())
+            .is_some_and(|p| p.get("truth").is_some());
+        if has(&["cell", "seed", "parameters"]) && is_truth {
+            return Ok(Document::Truth(
+                serde_json::from_value(value).map_err(read("truth record"))?,
+            ));
+        }
         let keys: Vec<&str> = obj.keys().map(String::as_str).take(8).collect();
         Err(fail(format!(
             "not an armcal result (top-level fields: {}); {EXPECTED}",
@@ -102,6 +116,7 @@ impl Document {
             Document::Design(_) => "design",
             Document::Study(_) => "study",
             Document::Demo(_) => "demo summary",
+            Document::Truth(_) => "truth",
         }
     }
 }

@@ -5,7 +5,7 @@
 use super::figures::{bar_figure, histogram_figure, series_figure, Reference};
 use super::html::{escape, facts, fixed, number, table, Section};
 use crate::accuracy::ErrorStats;
-use crate::identify::{Estimate, Method, Observability};
+use crate::identify::{Estimate, Observability};
 use crate::Error;
 
 fn stats_row(name: &str, s: &ErrorStats) -> Vec<String> {
@@ -42,7 +42,7 @@ fn value(x: f64, unit: &str) -> String {
 }
 
 /// Text between backticks (parameter names in the identifiability reasons) as code.
-fn code_spans(escaped: &str) -> String {
+pub(super) fn code_spans(escaped: &str) -> String {
     let mut out = String::with_capacity(escaped.len() + 16);
     for (i, part) in escaped.split('`').enumerate() {
         if i % 2 == 1 {
@@ -84,11 +84,7 @@ pub fn estimate_section(id: &str, label: &str, e: &Estimate) -> Result<Section, 
             "solver",
             format!(
                 "{}{}, {} — {} iterations",
-                match sol.method {
-                    Method::Lm => "Levenberg–Marquardt",
-                    Method::GaussNewton => "Gauss–Newton",
-                    Method::Kalman => "recursive (Kalman filter)",
-                },
+                super::verdict::method_name(sol.method),
                 sol.robust
                     .map(|l| format!(" with robust {l:?} loss"))
                     .unwrap_or_default(),

@@ -2,7 +2,7 @@
 //! builder takes plain data and returns one `<svg>` element, ready to be placed inline in
 //! an HTML page (no XML prolog, no namespace URL).
 //!
-//! (Over 600 lines: seven figure builders that share one style — palette, fonts, legend
+//! (Over 600 lines: seven figure builders (two with explicit series colours) that share one style — palette, fonts, legend
 //! strip, mesh — kept beside it so every figure of a report looks the same; each builder
 //! is ~50–110 lines.)
 
@@ -32,18 +32,35 @@ pub fn colour(i: usize) -> RGBColor {
     PALETTE[i % PALETTE.len()]
 }
 
+/// Palette index of the nominal model in every figure (black); designs take the colours
+/// before [`FRAMES_ONLY`] ([`design_colour`]).
+pub const NOMINAL: usize = 6;
+
+/// Palette index of the frames-only fit in every figure (sky blue).
+pub const FRAMES_ONLY: usize = 5;
+
+/// Palette index of the `k`-th design of a report: the first five colours in turn, so that
+/// a design (and the estimate made from it) has one colour in every figure and never the
+/// nominal model's or the frames-only fit's.
+pub fn design_colour(k: usize) -> usize {
+    k % FRAMES_ONLY
+}
+
 /// Width of the full-width figures (px; the page scales them to its column).
-const WIDE: u32 = 1100;
+pub(super) const WIDE: u32 = 1100;
 
 /// A drawing area of an SVG figure.
-type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
+pub(super) type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
 
-fn drawing_error<E: std::fmt::Display>(e: E) -> Error {
+pub(super) fn drawing_error<E: std::fmt::Display>(e: E) -> Error {
     Error::Output(format!("drawing a figure: {e}"))
 }
 
 /// Draws into an SVG string of `size` px and strips what inline SVG does not need.
-fn svg(size: (u32, u32), draw: impl FnOnce(&Area) -> Result<(), Error>) -> Result<String, Error> {
+pub(super) fn svg(
+    size: (u32, u32),
+    draw: impl FnOnce(&Area) -> Result<(), Error>,
+) -> Result<String, Error> {
     ensure_registered()?;
     let mut buf = String::new();
     {
@@ -77,7 +94,7 @@ fn range_of(values: impl Iterator<Item = f64>, pad: f64) -> (f64, f64) {
 /// A chart axis `lo..hi`, refused unless both ends and the span are finite: on an infinite
 /// span plotters' tick search never ends (issue 15: a design's joint range of ±1e308, or
 /// residuals of 1e308 and −1e308, froze `armcal report`).
-fn axis(lo: f64, hi: f64) -> Result<std::ops::Range<f64>, Error> {
+pub(super) fn axis(lo: f64, hi: f64) -> Result<std::ops::Range<f64>, Error> {
     if lo.is_finite() && hi.is_finite() && (hi - lo).is_finite() {
         Ok(lo..hi)
     } else {
@@ -89,7 +106,7 @@ fn axis(lo: f64, hi: f64) -> Result<std::ops::Range<f64>, Error> {
 }
 
 /// Tick label text: integer positions get `names[i]`, others nothing.
-fn category_label(x: f64, names: &[String]) -> String {
+pub(super) fn category_label(x: f64, names: &[String]) -> String {
     let i = x.round();
     if (x - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < names.len() {
         names[i as usize].clone()
@@ -99,9 +116,9 @@ fn category_label(x: f64, names: &[String]) -> String {
 }
 
 /// Font sizes (plotters size; the SVG text is drawn at size/1.24 px).
-const TITLE: u32 = 20;
-const LABEL: u32 = 15;
-const DESC: u32 = 16;
+pub(super) const TITLE: u32 = 20;
+pub(super) const LABEL: u32 = 15;
+pub(super) const DESC: u32 = 16;
 const LEGEND: u32 = 15;
 
 /// A tick label: up to six decimals, trailing zeros dropped, a true minus sign.
@@ -196,7 +213,7 @@ fn titled_with_legend_strip<'a>(
 /// ([`LABEL`]) and axis descriptions ([`DESC`]), a faint major grid and no minor one,
 /// [`tick`] labels on both axes. Callers add the axis descriptions and label counts and may
 /// override any of these.
-fn styled_mesh<'a, 'b, DB: DrawingBackend>(
+pub(super) fn styled_mesh<'a, 'b, DB: DrawingBackend>(
     chart: &'b mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
 ) -> MeshStyle<'a, 'b, RangedCoordf64, RangedCoordf64, DB> {
     let mut mesh = chart.configure_mesh();
@@ -265,7 +282,11 @@ pub fn ellipse_figure(plane: Plane, series: &[EllipseSeries], k: f64) -> Result<
             .y_labels(5)
             .draw()
             .map_err(drawing_error)?;
-        for (s, c) in series.iter().zip(&curves) {
+        // Identified (solid) outlines first, predicted (dashed) ones on top: a prediction
+        // that matches its identification stays visible.
+        let mut order: Vec<usize> = (0..series.len()).collect();
+        order.sort_by_key(|&i| series[i].dashed);
+        for (s, c) in order.iter().map(|&i| (&series[i], &curves[i])) {
             let style = colour(s.colour).stroke_width(2);
             if s.dashed {
                 chart
@@ -298,6 +319,18 @@ pub fn cdf_figure(
     x_label: &str,
     series: &[(String, Vec<f64>)],
 ) -> Result<String, Error> {
+    let colours: Vec<usize> = (0..series.len()).collect();
+    cdf_figure_coloured(title, x_label, series, &colours)
+}
+
+/// [`cdf_figure`] with series `i` drawn in palette colour `colours[i]`.
+pub fn cdf_figure_coloured(
+    title: &str,
+    x_label: &str,
+    series: &[(String, Vec<f64>)],
+    colours: &[usize],
+) -> Result<String, Error> {
+    let pick = |i: usize| colour(colours.get(i).copied().unwrap_or(i));
     let (_, hi) = range_of(series.iter().flat_map(|s| s.1.iter().copied()), 0.05);
     svg((WIDE, 420), |root| {
         let (legend_area, plot_area) =
@@ -324,9 +357,9 @@ pub fn cdf_figure(
                 pts.push((*x, 100.0 * (k + 1) as f64 / n));
             }
             chart
-                .draw_series(LineSeries::new(pts, colour(i).stroke_width(2)))
+                .draw_series(LineSeries::new(pts, pick(i).stroke_width(2)))
                 .map_err(drawing_error)?;
-            entries.push((label.clone(), Mark::Line, colour(i)));
+            entries.push((label.clone(), Mark::Line, pick(i)));
         }
         draw_legend(&legend_area, &entries, false)
     })
@@ -341,6 +374,20 @@ pub fn bar_figure(
     y_label: &str,
     categories: &[String],
     series: &[(String, Vec<f64>)],
+    highlight: Option<(usize, usize)>,
+    log: bool,
+) -> Result<String, Error> {
+    let colours: Vec<usize> = (0..series.len()).collect();
+    bar_figure_coloured(title, y_label, categories, series, &colours, highlight, log)
+}
+
+/// [`bar_figure`] with series `i` drawn in palette colour `colours[i]`.
+pub fn bar_figure_coloured(
+    title: &str,
+    y_label: &str,
+    categories: &[String],
+    series: &[(String, Vec<f64>)],
+    colours: &[usize],
     highlight: Option<(usize, usize)>,
     log: bool,
 ) -> Result<String, Error> {
@@ -405,7 +452,7 @@ pub fn bar_figure(
         let warn = colour(1);
         let mut entries = Vec::new();
         for (s, (label, values)) in series.iter().enumerate() {
-            let fill = colour(s);
+            let fill = colour(colours.get(s).copied().unwrap_or(s));
             let bars: Vec<(f64, f64, bool)> = values
                 .iter()
                 .enumerate()

@@ -1,5 +1,6 @@
 //! A report of armcal's JSON files, as `armcal report` makes it: each file recognised
-//! ([`Document::from_file`]) and labelled by its file name, estimates checked for use, and
+//! ([`Document::from_file`]) once however often it is given, labelled by its file name,
+//! estimates checked for use, and
 //! the 3D view of the cell the first design names (looked up as given, then beside the
 //! design file), with a note for the reader where something is left out.
 
@@ -40,7 +41,23 @@ pub fn files_report(
 ) -> Result<FilesReport, Error> {
     let mut inputs: Vec<Input> = Vec::new();
     let mut notes = Vec::new();
+    // A file given twice (by the same or another path) is shown once.
+    let mut seen: Vec<PathBuf> = Vec::new();
+    let mut unique: Vec<&PathBuf> = Vec::new();
     for f in files {
+        let key = f.canonicalize().unwrap_or_else(|_| f.clone());
+        if seen.contains(&key) {
+            notes.push(format!(
+                "{} was given more than once; it is shown once.",
+                f.display()
+            ));
+        } else {
+            seen.push(key);
+            unique.push(f);
+        }
+    }
+    let files = unique;
+    for f in files.iter().copied() {
         let document = Document::from_file(f)?;
         if let Document::Estimate(e) = &document {
             let usable = e.check_usable(acceptance).map_err(|e| Error::File {

@@ -45,10 +45,11 @@ pub fn fixed(x: f64, decimals: usize) -> String {
     }
 }
 
-/// An HTML table. `rows` hold HTML (escape text first); the columns listed in `numeric` are
+/// An HTML table in a wrapper that scrolls sideways on a screen narrower than the table.
+/// `rows` hold HTML (escape text first); the columns listed in `numeric` are
 /// right-aligned; a row whose first cell starts with `!` is highlighted (the `!` dropped).
 pub fn table(head: &[&str], rows: &[Vec<String>], numeric: &[usize]) -> String {
-    let mut s = String::from("<table>\n<thead><tr>");
+    let mut s = String::from("<div class=\"table-wrap\"><table>\n<thead><tr>");
     for (i, h) in head.iter().enumerate() {
         let class = if numeric.contains(&i) {
             " class=\"num\""
@@ -76,18 +77,27 @@ pub fn table(head: &[&str], rows: &[Vec<String>], numeric: &[usize]) -> String {
         }
         s.push_str("</tr>\n");
     }
-    s.push_str("</tbody>\n</table>\n");
+    s.push_str("</tbody>\n</table></div>\n");
     s
 }
 
-/// A key–value table (two columns, the keys as row headers).
+/// A key–value table (two columns, the keys as row headers), scrolling like [`table`].
 pub fn facts(rows: &[(&str, String)]) -> String {
-    let mut s = String::from("<table class=\"facts\">\n<tbody>\n");
+    let mut s = String::from("<div class=\"table-wrap\"><table class=\"facts\">\n<tbody>\n");
     for (k, v) in rows {
         s.push_str(&format!("<tr><th>{k}</th><td>{v}</td></tr>\n"));
     }
-    s.push_str("</tbody>\n</table>\n");
+    s.push_str("</tbody>\n</table></div>\n");
     s
+}
+
+/// `svg` (one `<svg …>` element) marked with `data-figure="kind"`, so that a reader of the
+/// page (a test, a script) finds each kind of figure.
+pub fn tagged(svg: String, kind: &str) -> String {
+    match svg.strip_prefix("<svg ") {
+        Some(rest) => format!("<svg data-figure=\"{}\" {rest}", escape(kind)),
+        None => svg,
+    }
 }
 
 /// One inline SVG figure and its caption (HTML).
@@ -188,7 +198,8 @@ pub struct Page {
 }
 
 const CSS: &str = r#"
-:root { --ink: #1d2630; --muted: #5b6770; --line: #d5dbe0; --accent: #0072b2; --warn: #d55e00; }
+:root { --ink: #1d2630; --muted: #5b6770; --line: #d5dbe0; --accent: #0072b2; --warn: #d55e00;
+  --ok: #009e73; --caution: #e69f00; }
 * { box-sizing: border-box; }
 body { margin: 0; color: var(--ink); background: #f4f6f8;
   font: 15px/1.5 "DejaVu Sans", "Helvetica Neue", Arial, sans-serif; }
@@ -217,6 +228,20 @@ table.facts th { background: none; font-weight: 600; color: var(--muted); white-
 .flag { color: var(--warn); font-weight: 600; }
 .scroll { max-height: 560px; overflow: auto; border: 1px solid var(--line); }
 .scroll table { margin: 0; }
+.table-wrap { max-width: 100%; overflow-x: auto; }
+.table-wrap table { margin: 8px 0 14px; }
+.verdicts { display: flex; flex-wrap: wrap; gap: 12px; }
+.verdict-panel { flex: 1 1 420px; min-width: 0; border: 1px solid var(--line); border-left: 6px solid var(--ok);
+  border-radius: 6px; padding: 4px 14px 8px; }
+.verdict-panel.check { border-left-color: var(--caution); }
+.verdict-panel.bad { border-left-color: var(--warn); }
+.verdict-panel h3 { margin: 8px 0 4px; }
+.verdict-panel .headline { font-weight: 600; margin: 4px 0 6px; }
+.frame-toggle > input { margin-left: 0; }
+.frame-toggle > label { margin-right: 16px; cursor: pointer; }
+.frame-toggle > .frame-base { display: none; }
+.frame-toggle > input.base:checked ~ .frame-base { display: block; }
+.frame-toggle > input.base:checked ~ .frame-instrument { display: none; }
 .figrow { display: flex; gap: 12px; flex-wrap: wrap; }
 .figrow figure { flex: 1 1 340px; }
 figure.armcal-figure { margin: 10px 0 16px; }

@@ -1,11 +1,15 @@
 //! Self-contained HTML reports: figures as inline SVG (plotters, embedded font) and a 3D
 //! view of the cell drawn in the browser from inline data. One file, no network fetches.
 //!
-//! [`documents`] recognises armcal's JSON results; one module per kind builds its section
-//! ([`estimate`], [`design`], [`study`], [`tcp`] for the Figure 7 comparison,
-//! [`demo_summary`]); [`figures`] draws plain data to SVG; [`html`] assembles the page.
+//! [`documents`] recognises armcal's JSON results; the page opens with the [`verdict`]
+//! panels, then one module per kind builds its section ([`estimate`] with
+//! [`parameter_view`] and [`held_out`], [`design`], [`study`], [`tcp`] for the Figure 7
+//! comparison, [`demo_summary`] and [`compensation`]); [`figures`] and
+//! [`parameter_charts`] draw plain data to SVG; [`html`] assembles the page. A design (and
+//! the estimate made from it) keeps one colour in every figure ([`design_key`]).
 
 pub mod cell_view;
+pub mod compensation;
 pub mod demo_summary;
 pub mod design;
 pub mod documents;
@@ -14,13 +18,18 @@ pub mod estimate;
 pub mod figures;
 pub mod files;
 pub mod font;
+pub mod held_out;
 pub mod html;
+pub mod parameter_charts;
+pub mod parameter_view;
 pub mod study;
 pub mod tcp;
+pub mod verdict;
 
 pub use documents::Document;
 
 use crate::cell::Cell;
+use crate::sim::TruthRecord;
 use crate::study::demo::DemoSummary;
 use crate::study::paper::StudyRecord;
 use crate::Error;
@@ -79,6 +88,12 @@ fn inputs_section(inputs: &[Input], notes: &[String]) -> Section {
                     if st.collisions { "on" } else { "off" }
                 ),
                 Document::Demo(d) => format!("{} poses per design, seed {}", d.poses, d.seed),
+                Document::Truth(t) => format!(
+                    "true parameters of cell <em>{}</em> ({} parameters, seed {})",
+                    escape(&t.cell),
+                    t.parameters.len(),
+                    t.seed
+                ),
             };
             vec![
                 escape(&i.label),
@@ -95,8 +110,48 @@ fn inputs_section(inputs: &[Input], notes: &[String]) -> Section {
     s
 }
 
-/// The page for `c`: the demo summary, the inputs, the TCP comparison (Figure 7), each
-/// design, the 3D view, each estimate, the studies.
+/// What names one design across a report's inputs: the label in lower case without the
+/// words "design" and "estimate" and without separators, so that `design-kpi` (a design
+/// file), `estimate-kpi` (the estimate from its data), "KPI design" (the demo's label) and
+/// `kpi` (the demo summary's campaign) are one design.
+pub fn design_key(label: &str) -> String {
+    label
+        .to_lowercase()
+        .split(|c: char| !c.is_alphanumeric())
+        .filter(|w| !w.is_empty() && *w != "design" && *w != "estimate")
+        .collect::<Vec<_>>()
+        .join("-")
+}
+
+/// The palette index of every design of a report, by [`design_key`] in the order the
+/// designs and estimates first appear.
+struct Colours(Vec<String>);
+
+impl Colours {
+    fn of_inputs(inputs: &[Input]) -> Colours {
+        let mut keys: Vec<String> = Vec::new();
+        for i in inputs {
+            if matches!(i.document, Document::Design(_) | Document::Estimate(_)) {
+                let k = design_key(&i.label);
+                if !keys.contains(&k) {
+                    keys.push(k);
+                }
+            }
+        }
+        Colours(keys)
+    }
+
+    /// The colour of the design named `label` (a design not among the inputs takes the
+    /// next colour after them, the same for the same name).
+    fn of(&self, label: &str) -> usize {
+        let k = design_key(label);
+        figures::design_colour(self.0.iter().position(|x| *x == k).unwrap_or(self.0.len()))
+    }
+}
+
+/// The page for `c`: the verdict panels, the demo summary and its compensated program, the
+/// inputs, the TCP comparison (Figure 7), each design, the 3D view, each estimate, the
+/// studies.
 pub fn page(c: &ReportContent) -> Result<Page, Error> {
     let mut sections = Vec::new();
     // A document that cannot be drawn (e.g. values out of any physical range) is named.
@@ -113,8 +168,49 @@ pub fn page(c: &ReportContent) -> Result<Page, Error> {
             _ => None,
         })
     });
+    let colours = Colours::of_inputs(c.inputs);
+    let estimates: Vec<(&str, &crate::identify::Estimate)> = c
+        .inputs
+        .iter()
+        .filter_map(|i| match &i.document {
+            Document::Estimate(e) => Some((i.label.as_str(), e.as_ref())),
+            _ => None,
+        })
+        .collect();
+    let designs: Vec<(&str, &crate::design::DesignRecord)> = c
+        .inputs
+        .iter()
+        .filter_map(|i| match &i.document {
+            Document::Design(d) => Some((i.label.as_str(), d.as_ref())),
+            _ => None,
+        })
+        .collect();
+    sections.extend(verdict::verdict_section("verdict", &estimates, &designs)?);
+    // The true robot, where known: the demo's, or a truth record among the inputs.
+    let truths: Vec<&TruthRecord> = demo
+        .and_then(|d| d.truth.as_ref())
+        .into_iter()
+        .chain(c.inputs.iter().filter_map(|i| match &i.document {
+            Document::Truth(t) => Some(t),
+            _ => None,
+        }))
+        .collect();
     if let Some(d) = demo {
-        sections.push(demo_summary::demo_section("summary", d)?);
+        sections.push(demo_summary::demo_section("summary", d, &|l| {
+            colours.of(l)
+        })?);
+        if let Some(p) = &d.program {
+            sections.push(compensation::compensation_section(
+                "compensation",
+                p,
+                &format!(
+                    "The demo's working program of {} poses (<code>program.csv</code>), compensated with the KPI design's estimate (<code>program-corrected.csv</code>): on the true robot its largest miss falls from {} mm with the nominal joints to {} mm with the compensated ones.",
+                    p.rows.len(),
+                    html::fixed(d.program_miss_nominal, 3),
+                    html::fixed(d.program_miss_compensated, 3)
+                ),
+            )?);
+        }
     }
     if !c.inputs.is_empty() {
         sections.push(inputs_section(c.inputs, c.notes));
@@ -124,7 +220,7 @@ pub fn page(c: &ReportContent) -> Result<Page, Error> {
         let (tcp, predicted) = match &i.document {
             Document::Design(d) => (d.assessment.tcp.first(), true),
             Document::Estimate(e) => (e.tcp.first(), false),
-            Document::Study(_) | Document::Demo(_) => (None, false),
+            Document::Study(_) | Document::Demo(_) | Document::Truth(_) => (None, false),
         };
         if let Some(t) = tcp {
             items.push(TcpItem {
@@ -132,6 +228,8 @@ pub fn page(c: &ReportContent) -> Result<Page, Error> {
                 predicted,
                 working: t.name.clone(),
                 covariance: t.covariance,
+                covariance_base: t.covariance_base,
+                colour: colours.of(&i.label),
             });
         }
     }
@@ -152,10 +250,15 @@ pub fn page(c: &ReportContent) -> Result<Page, Error> {
     }
     for (k, i) in c.inputs.iter().enumerate() {
         if let Document::Estimate(e) = &i.document {
-            sections.push(
+            let mut section =
                 estimate::estimate_section(&format!("estimate-{}", k + 1), &i.label, e)
-                    .map_err(of(i))?,
-            );
+                    .map_err(of(i))?;
+            let fill = colours.of(&i.label);
+            held_out::held_out_axes_block(&mut section, &i.label, e, fill).map_err(of(i))?;
+            let truth = truths.iter().copied().find(|t| t.cell == e.cell);
+            parameter_view::parameter_blocks(&mut section, &i.label, e, truth, fill)
+                .map_err(of(i))?;
+            sections.push(section);
         }
     }
     let studies: Vec<(String, &StudyRecord)> = c

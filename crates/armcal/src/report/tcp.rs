@@ -1,10 +1,11 @@
 //! The TCP-precision section: C_s at the working pose for every design (predicted before
 //! measuring) and every estimate (after identification), as a table and as the projections
-//! of the 95 % confidence ellipsoids on the xy, xz and yz planes (paper Figure 7).
+//! of the 95 % confidence ellipsoids on the xy, xz and yz planes (paper Figure 7), in the
+//! instrument frame and — a toggle that needs no script — in the robot base frame.
 
 use super::ellipse::{confidence_scale, Plane};
 use super::figures::{ellipse_figure, EllipseSeries};
-use super::html::{escape, fixed, number, table, Figure, Section};
+use super::html::{escape, fixed, number, table, tagged, Figure, Section};
 use crate::Error;
 use nalgebra::Matrix3;
 
@@ -20,8 +21,12 @@ pub struct TcpItem {
     pub predicted: bool,
     /// The working pose's name.
     pub working: String,
-    /// C_s (mm²).
+    /// C_s (mm²), instrument frame.
     pub covariance: Matrix3<f64>,
+    /// C_s (mm²) in the robot base frame, if the record holds it.
+    pub covariance_base: Option<Matrix3<f64>>,
+    /// Palette index: the design's colour in every figure.
+    pub colour: usize,
 }
 
 /// The section comparing `items`; `None` when there is nothing to compare.
@@ -76,40 +81,65 @@ pub fn tcp_section(id: &str, items: &[TcpItem]) -> Result<Option<Section>, Error
         &rows,
         &[3, 4, 5, 6, 7, 8],
     ));
-    let mut labels: Vec<&str> = Vec::new();
-    for t in items {
-        if !labels.contains(&t.label.as_str()) {
-            labels.push(&t.label);
-        }
-    }
-    let series: Vec<EllipseSeries> = items
-        .iter()
-        .map(|t| EllipseSeries {
-            colour: labels.iter().position(|l| *l == t.label).unwrap_or(0),
-            label: format!(
-                "{} ({})",
-                t.label,
-                if t.predicted {
-                    "predicted"
+    let series_of = |base: bool| -> Vec<EllipseSeries> {
+        items
+            .iter()
+            .map(|t| EllipseSeries {
+                colour: t.colour,
+                label: format!(
+                    "{} ({})",
+                    t.label,
+                    if t.predicted {
+                        "predicted"
+                    } else {
+                        "identified"
+                    }
+                ),
+                covariance: if base {
+                    t.covariance_base.unwrap_or(t.covariance)
                 } else {
-                    "identified"
-                }
-            ),
-            covariance: t.covariance,
-            dashed: t.predicted,
-        })
-        .collect();
-    let mut figures = Vec::new();
-    for plane in Plane::ALL {
-        let (a, b) = plane.axis_names();
-        figures.push(Figure {
-            svg: ellipse_figure(plane, &series, k)?,
-            caption: format!(
-                "{a}{b} projection of the {:.0} % confidence ellipsoid of the TCP (δ{a}, δ{b} in mm).",
-                100.0 * CONFIDENCE
-            ),
-        });
+                    t.covariance
+                },
+                dashed: t.predicted,
+            })
+            .collect()
+    };
+    let figures = |base: bool| -> Result<Vec<Figure>, Error> {
+        let series = series_of(base);
+        let frame = if base {
+            "robot base frame"
+        } else {
+            "instrument frame"
+        };
+        Plane::ALL
+            .iter()
+            .map(|&plane| {
+                let (a, b) = plane.axis_names();
+                Ok(Figure {
+                    svg: tagged(
+                        ellipse_figure(plane, &series, k)?,
+                        if base { "ellipse-base" } else { "ellipse-instrument" },
+                    ),
+                    caption: format!(
+                        "{a}{b} projection, {frame}, of the {:.0} % confidence ellipsoid of the TCP (δ{a}, δ{b} in mm).",
+                        100.0 * CONFIDENCE
+                    ),
+                })
+            })
+            .collect()
+    };
+    if items.iter().all(|t| t.covariance_base.is_some()) {
+        // Two views and a pure-CSS toggle (radio buttons): works offline, without scripts.
+        s.html(format!(
+            "<div class=\"frame-toggle\">\n<input type=\"radio\" class=\"instrument\" name=\"{id}-frame\" id=\"{id}-frame-instrument\" checked><label for=\"{id}-frame-instrument\">instrument frame</label>\n<input type=\"radio\" class=\"base\" name=\"{id}-frame\" id=\"{id}-frame-base\"><label for=\"{id}-frame-base\">robot base frame</label>\n<div class=\"frame-view frame-instrument\">\n"
+        ));
+        s.figure_row(figures(false)?);
+        s.html("</div>\n<div class=\"frame-view frame-base\">\n<p class=\"note\">The TCP's confidence ellipsoids in the robot base (world) frame: C_base = G_w C_p G_wᵀ with G_w the derivative of the TCP's world position — where the robot's TCP is, without the uncertainty of the instrument's own pose that the instrument-frame C_s includes (so the two differ in size as well as orientation).</p>\n");
+        s.figure_row(figures(true)?);
+        s.html("</div>\n</div>\n");
+    } else {
+        s.html("<p class=\"note\">Instrument frame only: a record of an older armcal holds no base-frame C_s.</p>\n");
+        s.figure_row(figures(false)?);
     }
-    s.figure_row(figures);
     Ok(Some(s))
 }

@@ -6,7 +6,7 @@
 //! (solver times are left out of them).
 
 use crate::accuracy::ErrorStats;
-use crate::compensate::program::filter_joint_program;
+use crate::compensate::program::{filter_joint_program, ProgramRecord};
 use crate::compensate::IkSettings;
 use crate::design::baselines::random_feasible;
 use crate::design::plan::{constraint_set, plan, CellConstraints, PlanSettings};
@@ -15,7 +15,7 @@ use crate::identify::{identify, Estimate, IdentifySettings};
 use crate::measure::csv;
 use crate::model::{forward_kinematics, observed_position, Data, Observed};
 use crate::progress::Observer;
-use crate::sim::{perturbed_truth, simulate, Perturbation};
+use crate::sim::{perturbed_truth, simulate, Perturbation, TruthRecord};
 use crate::Error;
 use serde::{Deserialize, Serialize};
 
@@ -64,6 +64,13 @@ pub struct DemoSummary {
     pub program_miss_compensated: f64,
     /// Efficiency of the KPI design against the optimality bound, if computed.
     pub kpi_bound_efficiency: Option<f64>,
+    /// The working program compensated with the KPI design's estimate (`program.csv` →
+    /// `program-corrected.csv`); `None` in summaries of an older armcal.
+    #[serde(default)]
+    pub program: Option<ProgramRecord>,
+    /// The true robot the campaigns measured; `None` in summaries of an older armcal.
+    #[serde(default)]
+    pub truth: Option<TruthRecord>,
 }
 
 /// The demo: its summary, the files it produced (name, content) and the records a report
@@ -180,6 +187,13 @@ pub fn run_demo(seed: u64, observer: &mut dyn Observer) -> Result<Demo, Error> {
         observed_position(fk, Observed::Tool)
     };
     let tcp_truth = tcp(&truth, &mut fk);
+    // The held-out poses measured without noise on the true robot: each estimate's
+    // held-out validation is then its error against the truth.
+    let mut held_out_truth = simulate(model, &truth, &held_out, None, 0)?;
+    held_out_truth.source = format!(
+        "{} feasible poses in neither design, measured without noise on the true robot",
+        held_out.len()
+    );
 
     let mut campaign = |name: &str,
                         design: &[Vec<f64>],
@@ -197,6 +211,7 @@ pub fn run_demo(seed: u64, observer: &mut dyn Observer) -> Result<Demo, Error> {
             &data,
             &IdentifySettings {
                 seed,
+                test: Some(held_out_truth.clone()),
                 ..Default::default()
             },
             observer,
@@ -286,6 +301,8 @@ pub fn run_demo(seed: u64, observer: &mut dyn Observer) -> Result<Demo, Error> {
         program_miss_nominal: miss_nominal,
         program_miss_compensated: miss_comp,
         kpi_bound_efficiency: plan_report.bound.as_ref().and_then(|b| b.efficiency),
+        program: Some(ProgramRecord::of(model, &rows)),
+        truth: Some(TruthRecord::new(&cell.name, model, &truth, seed)),
     };
     files.push((
         "summary.json".into(),

@@ -61,6 +61,7 @@ mod hostile {
 mod report {
     mod cell_view;
     mod html;
+    mod verdict;
 }
 mod repository {
     mod builtin_cells;
