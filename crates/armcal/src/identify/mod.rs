@@ -280,16 +280,17 @@ pub fn holdout_split(n: usize, fraction: f64, seed: u64) -> (Vec<usize>, Vec<usi
 /// configurations held out at random (seeded), or the whole data fitted and validated on
 /// `opts.test`, or no validation. A fraction outside [0, 1), or both a fraction and test
 /// data, is an error.
-struct Split {
-    train: Dataset,
+struct Split<'d> {
+    /// The data fitted: the whole data set (borrowed, not copied) or a training subset.
+    train: std::borrow::Cow<'d, Dataset>,
     /// Index in the data file of each training configuration.
     train_configs: Vec<usize>,
     /// Validation data and what it is.
-    test: Option<(Dataset, String)>,
+    test: Option<(std::borrow::Cow<'d, Dataset>, String)>,
 }
 
-impl Split {
-    fn of(data: &Dataset, opts: &IdentifySettings) -> Result<Split, Error> {
+impl<'d> Split<'d> {
+    fn of(data: &'d Dataset, opts: &'d IdentifySettings) -> Result<Split<'d>, Error> {
         let h = opts.holdout;
         if !(0.0..1.0).contains(&h) {
             return Err(Error::Input(format!(
@@ -302,9 +303,9 @@ impl Split {
                 "give either a holdout fraction or test data for validation, not both".into(),
             )),
             (Some(test), false) => Ok(Split {
-                train: data.clone(),
+                train: std::borrow::Cow::Borrowed(data),
                 train_configs: all,
-                test: Some((test.clone(), test.source.clone())),
+                test: Some((std::borrow::Cow::Borrowed(test), test.source.clone())),
             }),
             (None, true) => {
                 let (train, test) = holdout_split(all.len(), h, opts.seed);
@@ -315,10 +316,10 @@ impl Split {
                     )));
                 }
                 Ok(Split {
-                    train: data.subset(&train),
+                    train: std::borrow::Cow::Owned(data.subset(&train)),
                     train_configs: train,
                     test: Some((
-                        data.subset(&test),
+                        std::borrow::Cow::Owned(data.subset(&test)),
                         format!(
                             "{} of the {} configurations of {} held out at random (seed {})",
                             test.len(),
@@ -330,7 +331,7 @@ impl Split {
                 })
             }
             (None, false) => Ok(Split {
-                train: data.clone(),
+                train: std::borrow::Cow::Borrowed(data),
                 train_configs: all,
                 test: None,
             }),
@@ -422,7 +423,7 @@ pub fn identify(
 ) -> Result<Estimate, Error> {
     let noise = cell.noise();
     let split = Split::of(data, opts)?;
-    let train = &split.train;
+    let train: &Dataset = &split.train;
     let fit = fit_free_set(cell, train, &noise, opts, observer)?;
     let (model, reasons) = (&fit.model, fit.reasons);
     let (sol, outliers, robust_scale) = (fit.solution, fit.outliers, fit.robust_scale);
@@ -460,7 +461,7 @@ pub fn identify(
         (cs, blocks)
     };
     let data_rows = sol.jacobian.nrows() - problem.priors.len();
-    let observability = uncertainty::observability(&sol.jacobian.rows(0, data_rows).into_owned());
+    let observability = uncertainty::observability(sol.jacobian.rows(0, data_rows));
     let residuals = residual_report(&problem, &sol.params, &split.train_configs);
     let validation = split.validate(model, &sol.params, opts, &noise)?;
     let free_set: std::collections::HashSet<usize> = problem.free.iter().copied().collect();
