@@ -8,4 +8,5 @@ mod compensate_cli;
 mod estimate_checks;
 mod import_cli;
 mod outputs_cli;
+mod scale;
 mod workflow;

@@ -425,9 +425,27 @@ pub fn identify(
     let split = Split::of(data, opts)?;
     let train: &Dataset = &split.train;
     let fit = fit_free_set(cell, train, &noise, opts, observer)?;
+    observer.start("uncertainty, observability and residuals", None);
+    let estimate = estimate_of_fit(cell, data, opts, &split, fit, &noise, observer);
+    observer.finish();
+    estimate
+}
+
+/// The estimate of a fit: covariance, TCP covariance at the working configurations,
+/// diagnostics, residuals and the held-out validation.
+fn estimate_of_fit(
+    cell: &Cell,
+    data: &Dataset,
+    opts: &IdentifySettings,
+    split: &Split,
+    fit: FreeSetFit,
+    noise: &crate::measure::NoiseModel,
+    observer: &mut dyn Observer,
+) -> Result<Estimate, Error> {
+    let train: &Dataset = &split.train;
     let (model, reasons) = (&fit.model, fit.reasons);
     let (sol, outliers, robust_scale) = (fit.solution, fit.outliers, fit.robust_scale);
-    let mut problem = Problem::new(model, train, &noise)?;
+    let mut problem = Problem::new(model, train, noise)?;
     problem.row_weights = fit.row_weights;
     let branch = crate::model::branch::nearest_branch(model, &sol.params);
     let sol = sol.in_branch(&branch, &problem.free);
@@ -463,7 +481,9 @@ pub fn identify(
     let data_rows = sol.jacobian.nrows() - problem.priors.len();
     let observability = uncertainty::observability(sol.jacobian.rows(0, data_rows));
     let residuals = residual_report(&problem, &sol.params, &split.train_configs);
-    let validation = split.validate(model, &sol.params, opts, &noise)?;
+    let validation = phase(observer, "held-out validation", || {
+        split.validate(model, &sol.params, opts, noise)
+    })?;
     let free_set: std::collections::HashSet<usize> = problem.free.iter().copied().collect();
     let parameters = (0..model.param_count())
         .map(|i| {
@@ -528,6 +548,14 @@ pub fn identify(
     })
 }
 
+/// Runs `f` as the task `task` of `observer` (a phase that reports no steps of its own).
+fn phase<T>(observer: &mut dyn Observer, task: &str, f: impl FnOnce() -> T) -> T {
+    observer.start(task, None);
+    let result = f();
+    observer.finish();
+    result
+}
+
 /// A fit with its free set, as [`fit_free_set`] decided it.
 struct FreeSetFit {
     model: Model,
@@ -565,15 +593,23 @@ fn fit_free_set(
         Some(g) => identifiable_model_given(cell, train, at, g),
         None => Ok((cell.model.clone(), Vec::new())),
     };
-    let mut at = frames_first_start(&declared, train, noise, opts)?;
-    let mut decided = decide(&at)?;
+    let mut at = phase(observer, "fitting the frames first", || {
+        frames_first_start(&declared, train, noise, opts)
+    })?;
+    let mut decided = phase(observer, "choosing the identifiable parameters", || {
+        decide(&at)
+    })?;
     loop {
         let (model, reasons) = decided;
         let mut problem = Problem::new(&model, train, noise)?;
         let (solution, outliers, robust_scale) = solve(&mut problem, &at, opts, observer)?;
         let row_weights = problem.row_weights.clone();
         drop(problem);
-        let recheck = decide(&solution.params)?;
+        let recheck = phase(
+            observer,
+            "checking the identifiable parameters at the fit",
+            || decide(&solution.params),
+        )?;
         if recheck.0.registry.free().len() <= model.registry.free().len() {
             return Ok(FreeSetFit {
                 model,

@@ -84,7 +84,7 @@ pub fn parameter_uncertainty(
     names: &[String],
 ) -> Result<ParameterUncertainty, Error> {
     let n = j.ncols();
-    let info = j.tr_mul(j);
+    let info = crate::linalg::gram(j.as_view());
     let cov = information_inverse(&info, names)?;
     let sigma: Vec<f64> = (0..n).map(|k| cov[(k, k)].max(0.0).sqrt()).collect();
     let correlation =
@@ -222,7 +222,8 @@ pub fn tcp_covariance_constrained(
     let (np, ns) = (j.ncols(), g.nrows());
     let nv = np + ns;
     let mut kkt = DMatrix::zeros(nv + ns, nv + ns);
-    kkt.view_mut((0, 0), (np, np)).copy_from(&j.tr_mul(j));
+    kkt.view_mut((0, 0), (np, np))
+        .copy_from(&crate::linalg::gram(j.as_view()));
     kkt.view_mut((nv, 0), (ns, np)).copy_from(g);
     kkt.view_mut((0, nv), (np, ns)).copy_from(&g.transpose());
     for k in 0..ns {

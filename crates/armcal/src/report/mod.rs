@@ -6,6 +6,7 @@
 //! [`demo_summary`]); [`figures`] draws plain data to SVG; [`html`] assembles the page.
 
 pub mod cell_view;
+pub mod decimate;
 pub mod demo_summary;
 pub mod design;
 pub mod documents;

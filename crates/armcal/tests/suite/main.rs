@@ -57,6 +57,7 @@ mod hostile {
 }
 mod report {
     mod cell_view;
+    mod decimation;
     mod html;
 }
 mod repository {
