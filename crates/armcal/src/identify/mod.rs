@@ -12,6 +12,7 @@ pub mod lm;
 pub mod problem;
 pub mod robust;
 pub mod solver;
+mod split;
 pub mod uncertainty;
 pub mod verdicts;
 
@@ -41,6 +42,7 @@ use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
+use split::Split;
 
 /// Which solver.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -274,95 +276,6 @@ pub fn holdout_split(n: usize, fraction: f64, seed: u64) -> (Vec<usize>, Vec<usi
     train.sort();
     test.sort();
     (train, test)
-}
-
-/// The data a fit uses and the data it is validated on: `opts.holdout` of the
-/// configurations held out at random (seeded), or the whole data fitted and validated on
-/// `opts.test`, or no validation. A fraction outside [0, 1), or both a fraction and test
-/// data, is an error.
-struct Split<'d> {
-    /// The data fitted: the whole data set (borrowed, not copied) or a training subset.
-    train: std::borrow::Cow<'d, Dataset>,
-    /// Index in the data file of each training configuration.
-    train_configs: Vec<usize>,
-    /// Validation data and what it is.
-    test: Option<(std::borrow::Cow<'d, Dataset>, String)>,
-}
-
-impl<'d> Split<'d> {
-    fn of(data: &'d Dataset, opts: &'d IdentifySettings) -> Result<Split<'d>, Error> {
-        let h = opts.holdout;
-        if !(0.0..1.0).contains(&h) {
-            return Err(Error::Input(format!(
-                "the holdout fraction {h} must be in [0, 1) (0: no held-out validation)"
-            )));
-        }
-        let all: Vec<usize> = (0..data.configurations.len()).collect();
-        match (&opts.test, h > 0.0) {
-            (Some(_), true) => Err(Error::Input(
-                "give either a holdout fraction or test data for validation, not both".into(),
-            )),
-            (Some(test), false) => Ok(Split {
-                train: std::borrow::Cow::Borrowed(data),
-                train_configs: all,
-                test: Some((std::borrow::Cow::Borrowed(test), test.source.clone())),
-            }),
-            (None, true) => {
-                let (train, test) = holdout_split(all.len(), h, opts.seed);
-                if test.is_empty() {
-                    return Err(Error::Input(format!(
-                        "the holdout fraction {h} of {} configurations holds out none; hold out a larger fraction",
-                        all.len()
-                    )));
-                }
-                Ok(Split {
-                    train: std::borrow::Cow::Owned(data.subset(&train)),
-                    train_configs: train,
-                    test: Some((
-                        std::borrow::Cow::Owned(data.subset(&test)),
-                        format!(
-                            "{} of the {} configurations of {} held out at random (seed {})",
-                            test.len(),
-                            all.len(),
-                            data.source,
-                            opts.seed
-                        ),
-                    )),
-                })
-            }
-            (None, false) => Ok(Split {
-                train: std::borrow::Cow::Borrowed(data),
-                train_configs: all,
-                test: None,
-            }),
-        }
-    }
-
-    /// Validation of the fit `calibrated` of `model` on the test data (`None` without).
-    fn validate(
-        &self,
-        model: &Model,
-        calibrated: &[f64],
-        opts: &IdentifySettings,
-        noise: &crate::measure::NoiseModel,
-    ) -> Result<Option<Validation>, Error> {
-        let Some((test, source)) = &self.test else {
-            return Ok(None);
-        };
-        let frames = frames_first_start(model, &self.train, noise, opts)?;
-        let eval = Problem::new(model, test, noise)?;
-        let mut ws = eval.workspace();
-        Ok(Some(Validation {
-            test_data: source.clone(),
-            train_configurations: self.train.configurations.len(),
-            test_configurations: test.configurations.len(),
-            train_ids: self.train.config_ids.clone(),
-            test_ids: test.config_ids.clone(),
-            nominal: ErrorStats::of(&eval.errors(&mut ws, &model.nominal())),
-            frames_only: ErrorStats::of(&eval.errors(&mut ws, &frames)),
-            calibrated: ErrorStats::of(&eval.errors(&mut ws, calibrated)),
-        }))
-    }
 }
 
 /// Residuals of the fit; `file_configs[c]` is the data-file index of the fitted data's

@@ -5,7 +5,6 @@ use crate::common::example_cell;
 use armcal::identify::{identify, IdentifySettings, MeasurementResidual};
 use armcal::model::random_configurations;
 use armcal::progress::Silent;
-use armcal::report::decimate::MAX_POINTS;
 use armcal::report::{self, Document, Input, ReportContent};
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 
