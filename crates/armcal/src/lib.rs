@@ -54,6 +54,7 @@ pub mod geometry;
 pub mod identify;
 pub mod input;
 pub mod json;
+pub mod linalg;
 pub mod measure;
 pub mod model;
 pub mod progress;

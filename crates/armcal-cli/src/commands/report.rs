@@ -2,6 +2,8 @@
 //! designs, `study paper` results), with inline SVG figures and the 3D view of the cell.
 
 use super::output::{AcceptUnconverged, Outputs};
+use super::progress::Progress;
+use armcal::progress::Observer;
 use armcal::report::files::files_report;
 use std::path::{Path, PathBuf};
 
@@ -22,18 +24,25 @@ pub struct Args {
     pub force: bool,
     #[command(flatten)]
     pub accept: AcceptUnconverged,
+    /// No progress display.
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let path = a.out.join("report.html");
     let inputs: Vec<&Path> = a.files.iter().map(PathBuf::as_path).collect();
     let outputs = Outputs::plan(a.force, &inputs, &[&path])?;
+    let mut progress = Progress::new(a.quiet);
+    progress.start("reading the results and drawing the report", None);
     let report = files_report(&a.files, &a.title, &a.accept.acceptance())?;
+    let page = &report.page;
+    let html = page.render();
+    progress.finish();
+    drop(progress);
     for n in &report.notes {
         eprintln!("note: {n}");
     }
-    let page = &report.page;
-    let html = page.render();
     outputs.commit(&[(&path, &html)])?;
     println!(
         "report → {} ({} figure{}{}, {} kB)",

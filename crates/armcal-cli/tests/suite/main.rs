@@ -11,4 +11,5 @@ mod import_cli;
 mod measurable_cli;
 mod outputs_cli;
 mod pool_cli;
+mod scale;
 mod workflow;

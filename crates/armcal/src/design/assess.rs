@@ -71,7 +71,7 @@ pub fn assess(cell: &Cell, design: &[Vec<f64>]) -> Result<DesignAssessment, Erro
         sigma: unc.sigma,
         c_p: unc.covariance,
         tcp,
-        observability: uncertainty::observability(&j),
+        observability: uncertainty::observability(j.as_view()),
         criteria,
     })
 }

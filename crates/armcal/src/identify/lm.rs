@@ -74,7 +74,7 @@ pub fn levenberg_marquardt(
             };
             break;
         }
-        let a = it.j.tr_mul(&it.j);
+        let a = crate::linalg::gram(it.j.as_view());
         let d: DVector<f64> = a.diagonal().map(|x| x.max(1e-300));
         let x = problem.free_values(&it.params);
         let mut accepted = false;

@@ -13,6 +13,7 @@ pub mod problem;
 pub mod residuals;
 pub mod robust;
 pub mod solver;
+mod split;
 pub mod uncertainty;
 pub mod verdicts;
 
@@ -30,7 +31,6 @@ pub use solver::{SolverResult, Status, ToleranceSettings};
 pub use uncertainty::{Chi2Outcome, Observability, ParameterUncertainty, TcpCovariance};
 pub use verdicts::{Chi2Verdict, IdentifiabilityVerdict, Verdicts};
 
-use crate::accuracy::ErrorStats;
 use crate::cell::Cell;
 use crate::measure::{Dataset, MeasurementKind};
 use crate::model::identifiability::{Identifiability, IdentifiabilitySettings, Measurement};
@@ -41,6 +41,7 @@ use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
+use split::Split;
 
 /// Which solver.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -276,107 +277,6 @@ pub fn holdout_split(n: usize, fraction: f64, seed: u64) -> (Vec<usize>, Vec<usi
     (train, test)
 }
 
-/// The data a fit uses and the data it is validated on: `opts.holdout` of the
-/// configurations held out at random (seeded), or the whole data fitted and validated on
-/// `opts.test`, or no validation. A fraction outside [0, 1), or both a fraction and test
-/// data, is an error.
-struct Split {
-    train: Dataset,
-    /// Index in the data file of each training configuration.
-    train_configs: Vec<usize>,
-    /// Validation data and what it is.
-    test: Option<(Dataset, String)>,
-}
-
-impl Split {
-    fn of(data: &Dataset, opts: &IdentifySettings) -> Result<Split, Error> {
-        let h = opts.holdout;
-        if !(0.0..1.0).contains(&h) {
-            return Err(Error::Input(format!(
-                "the holdout fraction {h} must be in [0, 1) (0: no held-out validation)"
-            )));
-        }
-        let all: Vec<usize> = (0..data.configurations.len()).collect();
-        match (&opts.test, h > 0.0) {
-            (Some(_), true) => Err(Error::Input(
-                "give either a holdout fraction or test data for validation, not both".into(),
-            )),
-            (Some(test), false) => Ok(Split {
-                train: data.clone(),
-                train_configs: all,
-                test: Some((test.clone(), test.source.clone())),
-            }),
-            (None, true) => {
-                let (train, test) = holdout_split(all.len(), h, opts.seed);
-                if test.is_empty() {
-                    return Err(Error::Input(format!(
-                        "the holdout fraction {h} of {} configurations holds out none; hold out a larger fraction",
-                        all.len()
-                    )));
-                }
-                Ok(Split {
-                    train: data.subset(&train),
-                    train_configs: train,
-                    test: Some((
-                        data.subset(&test),
-                        format!(
-                            "{} of the {} configurations of {} held out at random (seed {})",
-                            test.len(),
-                            all.len(),
-                            data.source,
-                            opts.seed
-                        ),
-                    )),
-                })
-            }
-            (None, false) => Ok(Split {
-                train: data.clone(),
-                train_configs: all,
-                test: None,
-            }),
-        }
-    }
-
-    /// Validation of the fit `calibrated` of `model` on the test data (`None` without).
-    fn validate(
-        &self,
-        model: &Model,
-        calibrated: &[f64],
-        opts: &IdentifySettings,
-        noise: &crate::measure::NoiseModel,
-    ) -> Result<Option<Validation>, Error> {
-        let Some((test, source)) = &self.test else {
-            return Ok(None);
-        };
-        let frames = frames_first_start(model, &self.train, noise, opts)?;
-        let eval = Problem::new(model, test, noise)?;
-        let mut ws = eval.workspace();
-        let mut axes = |params: &[f64]| {
-            let xyz: Vec<[f64; 3]> = residuals::position_components(&eval, &mut ws, params)
-                .into_iter()
-                .flatten()
-                .collect();
-            AxisErrors::of(&xyz)
-        };
-        let per_axis = HeldOutAxes {
-            nominal: axes(&model.nominal()),
-            frames_only: axes(&frames),
-            calibrated: axes(calibrated),
-        };
-        Ok(Some(Validation {
-            per_axis: Some(per_axis),
-            test_data: source.clone(),
-            train_configurations: self.train.configurations.len(),
-            test_configurations: test.configurations.len(),
-            train_ids: self.train.config_ids.clone(),
-            test_ids: test.config_ids.clone(),
-            nominal: ErrorStats::of(&eval.errors(&mut ws, &model.nominal())),
-            frames_only: ErrorStats::of(&eval.errors(&mut ws, &frames)),
-            calibrated: ErrorStats::of(&eval.errors(&mut ws, calibrated)),
-        }))
-    }
-}
-
 /// Identifies the cell's free parameters from a dataset: fit (optionally on a training
 /// split), covariance, TCP covariance at the working configurations, diagnostics, and
 /// held-out validation against the nominal and frames-only models.
@@ -388,11 +288,29 @@ pub fn identify(
 ) -> Result<Estimate, Error> {
     let noise = cell.noise();
     let split = Split::of(data, opts)?;
-    let train = &split.train;
+    let train: &Dataset = &split.train;
     let fit = fit_free_set(cell, train, &noise, opts, observer)?;
+    observer.start("uncertainty, observability and residuals", None);
+    let estimate = estimate_of_fit(cell, data, opts, &split, fit, &noise, observer);
+    observer.finish();
+    estimate
+}
+
+/// The estimate of a fit: covariance, TCP covariance at the working configurations,
+/// diagnostics, residuals and the held-out validation.
+fn estimate_of_fit(
+    cell: &Cell,
+    data: &Dataset,
+    opts: &IdentifySettings,
+    split: &Split,
+    fit: FreeSetFit,
+    noise: &crate::measure::NoiseModel,
+    observer: &mut dyn Observer,
+) -> Result<Estimate, Error> {
+    let train: &Dataset = &split.train;
     let (model, reasons) = (&fit.model, fit.reasons);
     let (sol, outliers, robust_scale) = (fit.solution, fit.outliers, fit.robust_scale);
-    let mut problem = Problem::new(model, train, &noise)?;
+    let mut problem = Problem::new(model, train, noise)?;
     problem.row_weights = fit.row_weights;
     let branch = crate::model::branch::nearest_branch(model, &sol.params);
     let sol = sol.in_branch(&branch, &problem.free);
@@ -430,9 +348,11 @@ pub fn identify(
         (cs, blocks)
     };
     let data_rows = sol.jacobian.nrows() - problem.priors.len();
-    let observability = uncertainty::observability(&sol.jacobian.rows(0, data_rows).into_owned());
+    let observability = uncertainty::observability(sol.jacobian.rows(0, data_rows));
     let residuals = residuals::residual_report(&problem, &sol.params, &split.train_configs);
-    let validation = split.validate(model, &sol.params, opts, &noise)?;
+    let validation = phase(observer, "held-out validation", || {
+        split.validate(model, &sol.params, opts, noise)
+    })?;
     let free_set: std::collections::HashSet<usize> = problem.free.iter().copied().collect();
     let parameters = (0..model.param_count())
         .map(|i| {
@@ -497,6 +417,14 @@ pub fn identify(
     })
 }
 
+/// Runs `f` as the task `task` of `observer` (a phase that reports no steps of its own).
+fn phase<T>(observer: &mut dyn Observer, task: &str, f: impl FnOnce() -> T) -> T {
+    observer.start(task, None);
+    let result = f();
+    observer.finish();
+    result
+}
+
 /// A fit with its free set, as [`fit_free_set`] decided it.
 struct FreeSetFit {
     model: Model,
@@ -534,15 +462,23 @@ fn fit_free_set(
         Some(g) => identifiable_model_given(cell, train, at, g),
         None => Ok((cell.model.clone(), Vec::new())),
     };
-    let mut at = frames_first_start(&declared, train, noise, opts)?;
-    let mut decided = decide(&at)?;
+    let mut at = phase(observer, "fitting the frames first", || {
+        frames_first_start(&declared, train, noise, opts)
+    })?;
+    let mut decided = phase(observer, "choosing the identifiable parameters", || {
+        decide(&at)
+    })?;
     loop {
         let (model, reasons) = decided;
         let mut problem = Problem::new(&model, train, noise)?;
         let (solution, outliers, robust_scale) = solve(&mut problem, &at, opts, observer)?;
         let row_weights = problem.row_weights.clone();
         drop(problem);
-        let recheck = decide(&solution.params)?;
+        let recheck = phase(
+            observer,
+            "checking the identifiable parameters at the fit",
+            || decide(&solution.params),
+        )?;
         if recheck.0.registry.free().len() <= model.registry.free().len() {
             return Ok(FreeSetFit {
                 model,

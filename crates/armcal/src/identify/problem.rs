@@ -42,12 +42,23 @@ pub struct Problem<'a> {
     slot_of: Vec<usize>,
     /// Per-row weight multipliers (robust estimation); 1 by default.
     pub row_weights: Vec<f64>,
+    /// Measurement indices grouped by configuration: those of configuration `c` are
+    /// `by_config[config_start[c]..config_start[c + 1]]` (an evaluation visits each
+    /// configuration once and keeps no per-configuration Jacobian).
+    by_config: Vec<usize>,
+    /// Offsets into `by_config`, one per configuration and one past the end.
+    config_start: Vec<usize>,
 }
 
-/// Buffers for evaluating a [`Problem`].
+/// Buffers for evaluating a [`Problem`]: their size does not depend on the number of
+/// measurements.
 pub struct Workspace {
     data: Data<f64>,
-    predictions: Vec<Prediction>,
+    /// Predictions of every slot at the configuration being visited.
+    current: Vec<Prediction>,
+    /// Kinematics and prediction at the other configuration of a distance measurement.
+    other_data: Data<f64>,
+    other: Prediction,
     block_r: [f64; 6],
 }
 
@@ -124,6 +135,7 @@ impl<'a> Problem<'a> {
             }
         }
         let rows = sigmas.len();
+        let (by_config, config_start) = group_by_config(data);
         Ok(Problem {
             model,
             data,
@@ -134,6 +146,8 @@ impl<'a> Problem<'a> {
             slots,
             slot_of,
             row_weights: vec![1.0; rows],
+            by_config,
+            config_start,
         })
     }
 
@@ -197,10 +211,9 @@ impl<'a> Problem<'a> {
     pub fn workspace(&self) -> Workspace {
         Workspace {
             data: Data::new(self.model),
-            predictions: vec![
-                Prediction::new(self.free.len());
-                self.slots.len() * self.data.configurations.len()
-            ],
+            current: vec![Prediction::new(self.free.len()); self.slots.len()],
+            other_data: Data::new(self.model),
+            other: Prediction::new(self.free.len()),
             block_r: [0.0; 6],
         }
     }
@@ -217,25 +230,55 @@ impl<'a> Problem<'a> {
         }
     }
 
-    /// Model predictions (pose and 6 × n Jacobian) at every configuration and slot.
-    fn predict(&self, ws: &mut Workspace, params: &[f64], with_jacobian: bool) {
-        let ns = self.slots.len();
+    /// The prediction (pose and, if asked, 6 × n Jacobian) of slot `slot` at the current
+    /// kinematics `data`.
+    fn predict_slot(&self, data: &Data<f64>, slot: usize, p: &mut Prediction, with_jacobian: bool) {
+        let obs = self.slots[slot];
+        p.pose = observed_pose(data, obs);
+        if with_jacobian {
+            identification_jacobian(self.model, data, obs, Rows::Pose, &self.free, &mut p.jac, 0);
+        }
+    }
+
+    /// Calls `f(i, a, b, block)` for every measurement `i` with the prediction `a` at its
+    /// configuration and, for a distance between poses, `b` at the other one, and a
+    /// residual buffer; configuration by configuration, each configuration's kinematics
+    /// computed once.
+    fn visit(
+        &self,
+        ws: &mut Workspace,
+        params: &[f64],
+        with_jacobian: bool,
+        mut f: impl FnMut(usize, &Prediction, Option<&Prediction>, &mut [f64; 6]),
+    ) {
+        let Workspace {
+            data,
+            current,
+            other_data,
+            other,
+            block_r,
+        } = ws;
         for (c, q) in self.data.configurations.iter().enumerate() {
-            forward_kinematics(self.model, &mut ws.data, params, q);
-            for (s, &obs) in self.slots.iter().enumerate() {
-                let p = &mut ws.predictions[c * ns + s];
-                p.pose = observed_pose(&ws.data, obs);
-                if with_jacobian {
-                    identification_jacobian(
-                        self.model,
-                        &ws.data,
-                        obs,
-                        Rows::Pose,
-                        &self.free,
-                        &mut p.jac,
-                        0,
-                    );
-                }
+            let measurements = &self.by_config[self.config_start[c]..self.config_start[c + 1]];
+            if measurements.is_empty() {
+                continue;
+            }
+            forward_kinematics(self.model, data, params, q);
+            for (s, p) in current.iter_mut().enumerate() {
+                self.predict_slot(data, s, p, with_jacobian);
+            }
+            for &i in measurements {
+                let slot = self.slot_of[i];
+                let b = match &self.data.measurements[i].kind {
+                    MeasurementKind::Distance { other: o, .. } => {
+                        let q = &self.data.configurations[*o];
+                        forward_kinematics(self.model, other_data, params, q);
+                        self.predict_slot(other_data, slot, other, with_jacobian);
+                        Some(&*other)
+                    }
+                    _ => None,
+                };
+                f(i, &current[slot], b, block_r);
             }
         }
     }
@@ -250,8 +293,6 @@ impl<'a> Problem<'a> {
         jac: Option<&mut DMatrix<f64>>,
     ) {
         let with_j = jac.is_some();
-        self.predict(ws, params, with_j);
-        let ns = self.slots.len();
         let mut scratch;
         let jac = match jac {
             Some(j) => j,
@@ -260,26 +301,19 @@ impl<'a> Problem<'a> {
                 &mut scratch
             }
         };
-        for (i, m) in self.data.measurements.iter().enumerate() {
-            let a = &ws.predictions[m.config * ns + self.slot_of[i]];
-            let b = match &m.kind {
-                MeasurementKind::Distance { other, .. } => {
-                    Some(&ws.predictions[other * ns + self.slot_of[i]])
-                }
-                _ => None,
-            };
+        self.visit(ws, params, with_j, |i, a, b, block_r| {
+            let m = &self.data.measurements[i];
             let row = self.row_of[i];
-            let rows = m.kind.rows();
             let jrow = if with_j { row } else { 0 };
-            residual_rows(&m.kind, a, b, &mut ws.block_r, jac, jrow);
-            for k in 0..rows {
+            residual_rows(&m.kind, a, b, block_r, jac, jrow);
+            for k in 0..m.kind.rows() {
                 let w = self.row_weights[row + k].sqrt() / self.sigmas[row + k];
-                r[row + k] = ws.block_r[k] * w;
+                r[row + k] = block_r[k] * w;
                 if with_j {
                     jac.row_mut(row + k).scale_mut(w);
                 }
             }
-        }
+        });
         let n = self.sigmas.len();
         for (k, pr) in self.priors.iter().enumerate() {
             r[n + k] = (params[self.free[pr.column]] - pr.mean) / pr.sigma;
@@ -293,28 +327,35 @@ impl<'a> Problem<'a> {
     /// Unwhitened position error (mm) of every position-bearing measurement at `params`
     /// (distances and planes: the scalar error). One entry per measurement.
     pub fn errors(&self, ws: &mut Workspace, params: &[f64]) -> Vec<f64> {
-        self.predict(ws, params, false);
-        let ns = self.slots.len();
         let mut dummy = DMatrix::zeros(6, self.free.len());
-        self.data
-            .measurements
-            .iter()
-            .enumerate()
-            .map(|(i, m)| {
-                let a = &ws.predictions[m.config * ns + self.slot_of[i]];
-                let b = match &m.kind {
-                    MeasurementKind::Distance { other, .. } => {
-                        Some(&ws.predictions[other * ns + self.slot_of[i]])
-                    }
-                    _ => None,
-                };
-                residual_rows(&m.kind, a, b, &mut ws.block_r, &mut dummy, 0);
-                match m.kind.rows() {
-                    1 => ws.block_r[0].abs(),
-                    _ => (ws.block_r[0].powi(2) + ws.block_r[1].powi(2) + ws.block_r[2].powi(2))
-                        .sqrt(),
-                }
-            })
-            .collect()
+        let mut errors = vec![0.0; self.data.measurements.len()];
+        self.visit(ws, params, false, |i, a, b, block_r| {
+            let m = &self.data.measurements[i];
+            residual_rows(&m.kind, a, b, block_r, &mut dummy, 0);
+            errors[i] = match m.kind.rows() {
+                1 => block_r[0].abs(),
+                _ => (block_r[0].powi(2) + block_r[1].powi(2) + block_r[2].powi(2)).sqrt(),
+            };
+        });
+        errors
     }
+}
+
+/// Measurement indices grouped by configuration (a counting sort, measurement order kept
+/// within a configuration) and the offsets of each configuration's group.
+fn group_by_config(data: &Dataset) -> (Vec<usize>, Vec<usize>) {
+    let mut start = vec![0usize; data.configurations.len() + 1];
+    for m in &data.measurements {
+        start[m.config + 1] += 1;
+    }
+    for c in 0..data.configurations.len() {
+        start[c + 1] += start[c];
+    }
+    let mut next = start.clone();
+    let mut by_config = vec![0; data.measurements.len()];
+    for (i, m) in data.measurements.iter().enumerate() {
+        by_config[next[m.config]] = i;
+        next[m.config] += 1;
+    }
+    (by_config, start)
 }

@@ -6,7 +6,7 @@ use crate::model::{
     forward_kinematics, identification_jacobian, Data, Model, Observed, Rows, Segment,
 };
 use crate::Error;
-use nalgebra::{DMatrix, DVector, Matrix3};
+use nalgebra::{DMatrix, DMatrixView, DVector, Matrix3};
 use serde::{Deserialize, Serialize};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 
@@ -86,7 +86,7 @@ pub fn parameter_uncertainty(
     names: &[String],
 ) -> Result<ParameterUncertainty, Error> {
     let n = j.ncols();
-    let info = j.tr_mul(j);
+    let info = crate::linalg::gram(j.as_view());
     let cov = information_inverse(&info, names)?;
     let sigma: Vec<f64> = (0..n).map(|k| cov[(k, k)].max(0.0).sqrt()).collect();
     let correlation =
@@ -270,7 +270,8 @@ pub fn tcp_covariance_constrained(
     let (np, ns) = (j.ncols(), g.nrows());
     let nv = np + ns;
     let mut kkt = DMatrix::zeros(nv + ns, nv + ns);
-    kkt.view_mut((0, 0), (np, np)).copy_from(&j.tr_mul(j));
+    kkt.view_mut((0, 0), (np, np))
+        .copy_from(&crate::linalg::gram(j.as_view()));
     kkt.view_mut((nv, 0), (ns, np)).copy_from(g);
     kkt.view_mut((0, nv), (np, ns)).copy_from(&g.transpose());
     for k in 0..ns {
@@ -309,20 +310,16 @@ pub struct Observability {
 }
 
 /// The observability indices of the whitened identification Jacobian `j` ([`Observability`]).
-pub fn observability(j: &DMatrix<f64>) -> Observability {
+/// Singular values and column norms are those of `j`'s triangular factor
+/// ([`crate::linalg`]), so a Jacobian of many rows is neither copied nor decomposed whole.
+pub fn observability(j: DMatrixView<f64>) -> Observability {
     let m = j.nrows() as f64;
-    let mut s: Vec<f64> = j
-        .clone()
-        .svd(false, false)
-        .singular_values
-        .iter()
-        .copied()
-        .collect();
-    s.sort_by(|a, b| b.total_cmp(a));
+    let r = crate::linalg::r_factor(j);
+    let s = crate::linalg::singular_values_of_factor(&r, j.nrows());
     let n = s.len() as f64;
     let (smax, smin) = (s[0], *s.last().unwrap_or(&0.0));
     let geo = (s.iter().map(|x| x.max(1e-300).ln()).sum::<f64>() / n).exp();
-    let mut scaled = j.clone();
+    let mut scaled = r;
     for c in 0..scaled.ncols() {
         let nn = scaled.column(c).norm();
         if nn > 0.0 {

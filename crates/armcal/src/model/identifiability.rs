@@ -15,6 +15,7 @@
 //! * explains every parameter left out by the kept parameters its column is a combination
 //!   of ("`j1.theta` cannot be separated from `tracker.rz`, ...").
 
+use crate::linalg::{singular_values_of_factor, RowCompressor};
 use crate::model::chain::Model;
 use crate::model::jacobian::{identification_jacobian, Observed, Rows};
 use crate::model::kinematics::{forward_kinematics, Data};
@@ -268,6 +269,32 @@ pub fn stacked_jacobian(
     dist
 }
 
+/// Configurations stacked per block of [`stacked_factor`].
+const FACTOR_BLOCK: usize = 256;
+
+/// The triangular factor of [`stacked_jacobian`] (`linalg`) and its number of rows, built
+/// a block of configurations at a time (a distance block overlaps the next by one
+/// configuration, so every successive pair is stacked once).
+fn stacked_factor(
+    model: &Model,
+    params: &[f64],
+    qs: &[Vec<f64>],
+    m: Measurement,
+    columns: &[usize],
+) -> (DMatrix<f64>, usize) {
+    let overlap = usize::from(m == Measurement::Distance);
+    let mut factor = RowCompressor::new(columns.len());
+    let mut start = 0;
+    while start + overlap < qs.len() {
+        let end = (start + FACTOR_BLOCK + overlap).min(qs.len());
+        let block = stacked_jacobian(model, params, &qs[start..end], m, columns);
+        factor.add_rows(block.as_view());
+        start = end - overlap;
+    }
+    let rows = factor.rows();
+    (factor.finish(), rows)
+}
+
 /// Analyses which free parameters of `model` can be identified at `params` from the given
 /// measurement type.
 pub fn analyze(
@@ -295,13 +322,18 @@ pub fn analyze_at(
         .map(|i| model.registry.get(i).name.clone())
         .collect();
     candidates.sort_by_key(|&i| preference(model, i));
-    let jac = stacked_jacobian(model, params, qs, opts.measurement, &candidates);
+    // Everything below depends on the stacked Jacobian only through inner products of its
+    // columns, so it runs on its n × n triangular factor (`linalg`), built a block of
+    // configurations at a time: memory and time stay flat in the number of configurations.
+    let (factor, m) = stacked_factor(model, params, qs, opts.measurement, &candidates);
     let name = |i: usize| model.registry.get(i).name.clone();
 
     // Column scaling to unit norm; zero columns stay zero.
-    let norms: Vec<f64> = (0..jac.ncols()).map(|c| jac.column(c).norm()).collect();
+    let norms: Vec<f64> = (0..factor.ncols())
+        .map(|c| factor.column(c).norm())
+        .collect();
     let max_norm = norms.iter().cloned().fold(0.0, f64::max);
-    let mut scaled = jac.clone();
+    let mut scaled = factor;
     for (c, &n) in norms.iter().enumerate() {
         if n > 1e-12 * max_norm.max(1e-300) {
             scaled.column_mut(c).unscale_mut(n);
@@ -310,27 +342,16 @@ pub fn analyze_at(
         }
     }
 
-    let mut sv: Vec<f64> = if scaled.ncols() > 0 {
-        scaled
-            .clone()
-            .svd(false, false)
-            .singular_values
-            .iter()
-            .copied()
-            .collect()
-    } else {
-        Vec::new()
-    };
-    sv.sort_by(|a, b| b.partial_cmp(a).unwrap_or(std::cmp::Ordering::Equal));
+    let sv = singular_values_of_factor(&scaled, m);
     let smax = sv.first().copied().unwrap_or(0.0);
     let rank_svd = sv
         .iter()
         .filter(|&&s| s > opts.tolerance * smax.max(1e-300))
         .count();
-    let rank_qr = if scaled.ncols() > 0 && scaled.nrows() > 0 {
+    let rank_qr = if scaled.ncols() > 0 && m > 0 {
         let r = scaled.clone().col_piv_qr().r();
         let d0 = r[(0, 0)].abs();
-        (0..r.nrows().min(r.ncols()))
+        (0..m.min(r.ncols()))
             .filter(|&i| r[(i, i)].abs() > opts.tolerance * d0.max(1e-300))
             .count()
     } else {

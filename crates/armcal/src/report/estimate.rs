@@ -2,6 +2,7 @@
 //! with σ and flagged correlations, observability, residuals (histograms, per pose) and the
 //! held-out validation.
 
+use super::decimate::{envelope, MAX_POINTS};
 use super::figures::{bar_figure, histogram_figure, series_figure, Reference};
 use super::html::{escape, facts, fixed, number, table, Section};
 use crate::accuracy::ErrorStats;
@@ -270,10 +271,18 @@ pub fn estimate_section(id: &str, label: &str, e: &Estimate) -> Result<Section, 
             ),
         );
         let per_pose = |k: usize| {
-            with_xyz
-                .iter()
-                .map(|(p, v)| (*p as f64, v[k]))
-                .collect::<Vec<(f64, f64)>>()
+            let all: Vec<(f64, f64)> = with_xyz.iter().map(|(p, v)| (*p as f64, v[k])).collect();
+            envelope(&all, MAX_POINTS)
+        };
+        let shown = if with_xyz.len() > MAX_POINTS {
+            format!(
+                " The plot shows at most {} of the {} measurements per component: of every {} consecutive ones, the smallest and the largest residual (so every extreme and every spike is drawn; the histograms and statistics use all of them).",
+                thousands(MAX_POINTS),
+                thousands(with_xyz.len()),
+                with_xyz.len().div_ceil(MAX_POINTS / 2)
+            )
+        } else {
+            String::new()
         };
         s.figure(
             series_figure(
@@ -291,7 +300,7 @@ pub fn estimate_section(id: &str, label: &str, e: &Estimate) -> Result<Section, 
                 }],
             )?,
             format!(
-                "Residual components of every measurement of <em>{}</em> against its pose number (mm). A pattern over the poses (a trend, a group of large residuals) shows where the model misses the robot.",
+                "Residual components of every measurement of <em>{}</em> against its pose number (mm). A pattern over the poses (a trend, a group of large residuals) shows where the model misses the robot.{shown}",
                 escape(label)
             ),
         );
@@ -354,4 +363,17 @@ pub fn estimate_section(id: &str, label: &str, e: &Estimate) -> Result<Section, 
         ));
     }
     Ok(s)
+}
+
+/// `n` with a thin space between groups of three digits ("100 000").
+fn thousands(n: usize) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
+            out.push('\u{202f}');
+        }
+        out.push(c);
+    }
+    out
 }

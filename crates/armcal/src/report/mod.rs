@@ -10,6 +10,7 @@
 
 pub mod cell_view;
 pub mod compensation;
+pub mod decimate;
 pub mod demo_summary;
 pub mod design;
 pub mod documents;

@@ -60,6 +60,7 @@ mod hostile {
 }
 mod report {
     mod cell_view;
+    mod decimation;
     mod html;
     mod verdict;
 }

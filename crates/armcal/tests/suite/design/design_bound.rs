@@ -84,7 +84,7 @@ fn book_strategy_one_is_much_worse_than_random() {
             d.jacobian(&mut ws, q);
             j.rows_mut(i * d.rows(), d.rows()).copy_from(&ws.jac);
         }
-        armcal::identify::uncertainty::observability(&j).condition_number
+        armcal::identify::uncertainty::observability(j.as_view()).condition_number
     };
     let k1 = obs(&strategy(&d.model, Strategy::S1, 60, 0));
     let k2 = obs(&strategy(&d.model, Strategy::S2, 60, 0));

@@ -11,7 +11,9 @@ const ABOVE_REPORT: &[&str] = &["workflow"];
 
 /// The layers of docs/DESIGN.md, bottom first: a module imports only from lower layers.
 const LAYERS: &[&[&str]] = &[
-    &["solve", "progress", "error", "json", "input", "table"],
+    &[
+        "solve", "progress", "error", "json", "input", "table", "linalg",
+    ],
     &["model", "geometry"],
     &["robots", "measure"],
     &["cell", "sim", "accuracy"],

@@ -1,0 +1,113 @@
+//! The split of a data set into the configurations a fit uses and those it is validated
+//! on (a seeded random holdout, or the user's own test file).
+
+use super::{
+    frames_first_start, holdout_split, residuals, AxisErrors, HeldOutAxes, IdentifySettings,
+    Problem, Validation,
+};
+use crate::accuracy::ErrorStats;
+use crate::measure::Dataset;
+use crate::model::Model;
+use crate::Error;
+
+/// The data a fit uses and the data it is validated on: `opts.holdout` of the
+/// configurations held out at random (seeded), or the whole data fitted and validated on
+/// `opts.test`, or no validation. A fraction outside [0, 1), or both a fraction and test
+/// data, is an error.
+pub(super) struct Split<'d> {
+    /// The data fitted: the whole data set (borrowed, not copied) or a training subset.
+    pub(super) train: std::borrow::Cow<'d, Dataset>,
+    /// Index in the data file of each training configuration.
+    pub(super) train_configs: Vec<usize>,
+    /// Validation data and what it is.
+    pub(super) test: Option<(std::borrow::Cow<'d, Dataset>, String)>,
+}
+
+impl<'d> Split<'d> {
+    pub(super) fn of(data: &'d Dataset, opts: &'d IdentifySettings) -> Result<Split<'d>, Error> {
+        let h = opts.holdout;
+        if !(0.0..1.0).contains(&h) {
+            return Err(Error::Input(format!(
+                "the holdout fraction {h} must be in [0, 1) (0: no held-out validation)"
+            )));
+        }
+        let all: Vec<usize> = (0..data.configurations.len()).collect();
+        match (&opts.test, h > 0.0) {
+            (Some(_), true) => Err(Error::Input(
+                "give either a holdout fraction or test data for validation, not both".into(),
+            )),
+            (Some(test), false) => Ok(Split {
+                train: std::borrow::Cow::Borrowed(data),
+                train_configs: all,
+                test: Some((std::borrow::Cow::Borrowed(test), test.source.clone())),
+            }),
+            (None, true) => {
+                let (train, test) = holdout_split(all.len(), h, opts.seed);
+                if test.is_empty() {
+                    return Err(Error::Input(format!(
+                        "the holdout fraction {h} of {} configurations holds out none; hold out a larger fraction",
+                        all.len()
+                    )));
+                }
+                Ok(Split {
+                    train: std::borrow::Cow::Owned(data.subset(&train)),
+                    train_configs: train,
+                    test: Some((
+                        std::borrow::Cow::Owned(data.subset(&test)),
+                        format!(
+                            "{} of the {} configurations of {} held out at random (seed {})",
+                            test.len(),
+                            all.len(),
+                            data.source,
+                            opts.seed
+                        ),
+                    )),
+                })
+            }
+            (None, false) => Ok(Split {
+                train: std::borrow::Cow::Borrowed(data),
+                train_configs: all,
+                test: None,
+            }),
+        }
+    }
+
+    /// Validation of the fit `calibrated` of `model` on the test data (`None` without).
+    pub(super) fn validate(
+        &self,
+        model: &Model,
+        calibrated: &[f64],
+        opts: &IdentifySettings,
+        noise: &crate::measure::NoiseModel,
+    ) -> Result<Option<Validation>, Error> {
+        let Some((test, source)) = &self.test else {
+            return Ok(None);
+        };
+        let frames = frames_first_start(model, &self.train, noise, opts)?;
+        let eval = Problem::new(model, test, noise)?;
+        let mut ws = eval.workspace();
+        let mut axes = |params: &[f64]| {
+            let xyz: Vec<[f64; 3]> = residuals::position_components(&eval, &mut ws, params)
+                .into_iter()
+                .flatten()
+                .collect();
+            AxisErrors::of(&xyz)
+        };
+        let per_axis = HeldOutAxes {
+            nominal: axes(&model.nominal()),
+            frames_only: axes(&frames),
+            calibrated: axes(calibrated),
+        };
+        Ok(Some(Validation {
+            per_axis: Some(per_axis),
+            test_data: source.clone(),
+            train_configurations: self.train.configurations.len(),
+            test_configurations: test.configurations.len(),
+            train_ids: self.train.config_ids.clone(),
+            test_ids: test.config_ids.clone(),
+            nominal: ErrorStats::of(&eval.errors(&mut ws, &model.nominal())),
+            frames_only: ErrorStats::of(&eval.errors(&mut ws, &frames)),
+            calibrated: ErrorStats::of(&eval.errors(&mut ws, calibrated)),
+        }))
+    }
+}
