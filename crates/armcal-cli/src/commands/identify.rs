@@ -99,11 +99,11 @@ pub fn print_summary(e: &Estimate) {
         e.cell, e.measurements, e.configurations, e.data
     );
     println!(
-        "solver {:?}{}: {} after {} iterations, {:.1} ms",
-        e.solver.method,
+        "solver {}{}: {} after {} iterations, {:.1} ms",
+        e.solver.method.words(),
         e.solver
             .robust
-            .map(|l| format!(" + robust {l:?}"))
+            .map(|l| format!(" + robust {}", l.words()))
             .unwrap_or_default(),
         e.solver.status,
         e.solver.iterations,

@@ -105,9 +105,12 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     for j in &model.joints {
         let f = j.kind.unit().display_factor();
         println!(
-            "  {:<6} {:?} [{:.2}, {:.2}] {}",
+            "  {:<6} {} [{:.2}, {:.2}] {}",
             j.name,
-            j.kind,
+            match j.kind {
+                armcal::model::JointKind::Revolute => "revolute",
+                armcal::model::JointKind::Prismatic => "prismatic",
+            },
             j.lower * f,
             j.upper * f,
             j.kind.unit().display_name()
@@ -120,10 +123,14 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     );
     match c.expected_for_measurement {
         Some(n) => println!(
-            "expected identifiable from {measurement:?} measurements in generic geometry: {n}"
+            "expected identifiable from {} measurements in generic geometry: {n}",
+            measurement.words()
         ),
         None => {
-            println!("no closed-form count for {measurement:?} measurements of several targets")
+            println!(
+                "no closed-form count for {} measurements of several targets",
+                measurement.words()
+            )
         }
     }
     println!(

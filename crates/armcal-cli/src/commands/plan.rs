@@ -139,10 +139,10 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         (&report_path, &serde_json::to_string_pretty(&record)?),
     ])?;
     println!(
-        "{} poses for `{}`, criterion {:?}: value {:.6} ({} {:.6}; refinement {}) in {:.2} s",
+        "{} poses for `{}`, criterion {}: value {:.6} ({} {:.6}; refinement {}) in {:.2} s",
         rep.design.len(),
         cell.name,
-        rep.criterion,
+        rep.criterion.words(),
         rep.value,
         if record.pool.is_some() {
             "pool selection"

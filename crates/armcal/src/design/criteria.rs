@@ -64,6 +64,21 @@ impl Criterion {
         })
     }
 
+    /// The criterion in words, for output: `A`, `D`, `E`, `KPI`, `O1` … `O5`.
+    pub fn words(self) -> &'static str {
+        match self {
+            Criterion::A => "A",
+            Criterion::D => "D",
+            Criterion::E => "E",
+            Criterion::Kpi => "KPI",
+            Criterion::O1 => "O1",
+            Criterion::O2 => "O2",
+            Criterion::O3 => "O3",
+            Criterion::O4 => "O4",
+            Criterion::O5 => "O5",
+        }
+    }
+
     /// The name [`Criterion::from_name`] reads (and the files carry): `a`, `d`, `e`, `kpi`,
     /// `o1` … `o5`.
     pub fn name(self) -> &'static str {

@@ -56,6 +56,16 @@ pub enum Method {
 }
 
 impl Method {
+    /// The method in words, for output: `Levenberg–Marquardt`, `Gauss–Newton`, `recursive
+    /// (Kalman filter)`.
+    pub fn words(self) -> &'static str {
+        match self {
+            Method::Lm => "Levenberg–Marquardt",
+            Method::GaussNewton => "Gauss–Newton",
+            Method::Kalman => "recursive (Kalman filter)",
+        }
+    }
+
     /// The method named `lm`, `gn` / `gauss-newton` or `kalman`; `None` for another name.
     pub fn from_name(s: &str) -> Option<Method> {
         match s {

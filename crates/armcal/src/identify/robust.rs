@@ -27,6 +27,14 @@ pub enum Loss {
 }
 
 impl Loss {
+    /// The loss in words, for output: `Huber`, `Cauchy`.
+    pub fn words(self) -> &'static str {
+        match self {
+            Loss::Huber => "Huber",
+            Loss::Cauchy => "Cauchy",
+        }
+    }
+
     /// The loss named `huber` or `cauchy`; `None` for another name.
     pub fn from_name(s: &str) -> Option<Loss> {
         match s {

@@ -114,7 +114,7 @@ impl IdentifiabilityVerdict {
     ) -> IdentifiabilityVerdict {
         let expected = expected_count(model, measurement);
         let fixed: Vec<String> = fixed_reasons.iter().map(|(n, _)| n.clone()).collect();
-        let what = format!("{measurement:?}").to_lowercase();
+        let what = measurement.words();
         let left_out = if fixed.is_empty() {
             String::new()
         } else {

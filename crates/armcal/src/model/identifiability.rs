@@ -40,6 +40,15 @@ pub enum Measurement {
 }
 
 impl Measurement {
+    /// The measurement in words, for output: `pose`, `position`, `distance`.
+    pub fn words(self) -> &'static str {
+        match self {
+            Measurement::Pose => "pose",
+            Measurement::Position => "position",
+            Measurement::Distance => "distance",
+        }
+    }
+
     /// Parses `pose` (or `full-pose`), `position` or `distance`; `None` otherwise.
     pub fn from_name(s: &str) -> Option<Measurement> {
         match s {

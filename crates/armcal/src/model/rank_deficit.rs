@@ -42,10 +42,10 @@ impl std::fmt::Display for RankDeficit {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "{} of the {} parameters a complete model identifies from {:?} measurements: {}",
+            "{} of the {} parameters a complete model identifies from {} measurements: {}",
             self.identifiable,
             self.expected,
-            self.measurement,
+            self.measurement.words(),
             self.causes.join("; ")
         )
     }

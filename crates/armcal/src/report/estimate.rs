@@ -85,7 +85,7 @@ pub fn estimate_section(id: &str, label: &str, e: &Estimate) -> Result<Section, 
             "solver",
             format!(
                 "{}{}, {} — {} iterations",
-                super::verdict::method_name(sol.method),
+                sol.method.words(),
                 sol.robust
                     .map(|l| format!(" with robust {l:?} loss"))
                     .unwrap_or_default(),

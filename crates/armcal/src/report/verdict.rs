@@ -8,7 +8,7 @@
 use super::estimate::code_spans;
 use super::html::{escape, facts, fixed, number, Section};
 use crate::design::DesignRecord;
-use crate::identify::{Chi2Outcome, Estimate, Method};
+use crate::identify::{Chi2Outcome, Estimate};
 use crate::Error;
 
 /// How an estimate or a design fares.
@@ -49,15 +49,6 @@ fn flagged(html: String, grade: Grade) -> String {
     }
 }
 
-/// The solver in words.
-pub fn method_name(m: Method) -> &'static str {
-    match m {
-        Method::Lm => "Levenberg–Marquardt",
-        Method::GaussNewton => "Gauss–Newton",
-        Method::Kalman => "recursive (Kalman filter)",
-    }
-}
-
 /// The held-out improvement `1 − after/before` of the RMS error (`None` without a
 /// validation or with a zero nominal error).
 pub fn held_out_gain(e: &Estimate) -> Option<f64> {
@@ -70,7 +61,7 @@ fn estimate_lines(e: &Estimate) -> Vec<Line> {
     let mut lines = Vec::new();
     let solver = format!(
         "{}{}, {} iterations",
-        method_name(sol.method),
+        sol.method.words(),
         sol.robust
             .map(|l| format!(" with robust {l:?} loss"))
             .unwrap_or_default(),
