@@ -57,6 +57,7 @@ mod hostile {
     mod input_size;
     mod report_ranges;
     mod urdf_depth;
+    mod urdf_parser_panic;
 }
 mod report {
     mod cell_view;

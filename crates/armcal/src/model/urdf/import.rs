@@ -33,8 +33,20 @@ pub fn read_urdf(path: impl AsRef<Path>, tip: Option<&str>) -> Result<ModelSpec,
 /// a text nesting deeper than [`super::depth::MAX_DEPTH`] is refused before parsing.
 pub fn from_urdf_str(xml: &str, tip: Option<&str>) -> Result<ModelSpec, Error> {
     super::depth::check_depth(xml)?;
-    let robot = urdf_rs::read_from_string(xml)
-        .map_err(|e| Error::Input(format!("not a valid URDF document: {e}")))?;
+    // The XML parser under urdf-rs (RustyXML 0.3) panics on some malformed documents instead
+    // of returning an error: an attribute name with an undeclared namespace prefix
+    // (`effort="0":velocity="0"`, found by fuzz/urdf) hits an `expect` in its element code.
+    // No maintained release fixes it, so the panic is caught here and becomes the error it
+    // should have been (tests/suite/hostile/urdf_parser_panic.rs).
+    let parsed = std::panic::catch_unwind(|| urdf_rs::read_from_string(xml)).map_err(|_| {
+        Error::Input(
+            "not a valid URDF document: the XML parser gave up on it (a name with an \
+             undeclared namespace prefix, or a malformed attribute list); check the file with \
+             an XML validator"
+                .into(),
+        )
+    })?;
+    let robot = parsed.map_err(|e| Error::Input(format!("not a valid URDF document: {e}")))?;
     from_urdf_robot(&robot, tip)
 }
 
