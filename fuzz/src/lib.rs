@@ -8,6 +8,8 @@
 use armcal::cell::export::{export_model, ExportFormat};
 use armcal::cell::model_analysis::analyze_model;
 use armcal::design::assess::evaluate_design;
+use armcal::design::cell_constraints::unmeasurable_poses;
+use armcal::design::user_pool::{plan_from_pool, PoolSettings};
 use armcal::identify::IdentifySettings;
 use armcal::measure::csv;
 use armcal::model::complete::LinkForm;
@@ -86,8 +88,9 @@ fn data_cells() -> &'static [Cell; 2] {
     })
 }
 
-/// Data CSV → dataset (first byte chooses the cell) → a short identification, and the
-/// dataset written in armcal's format read back with the same rows.
+/// A CSV file through one of armcal's CSV readers; the first byte chooses the cell (bit 0)
+/// and the reader (bits 1–2): a data file (0), a pose list or pose pool (1), a program of
+/// Cartesian targets (2).
 pub fn data_csv(bytes: &[u8]) {
     let Some((&choice, rest)) = bytes.split_first() else {
         return;
@@ -96,6 +99,18 @@ pub fn data_csv(bytes: &[u8]) {
         return;
     };
     let cell = &data_cells()[usize::from(choice & 1)];
+    match (choice >> 1) & 3 {
+        1 => configurations(cell, text),
+        2 => {
+            let _ = csv::read_targets_str(text, "fuzz.csv", &cell.model);
+        }
+        _ => measurements(cell, text),
+    }
+}
+
+/// Data CSV → dataset → a short identification, and the dataset written in armcal's format
+/// read back with the same rows.
+fn measurements(cell: &Cell, text: &str) {
     let Ok((data, _)) = csv::read_format_str(text, "fuzz.csv", &cell.model, &cell.data_format())
     else {
         return;
@@ -118,6 +133,23 @@ pub fn data_csv(bytes: &[u8]) {
         ),
         Err(e) => panic!("armcal cannot read the data file it wrote: {e}\n{written}"),
     }
+}
+
+/// Pose list CSV → configurations → the measurability check of `simulate` and a plan from
+/// them as a pose pool (`plan --pool`, the fewest poses, no collision model).
+fn configurations(cell: &Cell, text: &str) {
+    let Ok(poses) =
+        csv::read_configurations_format_str(text, "fuzz.csv", &cell.model, &cell.data_format())
+    else {
+        return;
+    };
+    let _ = unmeasurable_poses(cell, &poses);
+    let settings = PoolSettings {
+        poses: 1,
+        collisions: false,
+        ..PoolSettings::default()
+    };
+    let _ = plan_from_pool(cell, &poses, "fuzz.csv", &settings, &[], &mut Silent);
 }
 
 /// URDF → model → forward kinematics → URDF → model: the same tool pose.
@@ -185,7 +217,7 @@ pub fn records(text: &str) {
                 let _ = evaluate_design(cell, &design, true);
             }
         }
-        Document::Study(_) | Document::Demo(_) => {}
+        Document::Study(_) | Document::Demo(_) | Document::Truth(_) => {}
     }
     let inputs = [Input {
         label: "fuzz".into(),

@@ -87,3 +87,29 @@ fn main() {
         std::process::exit(1);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Cli;
+    use clap::CommandFactory;
+
+    /// Issue 12 item 9: every flag and argument of every command says what it is in `--help`.
+    #[test]
+    fn every_argument_has_a_help_line() {
+        let cli = Cli::command();
+        let mut missing = Vec::new();
+        for command in cli.get_subcommands() {
+            for arg in command.get_arguments() {
+                let generated = matches!(arg.get_id().as_str(), "help" | "version");
+                if !generated && arg.get_help().is_none() {
+                    missing.push(format!("armcal {} {}", command.get_name(), arg.get_id()));
+                }
+            }
+        }
+        assert!(
+            missing.is_empty(),
+            "arguments without a help line:\n{}",
+            missing.join("\n")
+        );
+    }
+}

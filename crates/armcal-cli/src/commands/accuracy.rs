@@ -16,6 +16,7 @@ pub struct Args {
     /// Identified parameters; nominal if absent.
     #[arg(long)]
     pub estimate: Option<PathBuf>,
+    /// Print the report as JSON instead of tables.
     #[arg(long)]
     pub json: bool,
     #[command(flatten)]

@@ -17,6 +17,7 @@ pub struct Args {
     /// Write the axes as JSON.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Overwrite existing output files (never an input file).
     #[arg(long)]
     pub force: bool,
 }

@@ -24,8 +24,11 @@ pub struct Args {
     /// joint columns are then the starting guesses (e.g. the controller's nominal solution).
     #[arg(long)]
     pub targets: PathBuf,
+    /// Output: the compensated program (CSV: pose_id, the joints to command, for Cartesian
+    /// targets the pose to send, then status, position_error_mm, orientation_error_deg).
     #[arg(long)]
     pub out: PathBuf,
+    /// Overwrite existing output files (never an input file).
     #[arg(long)]
     pub force: bool,
     /// Calibration data (CSV, as for `identify`) on which to fit a polynomial correction of

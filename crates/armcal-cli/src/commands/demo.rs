@@ -14,6 +14,8 @@ pub struct Args {
     /// Output folder.
     #[arg(long, default_value = "out/demo")]
     pub out: PathBuf,
+    /// Seed of every random draw (the simulated robot's errors, the measurement noise, the
+    /// planner's starts): the same seed gives the same numbers.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// No progress display.

@@ -22,6 +22,7 @@ pub struct Args {
     /// type and fixed parameters, with `free = "auto"`, so every command accepts it unchanged.
     #[arg(long)]
     pub cell: Option<String>,
+    /// Overwrite existing output files (never an input file).
     #[arg(long)]
     pub force: bool,
     #[command(flatten)]

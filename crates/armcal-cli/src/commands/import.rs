@@ -15,6 +15,7 @@ pub struct Args {
     /// Output (armcal's CSV).
     #[arg(long)]
     pub out: PathBuf,
+    /// Overwrite existing output files (never an input file).
     #[arg(long)]
     pub force: bool,
 }

@@ -51,6 +51,7 @@ pub struct PlanArgs {
     /// Also write the JSON report (default: the design path with .json).
     #[arg(long)]
     pub report: Option<PathBuf>,
+    /// Overwrite existing output files (never an input file).
     #[arg(long)]
     pub force: bool,
     /// No progress display.
@@ -69,6 +70,7 @@ pub struct EvaluateArgs {
     /// Collision and line-of-sight constraints for the margin report.
     #[arg(long, default_value = "on", value_parser = ["on", "off"])]
     pub collisions: String,
+    /// Print the evaluation (criteria, covariances, constraint margins) as JSON instead of text.
     #[arg(long)]
     pub json: bool,
 }

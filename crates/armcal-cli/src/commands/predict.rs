@@ -19,6 +19,7 @@ pub struct Args {
     /// Output (CSV, the columns of a data file).
     #[arg(long)]
     pub out: PathBuf,
+    /// Overwrite existing output files (never an input file).
     #[arg(long)]
     pub force: bool,
     #[command(flatten)]

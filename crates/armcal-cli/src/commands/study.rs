@@ -21,6 +21,8 @@ pub struct Args {
     /// Robots: table6 (the three KUKA robots), notional (the 90 manipulators) or all.
     #[arg(long, default_value = "all", value_parser = ["table6", "notional", "all"])]
     pub robots: String,
+    /// Seed of every random draw (simulated robots, measurement noise, starts): the same seed
+    /// gives the same tables.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Directory for the CSV and JSON files [default: out/study-paper or out/study-puma].
@@ -29,6 +31,7 @@ pub struct Args {
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
+    /// Overwrite existing output files (never an input file).
     #[arg(long)]
     pub force: bool,
 }

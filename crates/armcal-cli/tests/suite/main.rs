@@ -11,5 +11,6 @@ mod import_cli;
 mod measurable_cli;
 mod outputs_cli;
 mod pool_cli;
+mod readme;
 mod scale;
 mod workflow;

@@ -1,0 +1,210 @@
+//! README transcripts are real (issue 12 item 11): every ```` ```text ```` block of README.md
+//! whose lines start with `$ ` is run, in document order, in one scratch folder that sees the
+//! repository's `examples/` and `data/`, and each command's output (stdout and stderr, as a
+//! terminal shows them) must be what README prints under it.
+//!
+//! README may leave out lines: a line that is only `…` stands for any number of lines, and a
+//! line ending in ` …` for a line that begins with what precedes the `…`. Durations
+//! (`0.55 s`, `0.9 ms`) are compared as "a duration", since they change from run to run.
+
+use super::common::scratch;
+use std::path::Path;
+use std::process::Command;
+
+/// One `$ command` of a README block and the lines README shows under it.
+struct Transcript {
+    /// README line of the command.
+    line: usize,
+    command: String,
+    expected: Vec<String>,
+}
+
+/// The transcripts of README's text blocks, in document order.
+fn transcripts(readme: &str) -> Vec<Transcript> {
+    let mut out: Vec<Transcript> = Vec::new();
+    let mut in_text_block = false;
+    // Whether the last transcript of `out` is the one the current line belongs to.
+    let mut collecting = false;
+    for (i, line) in readme.lines().enumerate() {
+        if line.starts_with("```") {
+            in_text_block = line == "```text" && !in_text_block;
+            collecting = false;
+        } else if let Some(command) = line.strip_prefix("$ ").filter(|_| in_text_block) {
+            out.push(Transcript {
+                line: i + 1,
+                command: command.to_string(),
+                expected: Vec::new(),
+            });
+            collecting = true;
+        } else if let Some(t) = out.last_mut().filter(|_| collecting) {
+            t.expected.push(line.to_string());
+        }
+    }
+    for t in &mut out {
+        while t.expected.last().is_some_and(|l| l.trim().is_empty()) {
+            t.expected.pop();
+        }
+    }
+    out
+}
+
+/// `line` with every duration (a number followed by ` s` or ` ms`) replaced by `<duration>`.
+fn without_durations(line: &str) -> String {
+    let chars: Vec<char> = line.chars().collect();
+    let mut out = String::with_capacity(line.len());
+    let mut i = 0;
+    while i < chars.len() {
+        let starts_number =
+            chars[i].is_ascii_digit() && (i == 0 || !chars[i - 1].is_alphanumeric());
+        if starts_number {
+            let mut j = i;
+            while j < chars.len() && (chars[j].is_ascii_digit() || chars[j] == '.') {
+                j += 1;
+            }
+            let rest: String = chars[j..].iter().take(4).collect();
+            let unit = [" ms", " s"].into_iter().find(|u| {
+                rest.starts_with(u)
+                    && chars
+                        .get(j + u.chars().count())
+                        .is_none_or(|c| !c.is_alphanumeric())
+            });
+            if let Some(u) = unit {
+                out.push_str("<duration>");
+                i = j + u.chars().count();
+                continue;
+            }
+            out.extend(&chars[i..j]);
+            i = j;
+            continue;
+        }
+        out.push(chars[i]);
+        i += 1;
+    }
+    out
+}
+
+/// Whether README's `expected` line stands for the printed line `actual`.
+fn line_matches(expected: &str, actual: &str) -> bool {
+    let (e, a) = (without_durations(expected), without_durations(actual));
+    match e.strip_suffix(" …") {
+        Some(prefix) => a.starts_with(prefix),
+        None => e == a,
+    }
+}
+
+/// Whether `segment` matches `actual` line by line from its start.
+fn segment_at(segment: &[String], actual: &[String]) -> bool {
+    segment.len() <= actual.len() && segment.iter().zip(actual).all(|(e, a)| line_matches(e, a))
+}
+
+/// Whether the `expected` transcript (with `…` lines standing for any lines) is `actual`.
+fn transcript_matches(expected: &[String], actual: &[String]) -> bool {
+    let segments: Vec<&[String]> = expected.split(|l| l == "…").collect();
+    let (first, rest) = segments
+        .split_first()
+        .expect("split gives one segment at least");
+    if !segment_at(first, actual) {
+        return false;
+    }
+    if rest.is_empty() {
+        return first.len() == actual.len();
+    }
+    let (last, middle) = rest.split_last().expect("rest is not empty");
+    let mut at = first.len();
+    for segment in middle {
+        match (at..=actual.len()).find(|&k| segment_at(segment, &actual[k..])) {
+            Some(k) => at = k + segment.len(),
+            None => return false,
+        }
+    }
+    actual.len() >= at + last.len() && segment_at(last, &actual[actual.len() - last.len()..])
+}
+
+#[test]
+fn readme_transcripts_are_what_the_commands_print() {
+    let root = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."));
+    let readme = std::fs::read_to_string(root.join("README.md")).expect("README.md");
+    let transcripts = transcripts(&readme);
+    let demo = transcripts.iter().any(|t| t.command == "armcal demo");
+    let model = transcripts
+        .iter()
+        .any(|t| t.command.starts_with("armcal model "));
+    assert!(
+        demo && model,
+        "README has the demo's and the model's transcripts"
+    );
+
+    let dir = scratch("readme-transcripts");
+    let bin = dir.join("bin");
+    std::fs::create_dir_all(bin.join("..").join("out")).expect("out/");
+    std::fs::create_dir_all(&bin).expect("bin/");
+    std::os::unix::fs::symlink(env!("CARGO_BIN_EXE_armcal"), bin.join("armcal")).expect("armcal");
+    for folder in ["examples", "data"] {
+        std::os::unix::fs::symlink(root.join(folder).canonicalize().unwrap(), dir.join(folder))
+            .expect("a link to the repository's folder");
+    }
+    let path = format!(
+        "{}:{}",
+        bin.display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+
+    let mut failures = Vec::new();
+    for t in &transcripts {
+        let out = Command::new("sh")
+            .arg("-c")
+            .arg(format!("{} 2>&1", t.command))
+            .current_dir(&dir)
+            .env("PATH", &path)
+            .output()
+            .expect("run sh");
+        let text = String::from_utf8_lossy(&out.stdout);
+        let mut actual: Vec<String> = text.lines().map(str::to_string).collect();
+        while actual.last().is_some_and(|l| l.trim().is_empty()) {
+            actual.pop();
+        }
+        if !transcript_matches(&t.expected, &actual) {
+            failures.push(format!(
+                "README.md line {}: `$ {}`\n--- README shows:\n{}\n--- the command prints:\n{}",
+                t.line,
+                t.command,
+                t.expected.join("\n"),
+                actual.join("\n")
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n\n"));
+}
+
+#[test]
+fn the_transcript_matcher_checks_what_it_should() {
+    let lines = |s: &str| -> Vec<String> { s.lines().map(str::to_string).collect() };
+    let actual = lines("a\nb in 0.55 s\nc\nd\ne");
+    assert!(transcript_matches(
+        &lines("a\nb in 3.1 s\nc\nd\ne"),
+        &actual
+    ));
+    assert!(transcript_matches(&lines("a\n…\nd\ne"), &actual));
+    assert!(transcript_matches(&lines("a\n…\nc\n…"), &actual));
+    assert!(transcript_matches(&lines("a\nb …\n…\ne"), &actual));
+    assert!(
+        !transcript_matches(&lines("a\nb in 0.55 s\nc"), &actual),
+        "a missing tail"
+    );
+    assert!(
+        !transcript_matches(&lines("a\n…\nc\nb …"), &actual),
+        "out of order"
+    );
+    assert!(
+        !transcript_matches(&lines("b …\n…"), &actual),
+        "a missing first line"
+    );
+    assert!(
+        !transcript_matches(&lines("a\n…\nx\n…"), &actual),
+        "a line not printed"
+    );
+    assert_eq!(
+        without_durations("v2 60 poses (0.6 s), 9 ms, 3 sweeps"),
+        "v2 60 poses (<duration>), <duration>, 3 sweeps"
+    );
+}
