@@ -6,6 +6,7 @@ use super::progress::Progress;
 use anyhow::bail;
 use armcal::design::assess::evaluate_design;
 use armcal::design::plan::PlanSettings;
+use armcal::design::record::KindMargin;
 use armcal::design::user_pool::{PoolReport, PoolSettings};
 use armcal::design::Criterion;
 use armcal::design::DesignRecord;
@@ -155,24 +156,24 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         rep.refine_status.as_deref().unwrap_or("skipped"),
         rep.time.as_secs_f64()
     );
-    println!(
-        "constraints: {} per pose; {} (smallest margin {})",
-        rep.constraints_per_pose,
-        if rep.feasible {
-            "every pose feasible"
-        } else {
-            "NOT FEASIBLE"
-        },
-        rep.min_margin
-            .as_ref()
-            .map(|m| format!(
-                "{:.4} on `{}` at pose {}",
-                m.value,
-                m.constraint,
-                m.pose + 1
-            ))
-            .unwrap_or_else(|| "none".into())
-    );
+    match (rep.feasible, &rep.min_margin) {
+        (false, Some(m)) => println!(
+            "constraints: {} per pose; NOT FEASIBLE (worst: {:.4} on `{}` at pose {})",
+            rep.constraints_per_pose,
+            m.value,
+            m.constraint,
+            m.pose + 1
+        ),
+        (false, None) => println!(
+            "constraints: {} per pose; NOT FEASIBLE",
+            rep.constraints_per_pose
+        ),
+        (true, _) => println!(
+            "constraints: {} per pose; every pose feasible",
+            rep.constraints_per_pose
+        ),
+    }
+    print_margins(&record.margins);
     match rep.bound.as_ref().map(|b| (b, b.efficiency)) {
         Some((b, Some(e))) => println!(
             "optimality bound: no {}-pose design can go below {:.6}; this design's efficiency {e:.3}",
@@ -270,18 +271,7 @@ pub fn run_evaluate(a: &EvaluateArgs) -> anyhow::Result<()> {
     }
     let infeasible = &ev.infeasible_poses;
     match (&ev.min_margin, infeasible.is_empty()) {
-        (margin, true) => println!(
-            "every pose feasible; smallest margin {}",
-            margin
-                .as_ref()
-                .map(|m| format!(
-                    "{:.4} on `{}` at pose {}",
-                    m.value,
-                    m.constraint,
-                    m.pose + 1
-                ))
-                .unwrap_or_else(|| "none".into())
-        ),
+        (_, true) => println!("every pose feasible"),
         (Some(m), false) => println!(
             "{} poses violate constraints ({}); worst: {:.4} on `{}` at pose {}",
             infeasible.len(),
@@ -296,20 +286,26 @@ pub fn run_evaluate(a: &EvaluateArgs) -> anyhow::Result<()> {
         ),
         (None, false) => println!("{} poses outside the joint limits", infeasible.len()),
     }
-    if !ev.margins.is_empty() {
-        println!("least margin per constraint kind (required: the cell's [design]):");
-        for m in &ev.margins {
-            println!(
-                "  {:<15} {:>10.3} {:<3}  required {:>7.3}  {}  (`{}` at pose {})",
-                m.kind,
-                m.value,
-                m.unit,
-                m.required,
-                if m.meets { "met" } else { "NOT MET" },
-                m.constraint,
-                m.pose
-            );
-        }
-    }
+    print_margins(&ev.margins);
     Ok(())
+}
+
+/// The least margin of each kind of constraint against what the cell's `[design]` asks.
+fn print_margins(margins: &[KindMargin]) {
+    if margins.is_empty() {
+        return;
+    }
+    println!("least margin per constraint kind (required: the cell's [design]):");
+    for m in margins {
+        println!(
+            "  {:<15} {:>10.3} {:<3}  required {:>7.3}  {}  (`{}` at pose {})",
+            m.kind,
+            m.value,
+            m.unit,
+            m.required,
+            if m.meets { "met" } else { "NOT MET" },
+            m.constraint,
+            m.pose
+        );
+    }
 }

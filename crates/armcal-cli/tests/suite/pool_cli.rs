@@ -151,6 +151,33 @@ fn plan_from_a_2000_row_pool() {
     );
     assert_every_pose_feasible(&refined);
 
+    // The report shows where each pose came from and the rows refused.
+    let (ok, out, err) = armcal(&[
+        "report",
+        dir.join("refined.json").to_str().unwrap(),
+        "--out",
+        dir.join("report").to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(ok, "{out}\n{err}");
+    let page = std::fs::read_to_string(dir.join("report/report.html")).unwrap();
+    assert!(
+        page.contains(&format!(
+            "2000 rows, {feasible} feasible, {} infeasible (never chosen); refined within ±1.5",
+            infeasible.len()
+        )),
+        "the pose pool summary"
+    );
+    assert!(page.contains("<h3>Pose pool</h3>"));
+    let first_chosen = &record["pool"]["chosen"][0];
+    assert!(page.contains(&format!(
+        "<td class=\"num\">1</td><td class=\"num\">{}</td>",
+        first_chosen["row"]
+    )));
+    assert!(
+        page.contains(&format!("the first 200 of {}", infeasible.len())) || infeasible.len() <= 200
+    );
+
     // Too few feasible rows: the first 30 rows hold fewer than the 9 poses 27 parameters need.
     let small = dir.join("small.csv");
     std::fs::write(&small, write_configurations(&cell.model, &qs[..30])).unwrap();

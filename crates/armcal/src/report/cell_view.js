@@ -242,10 +242,13 @@
   }
 
   function describe(design, pose) {
-    var status = pose.ok ? 'feasible' : 'VIOLATES ' + pose.violations.join('; ');
+    var short = pose.below_required.length;
+    var status = !pose.ok ? 'VIOLATES ' + pose.violations.join('; ') :
+      short ? 'feasible, but closer than the cell\'s [design] asks: ' + pose.below_required.join('; ') : 'feasible';
     if (label) {
       label.textContent = 'pose ' + (view.pose + 1) + ' / ' + design.poses.length + ' \u2014 ' +
-        (pose.ok ? 'feasible' : 'violates ' + pose.violations.length + ' constraint(s)');
+        (!pose.ok ? 'violates ' + pose.violations.length + ' constraint(s)' :
+          short ? 'feasible, ' + short + ' margin(s) below [design]' : 'feasible');
     }
     if (poseText) {
       var q = pose.q.map(function (v, j) { return scene.joints[j].name + ' = ' + v.toFixed(2) + ' ' + scene.joints[j].unit; });

@@ -22,7 +22,7 @@
 
 use super::html::escape;
 use crate::cell::{half_space_unit_normal, Cell, Obstacle};
-use crate::design::cell_constraints::robot_capsules;
+use crate::design::cell_constraints::{robot_capsules, JOINT_MARGIN_TOLERANCE};
 use crate::design::plan::constraint_set;
 use crate::design::ConstraintKind;
 use crate::model::{forward_kinematics, Data};
@@ -88,6 +88,9 @@ struct PoseView {
     incidence: Option<f64>,
     /// Joints outside their limits and violated constraints.
     violations: Vec<String>,
+    /// Constraints met but closer than the cell's `[design]` asks (a distance under
+    /// `clearance_mm`, a joint within `joint_margin_deg` of a limit), each with its value.
+    below_required: Vec<String>,
     /// Indices (into `robot`) of the capsules named in violated constraints.
     hit: Vec<usize>,
     /// Names of the obstacles and half-spaces named in violated constraints.
@@ -233,6 +236,9 @@ fn scene(cell: &Cell, designs: &[(&str, &[Vec<f64>])]) -> Result<Scene, Error> {
     let params = model.nominal();
     let mut data = Data::<f64>::new(model);
     let (lower, upper) = model.joint_limits();
+    // The limits shrunk by the cell's joint margin (revolute joints), as the planner keeps them.
+    let (planned_lower, planned_upper) = set.joint_bounds();
+    let (planned_lower, planned_upper) = (planned_lower.to_vec(), planned_upper.to_vec());
     let display: Vec<f64> = model
         .joints
         .iter()
@@ -276,15 +282,25 @@ fn scene(cell: &Cell, designs: &[(&str, &[Vec<f64>])]) -> Result<Scene, Error> {
             });
 
             let mut violations = Vec::new();
+            let mut below_required = Vec::new();
             for (j, v) in q.iter().enumerate() {
+                let unit = model.joints[j].kind.unit().display_name();
                 if *v < lower[j] || *v > upper[j] {
                     violations.push(format!(
-                        "{} = {:.2} outside [{:.2}, {:.2}] {}",
+                        "{} = {:.2} outside [{:.2}, {:.2}] {unit}",
                         model.joints[j].name,
                         v * display[j],
                         lower[j] * display[j],
                         upper[j] * display[j],
-                        model.joints[j].kind.unit().display_name()
+                    ));
+                } else if *v < planned_lower[j] - JOINT_MARGIN_TOLERANCE
+                    || *v > planned_upper[j] + JOINT_MARGIN_TOLERANCE
+                {
+                    below_required.push(format!(
+                        "{} {:.2} {unit} from its limit (joint_margin_deg {:.2})",
+                        model.joints[j].name,
+                        (v - lower[j]).min(upper[j] - v) * display[j],
+                        cell.design.joint_margin.to_degrees()
                     ));
                 }
             }
@@ -302,6 +318,13 @@ fn scene(cell: &Cell, designs: &[(&str, &[Vec<f64>])]) -> Result<Scene, Error> {
                     let name = set.name(i);
                     violations.push(name.to_string());
                     mark_named(name, &robot, cell, &mut hit, &mut hit_obstacles);
+                } else if *v < set.required(i) {
+                    below_required.push(format!(
+                        "{} {:.1} mm (clearance_mm {:.1})",
+                        set.name(i),
+                        mm(*v),
+                        mm(set.required(i))
+                    ));
                 }
             }
             hit.sort_unstable();
@@ -319,6 +342,7 @@ fn scene(cell: &Cell, designs: &[(&str, &[Vec<f64>])]) -> Result<Scene, Error> {
                 clearance: clearance.map(|(v, n)| (mm(v), n)),
                 incidence: incidence.map(|b| round_to(b, 100.0)),
                 violations,
+                below_required,
                 hit,
                 hit_obstacles,
             });

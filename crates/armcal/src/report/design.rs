@@ -1,10 +1,12 @@
 //! The report section of one design: how it was made (criterion, solver statistics, the
 //! optimality bound and efficiency), its predicted precision (C_p, C_s), the poses as joint
-//! plots against the joint limits, and the smallest margin of every kind of constraint.
+//! plots against the joint limits, the smallest margin of every kind of constraint, and for
+//! a design chosen from the user's pose pool the pool row of each pose and the rows refused.
 
 use super::estimate::observability_table;
 use super::figures::{bar_figure, joint_figure, JointTrace};
 use super::html::{escape, facts, fixed, number, table, Section};
+use crate::design::user_pool::PoolReport;
 use crate::design::Criterion;
 use crate::design::DesignRecord;
 use crate::Error;
@@ -49,16 +51,26 @@ pub fn design_section(id: &str, label: &str, d: &DesignRecord) -> Result<Section
                 number(p.value)
             ),
         ));
+        let refinement = format!(
+            "refinement: {} ({} iterations)",
+            escape(p.refine_status.as_deref().unwrap_or("skipped")),
+            p.refine_iterations
+        );
         rows.push((
             "solver",
-            format!(
-                "candidate pool from {} random draws; exchange: {} after {} sweeps; refinement: {} ({} iterations)",
-                p.pool_draws,
-                number(p.exchange_value),
-                p.exchange_sweeps,
-                escape(p.refine_status.as_deref().unwrap_or("skipped")),
-                p.refine_iterations
-            ),
+            match &d.pool {
+                Some(pool) => format!(
+                    "{} → {}; {refinement}",
+                    escape(&pool.selection),
+                    number(pool.selection_value)
+                ),
+                None => format!(
+                    "candidate pool from {} random draws; exchange: {} after {} sweeps; {refinement}",
+                    p.pool_draws,
+                    number(p.exchange_value),
+                    p.exchange_sweeps,
+                ),
+            },
         ));
         rows.push((
             "feasibility",
@@ -124,7 +136,13 @@ pub fn design_section(id: &str, label: &str, d: &DesignRecord) -> Result<Section
             ),
         ));
     }
+    if let Some(pool) = &d.pool {
+        rows.push(("pose pool", pool_summary(pool)));
+    }
     s.html(facts(&rows));
+    if let Some(pool) = &d.pool {
+        pool_tables(&mut s, pool);
+    }
 
     s.html("<h3>Criteria and observability</h3>\n<p class=\"note\">Every criterion's value for this design (minimised; computed with the instrument's stated σ), and the observability indices of its identification Jacobian (larger is better).</p>\n");
     let crow: Vec<Vec<String>> = a
@@ -233,4 +251,73 @@ pub fn design_section(id: &str, label: &str, d: &DesignRecord) -> Result<Section
         }
     }
     Ok(s)
+}
+
+/// Most infeasible pool rows listed on the page; the design record lists them all.
+const INFEASIBLE_ROWS_SHOWN: usize = 200;
+
+/// The pose pool of a design planned with `plan --pool`, in one line.
+fn pool_summary(pool: &PoolReport) -> String {
+    let refinement = match pool.refine_radius {
+        Some(r) => format!(
+            "refined within ±{} per joint (deg; mm for a prismatic joint) of the pool poses, largest joint move {}",
+            number(r),
+            fixed(pool.largest_move, 4)
+        ),
+        None => "not refined: the design is pool rows exactly".into(),
+    };
+    format!(
+        "<code>{}</code>: {} rows, {} feasible, {} infeasible (never chosen); {refinement}",
+        escape(&pool.file),
+        pool.rows,
+        pool.feasible,
+        pool.infeasible.len()
+    )
+}
+
+/// The pool row behind each pose of the design, and the infeasible rows with their cause.
+fn pool_tables(s: &mut Section, pool: &PoolReport) {
+    s.html("<h3>Pose pool</h3>\n<p class=\"note\">The pool row (1-based, header not counted) and <code>pose_id</code> of each pose of the design, in design-file order: a refined pose started from that row.</p>\n");
+    let chosen: Vec<Vec<String>> = pool
+        .chosen
+        .iter()
+        .enumerate()
+        .map(|(k, r)| vec![(k + 1).to_string(), r.row.to_string(), escape(&r.id)])
+        .collect();
+    s.html(table(
+        &["design pose", "pool row", "pose_id"],
+        &chosen,
+        &[0, 1],
+    ));
+    if pool.infeasible.is_empty() {
+        return;
+    }
+    let shown = pool.infeasible.len().min(INFEASIBLE_ROWS_SHOWN);
+    s.html(format!(
+        "<p class=\"note\">Infeasible pool rows{}: the violated constraint with the smallest margin (a joint past its limit comes first). They were never chosen.</p>\n",
+        if shown < pool.infeasible.len() {
+            format!(
+                " (the first {shown} of {}; the design record's <code>pool.infeasible</code> lists all)",
+                pool.infeasible.len()
+            )
+        } else {
+            String::new()
+        }
+    ));
+    let infeasible: Vec<Vec<String>> = pool.infeasible[..shown]
+        .iter()
+        .map(|r| {
+            vec![
+                r.pose.row.to_string(),
+                escape(&r.pose.id),
+                escape(&r.constraint),
+                format!("{} {}", fixed(r.margin, 3), escape(&r.unit)),
+            ]
+        })
+        .collect();
+    s.html(table(
+        &["pool row", "pose_id", "violated constraint", "margin"],
+        &infeasible,
+        &[0, 3],
+    ));
 }

@@ -271,6 +271,50 @@ fn pose_status_follows_the_constraints() {
     assert!(obstacle_hits > 0);
 }
 
+/// With a `[design]` clearance and joint margin, a pose the robot can take but that keeps
+/// less than them is flagged `below_required` (issue 12 item 5): exactly the feasible poses
+/// that the planner's own feasibility test at the clearance refuses.
+#[test]
+fn poses_closer_than_the_cell_asks_are_flagged() {
+    let text = CELL
+        .replace("clearance_mm = 0", "clearance_mm = 50")
+        .replace("joint_margin_deg = 0", "joint_margin_deg = 5");
+    let cell = Cell::from_toml(&text, "clearance.toml", Path::new(".")).expect("cell");
+    let physical = Cell::from_toml(CELL, "no-clearance.toml", Path::new(".")).expect("cell");
+    let design = random_configurations(&cell.model, 150, 5);
+    let html = cell_view_section(&cell, &[("random", &design)]).unwrap();
+    let s = scene_json(&html);
+    let poses = s["designs"][0]["poses"].as_array().unwrap();
+    let (with_clearance, without) = (
+        constraint_set(&cell, true).unwrap(),
+        constraint_set(&physical, true).unwrap(),
+    );
+    let (mut ws, params) = (with_clearance.workspace(), cell.model.nominal());
+    let (mut short_distance, mut short_joint) = (0, 0);
+    for (q, pose) in design.iter().zip(poses) {
+        let below = pose["below_required"].as_array().unwrap();
+        assert_eq!(
+            pose["ok"].as_bool(),
+            Some(without.feasible(&mut ws, &params, q))
+        );
+        let meets_cell = with_clearance.feasible(&mut ws, &params, q);
+        assert_eq!(
+            pose["ok"].as_bool().unwrap() && below.is_empty(),
+            meets_cell,
+            "pose {q:?}: {below:?}"
+        );
+        for b in below.iter().map(|b| b.as_str().unwrap()) {
+            short_distance += usize::from(b.contains("(clearance_mm 50.0)"));
+            short_joint += usize::from(b.contains("(joint_margin_deg 5.00)"));
+        }
+    }
+    assert!(
+        short_distance > 0 && short_joint > 0,
+        "{short_distance} {short_joint}"
+    );
+    assert!(include_str!("../../../src/report/cell_view.js").contains("below_required"));
+}
+
 #[test]
 fn sections_on_one_page_do_not_clash_and_repeat_exactly() {
     let cell = cell();
