@@ -189,17 +189,31 @@ pub fn tcp_jacobian_world(
     free: &[usize],
     working: &[Vec<f64>],
 ) -> DMatrix<f64> {
-    let mut g = DMatrix::zeros(3 * working.len(), free.len());
-    let mut data = Data::new(model);
-    for (i, q) in working.iter().enumerate() {
-        forward_kinematics(model, &mut data, params, q);
+    tcp_rows(model, params, free, working, |data, g, row| {
         let p = data.tool().trans;
         for (c, &j) in free.iter().enumerate() {
             if model.registry.get(j).segment == Segment::Chain {
                 let v = data.param_twists[j].point_velocity(&p);
-                g.view_mut((3 * i, c), (3, 1)).copy_from(&v);
+                g.view_mut((row, c), (3, 1)).copy_from(&v);
             }
         }
+    })
+}
+
+/// The `3·working × free` matrix whose rows `fill(data, g, 3i)` writes from the forward
+/// kinematics at working configuration `i`.
+fn tcp_rows(
+    model: &Model,
+    params: &[f64],
+    free: &[usize],
+    working: &[Vec<f64>],
+    mut fill: impl FnMut(&Data<f64>, &mut DMatrix<f64>, usize),
+) -> DMatrix<f64> {
+    let mut g = DMatrix::zeros(3 * working.len(), free.len());
+    let mut data = Data::new(model);
+    for (i, q) in working.iter().enumerate() {
+        forward_kinematics(model, &mut data, params, q);
+        fill(&data, &mut g, 3 * i);
     }
     g
 }
@@ -225,21 +239,9 @@ pub fn tcp_jacobian(
     free: &[usize],
     working: &[Vec<f64>],
 ) -> DMatrix<f64> {
-    let mut g = DMatrix::zeros(3 * working.len(), free.len());
-    let mut data = Data::new(model);
-    for (i, q) in working.iter().enumerate() {
-        forward_kinematics(model, &mut data, params, q);
-        identification_jacobian(
-            model,
-            &data,
-            Observed::Tool,
-            Rows::Position,
-            free,
-            &mut g,
-            3 * i,
-        );
-    }
-    g
+    tcp_rows(model, params, free, working, |data, g, row| {
+        identification_jacobian(model, data, Observed::Tool, Rows::Position, free, g, row);
+    })
 }
 
 /// `C_s = G C_p Gᵀ` per working configuration (paper appendix).
