@@ -217,3 +217,21 @@ fn cell_and_model_inputs_that_were_missing_checks() {
     let (ok, _, err) = armcal(&["model", &cell]);
     assert!(!ok && err.contains("two joints are named `j`"), "{err}");
 }
+
+/// A URDF the XML parser under urdf-rs panics on (found by fuzz/urdf, issue 15) gives
+/// armcal's error and nothing of the parser's panic.
+#[test]
+fn a_urdf_the_parser_panics_on_gives_only_the_error() {
+    let dir = scratch("error-causes-urdf-panic");
+    write(
+        &dir,
+        "bad.urdf",
+        "<robot name=\"r\"><link name=\"a\"/><link name=\"b\"/><joint name=\"q1\" type=\"revolute\">\
+         <parent link=\"a\"/><child link=\"b\"/><limit xmlns=\"0\" upper=\"0\" effort=\"0\":velocity=\"0\"/>\
+         </joint></robot>",
+    );
+    let cell = write(&dir, "bad.toml", "[robot]\nurdf = \"bad.urdf\"\n");
+    let (ok, _, err) = armcal(&["model", &cell]);
+    assert!(!ok && err.contains("not a valid URDF document"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+}

@@ -37,8 +37,15 @@ pub fn from_urdf_str(xml: &str, tip: Option<&str>) -> Result<ModelSpec, Error> {
     // of returning an error: an attribute name with an undeclared namespace prefix
     // (`effort="0":velocity="0"`, found by fuzz/urdf) hits an `expect` in its element code.
     // No maintained release fixes it, so the panic is caught here and becomes the error it
-    // should have been (tests/suite/hostile/urdf_parser_panic.rs).
-    let parsed = std::panic::catch_unwind(|| urdf_rs::read_from_string(xml)).map_err(|_| {
+    // should have been (tests/suite/hostile/urdf_parser_panic.rs). The default hook would
+    // still print the parser's panic message before armcal's error, so a silent hook stands
+    // in while it parses (process-wide: a panic of another thread in that window goes
+    // unprinted, but still unwinds and fails as it would).
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let parsed = std::panic::catch_unwind(|| urdf_rs::read_from_string(xml));
+    std::panic::set_hook(hook);
+    let parsed = parsed.map_err(|_| {
         Error::Input(
             "not a valid URDF document: the XML parser gave up on it (a name with an \
              undeclared namespace prefix, or a malformed attribute list); check the file with \
