@@ -64,6 +64,7 @@ pub mod sim;
 pub mod solve;
 pub mod study;
 pub mod table;
+pub mod toml_text;
 pub mod workflow;
 
 pub use error::{Error, Result};

@@ -11,6 +11,7 @@ use crate::model::complete::LinkForm;
 use crate::model::export::{self as model_export, to_cell_toml_with, CellSections};
 use crate::model::{urdf, Model, ModelSpec, Status, Unit};
 use crate::robots::transfer_capsules;
+use crate::toml_text;
 use crate::Error;
 use std::fmt::Write;
 
@@ -26,12 +27,15 @@ pub fn to_cell_toml(cell: &Cell, identified: &Model, spec: &ModelSpec) -> Result
     for c in transfer_capsules(identified, &exported, &cell.capsules)? {
         let _ = writeln!(
             s.robot,
-            "[[robot.capsules]]\nframe = {:?}\na_mm = {:?}\nb_mm = {:?}\nradius_mm = {:?}\n",
-            c.frame, c.a, c.b, c.radius
+            "[[robot.capsules]]\nframe = {}\na_mm = {:?}\nb_mm = {:?}\nradius_mm = {:?}\n",
+            toml_text::string(&c.frame),
+            c.a,
+            c.b,
+            c.radius
         );
     }
     if let Some(i) = &cell.instrument {
-        let _ = writeln!(s.instrument, "kind = {:?}", i.kind);
+        let _ = writeln!(s.instrument, "kind = {}", toml_text::string(&i.kind));
         let noise = match &i.noise {
             NoiseModel::Constant { sigma, sigma_angle } => format!(
                 "{{ model = \"constant\", sigma_mm = {:?}, sigma_angle_deg = {:?} }}",
@@ -60,15 +64,17 @@ pub fn to_cell_toml(cell: &Cell, identified: &Model, spec: &ModelSpec) -> Result
                 .collect();
         let _ = writeln!(
             s.tail,
-            "\n[[working]]\nname = {:?}\njoints_deg = {q:?}\nweight = {:?}",
-            w.name, w.weight
+            "\n[[working]]\nname = {}\njoints_deg = {q:?}\nweight = {:?}",
+            toml_text::string(&w.name),
+            w.weight
         );
     }
     for o in &cell.obstacles {
         let _ = match o {
             Obstacle::Capsule { name, a, b, radius } => writeln!(
                 s.tail,
-                "\n[[obstacles]]\nname = {name:?}\nkind = \"capsule\"\na_mm = {a:?}\nb_mm = {b:?}\nradius_mm = {radius:?}"
+                "\n[[obstacles]]\nname = {}\nkind = \"capsule\"\na_mm = {a:?}\nb_mm = {b:?}\nradius_mm = {radius:?}",
+                toml_text::string(name)
             ),
             Obstacle::HalfSpace {
                 name,
@@ -76,7 +82,8 @@ pub fn to_cell_toml(cell: &Cell, identified: &Model, spec: &ModelSpec) -> Result
                 offset,
             } => writeln!(
                 s.tail,
-                "\n[[obstacles]]\nname = {name:?}\nkind = \"half-space\"\nnormal = {normal:?}\noffset_mm = {offset:?}"
+                "\n[[obstacles]]\nname = {}\nkind = \"half-space\"\nnormal = {normal:?}\noffset_mm = {offset:?}",
+                toml_text::string(name)
             ),
         };
     }
@@ -104,10 +111,10 @@ fn parameters(cell: &Cell, exported: &Model) -> String {
             continue;
         }
         match p.status {
-            Status::Fixed => fixed.push(format!("{:?}", p.name)),
+            Status::Fixed => fixed.push(toml_text::string(&p.name)),
             Status::Prior { sigma } => priors.push(format!(
-                "{:?} = {{ sigma_{} = {:?} }}",
-                p.name,
+                "{} = {{ sigma_{} = {:?} }}",
+                toml_text::string(&p.name),
                 if p.unit == Unit::Rad { "deg" } else { "mm" },
                 sigma * p.unit.display_factor()
             )),

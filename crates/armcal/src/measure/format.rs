@@ -27,6 +27,7 @@
 
 use crate::measure::angles::Orientation;
 use crate::model::{JointKind, Model};
+use crate::toml_text;
 use serde::{Deserialize, Serialize};
 
 /// How decimals are written in a file's numbers.
@@ -203,13 +204,16 @@ impl DataFormat {
     pub fn to_toml(&self) -> String {
         let mut out = Vec::new();
         if self.delimiter != ',' {
-            out.push(format!("delimiter = {:?}", self.delimiter.to_string()));
+            out.push(format!(
+                "delimiter = {}",
+                toml_text::string(&self.delimiter.to_string())
+            ));
         }
         if self.decimal == Decimal::Comma {
             out.push("decimal = \",\"".into());
         }
         if let Some(j) = &self.joints {
-            out.push(format!("joints = {j:?}"));
+            out.push(format!("joints = {}", toml_text::strings(j)));
         }
         if let Some(u) = self.joint_unit {
             out.push(format!("joint_unit = {:?}", u.name()));
@@ -218,8 +222,8 @@ impl DataFormat {
             c.as_ref().map(|c| {
                 let optional = if c.optional { ", optional = true" } else { "" };
                 format!(
-                    "{field} = {{ columns = {:?}, unit = {:?}{optional} }}",
-                    c.columns,
+                    "{field} = {{ columns = {}, unit = {:?}{optional} }}",
+                    toml_text::strings(&c.columns),
                     c.unit.name()
                 )
             })
@@ -231,8 +235,8 @@ impl DataFormat {
                 .map(|u| format!(", unit = {:?}", u.name()))
                 .unwrap_or_default();
             out.push(format!(
-                "orientation = {{ columns = {:?}{unit}, convention = {:?} }}",
-                o.columns,
+                "orientation = {{ columns = {}{unit}, convention = {:?} }}",
+                toml_text::strings(&o.columns),
                 o.convention.name()
             ));
         }
@@ -240,7 +244,8 @@ impl DataFormat {
         out.extend(three("sigma_orientation", &self.sigma_orientation));
         if let Some(t) = &self.temperature {
             out.push(format!(
-                "temperature = {{ column = {t:?}, unit = \"degC\" }}"
+                "temperature = {{ column = {}, unit = \"degC\" }}",
+                toml_text::string(t)
             ));
         }
         out.join("\n")

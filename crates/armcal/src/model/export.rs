@@ -7,6 +7,7 @@ use crate::model::convert;
 use crate::model::link::{Convention, JointKind};
 use crate::model::registry::{Segment, Unit};
 use crate::table::Table;
+use crate::toml_text;
 use crate::Error;
 use std::fmt::Write;
 
@@ -24,7 +25,7 @@ fn display(u: Unit, v: f64) -> f64 {
 
 fn link_toml(out: &mut String, table: &str, l: &LinkSpec, with_convention: bool) {
     let kind = l.joint.as_ref().map(|j| j.kind);
-    let _ = writeln!(out, "[[{table}]]\nname = \"{}\"", l.name);
+    let _ = writeln!(out, "[[{table}]]\nname = {}", toml_text::string(&l.name));
     if with_convention {
         let _ = writeln!(out, "convention = \"{}\"", l.geometry.convention.name());
     }
@@ -32,13 +33,13 @@ fn link_toml(out: &mut String, table: &str, l: &LinkSpec, with_convention: bool)
         let f = j.kind.unit().display_factor();
         let _ = writeln!(
             out,
-            "joint = \"{}\"\njoint_name = \"{}\"\nlimits = [{:?}, {:?}]",
+            "joint = \"{}\"\njoint_name = {}\nlimits = [{:?}, {:?}]",
             if j.kind == JointKind::Revolute {
                 "revolute"
             } else {
                 "prismatic"
             },
-            j.name,
+            toml_text::string(&j.name),
             j.lower * f,
             j.upper * f
         );
@@ -97,8 +98,10 @@ pub fn to_cell_toml(spec: &ModelSpec) -> Result<String, Error> {
 pub fn to_cell_toml_with(spec: &ModelSpec, sections: &CellSections) -> Result<String, Error> {
     let name = sections.name.as_deref().unwrap_or(&spec.name);
     let mut out = format!(
-        "# armcal model export: {}\nname = {name:?}\n\n[robot]\nname = \"{}\"\n\n",
-        spec.name, spec.name
+        "# armcal model export: {}\nname = {}\n\n[robot]\nname = {}\n\n",
+        toml_text::string(&spec.name),
+        toml_text::string(name),
+        toml_text::string(&spec.name)
     );
     for l in &spec.links {
         link_toml(&mut out, "robot.links", l, true);
@@ -113,8 +116,8 @@ pub fn to_cell_toml_with(spec: &ModelSpec, sections: &CellSections) -> Result<St
         }
         let _ = writeln!(
             out,
-            "[instrument]\nname = \"{}\"\n{}{}",
-            i.name,
+            "[instrument]\nname = {}\n{}{}",
+            toml_text::string(&i.name),
             frame_fields(&i.geometry.values),
             sections.instrument
         );
@@ -125,15 +128,18 @@ pub fn to_cell_toml_with(spec: &ModelSpec, sections: &CellSections) -> Result<St
             Convention::Point => {
                 let _ = writeln!(
                     out,
-                    "[[targets]]\nname = \"{}\"\nxyz_mm = [{:?}, {:?}, {:?}]\n",
-                    t.name, v[0], v[1], v[2]
+                    "[[targets]]\nname = {}\nxyz_mm = [{:?}, {:?}, {:?}]\n",
+                    toml_text::string(&t.name),
+                    v[0],
+                    v[1],
+                    v[2]
                 );
             }
             Convention::Frame6 => {
                 let _ = writeln!(
                     out,
-                    "[[targets]]\nname = \"{}\"\n{}",
-                    t.name,
+                    "[[targets]]\nname = {}\n{}",
+                    toml_text::string(&t.name),
                     frame_fields(v)
                 );
             }

@@ -53,6 +53,7 @@ mod real_data {
     mod ur10_import;
 }
 mod hostile {
+    mod cell_export_strings;
     mod cell_values;
     mod input_size;
     mod report_ranges;

@@ -12,7 +12,14 @@ const ABOVE_REPORT: &[&str] = &["workflow"];
 /// The layers of docs/DESIGN.md, bottom first: a module imports only from lower layers.
 const LAYERS: &[&[&str]] = &[
     &[
-        "solve", "progress", "error", "json", "input", "table", "linalg",
+        "solve",
+        "progress",
+        "error",
+        "json",
+        "input",
+        "table",
+        "toml_text",
+        "linalg",
     ],
     &["model", "geometry"],
     &["robots", "measure"],
