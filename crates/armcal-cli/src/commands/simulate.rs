@@ -51,7 +51,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let outputs = Outputs::plan(a.force, &[Path::new(&a.cell), &a.poses], &outs)?;
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
-    let poses = csv::read_configurations(&a.poses, model, None)?;
+    let poses = csv::read_reachable_configurations(&a.poses, model)?;
     let unmeasurable = unmeasurable_poses(&cell, &poses)?;
     if !unmeasurable.is_empty() {
         let (n, total) = (unmeasurable.len(), poses.len());

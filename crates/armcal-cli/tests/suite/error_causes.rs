@@ -235,3 +235,32 @@ fn a_urdf_the_parser_panics_on_gives_only_the_error() {
     assert!(!ok && err.contains("not a valid URDF document"), "{err}");
     assert!(!err.contains("panicked"), "{err}");
 }
+
+/// A pose to simulate beyond a joint limit is refused with the file, line, pose and joint.
+#[test]
+fn a_pose_beyond_a_limit_names_its_file_and_line() {
+    let dir = scratch("error-causes-pose-limits");
+    let poses = write(
+        &dir,
+        "poses.csv",
+        "pose_id,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg\n\
+         a,0,-30,30,0,-60,0\nb,100,-30,30,0,-60,0\n",
+    );
+    let out = dir.join("data.csv");
+    let (ok, _, err) = armcal(&[
+        "simulate",
+        "--cell",
+        "examples/paper-cell.toml",
+        "--poses",
+        &poses,
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && err.contains(
+            "poses.csv: line 3 (pose `b`): joint `q1` = 100.0000 deg is outside its limits"
+        ),
+        "{err}"
+    );
+    assert!(!out.exists());
+}

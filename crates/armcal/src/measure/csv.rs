@@ -260,6 +260,29 @@ pub fn read_configurations_format_str(
     model: &Model,
     format: &DataFormat,
 ) -> Result<Vec<(String, Vec<f64>)>, Error> {
+    configurations(text, file, model, format, Limits::Unchecked)
+}
+
+/// As [`read_configurations`] (armcal's joint columns), for poses the robot must take (a
+/// pose list to measure): a row with a joint outside its limits is an error naming the
+/// file, line, pose and joint.
+pub fn read_reachable_configurations(
+    path: &Path,
+    model: &Model,
+) -> Result<Vec<(String, Vec<f64>)>, Error> {
+    let (file, text) = read_data_file(path)?;
+    configurations(&text, &file, model, &DataFormat::armcal(), Limits::Checked)
+}
+
+/// The rows of a joint-configuration file; with [`Limits::Checked`] every row within the
+/// joint limits.
+fn configurations(
+    text: &str,
+    file: &str,
+    model: &Model,
+    format: &DataFormat,
+    limits: Limits,
+) -> Result<Vec<(String, Vec<f64>)>, Error> {
     let (mut rdr, header, lines) = reader(text, file, format)?;
     let mut used = vec![false; header.len()];
     let joints = format.joint_layout(&header, model, file, &mut used)?;
@@ -279,6 +302,11 @@ pub fn read_configurations_format_str(
         let id = id_col
             .map(|c| row.text(c).to_string())
             .unwrap_or_else(|| format!("{}", r + 1));
+        if limits == Limits::Checked {
+            model
+                .check_joints(&q)
+                .map_err(|e| err(file, format!("line {line} (pose `{id}`): {e}")))?;
+        }
         out.push((id, q));
     }
     if out.is_empty() {
@@ -338,7 +366,8 @@ pub fn read_targets_str(text: &str, file: &str, model: &Model) -> Result<Dataset
     read_rows(text, file, model, &DataFormat::armcal(), Limits::Unchecked).map(|(d, _)| d)
 }
 
-/// Whether the joint values of a file are measured ones, checked against the model's limits.
+/// Whether the joint values of a file are checked against the model's limits (measured joints
+/// with a tolerance and a warning, see `read_rows`; poses to take exactly).
 #[derive(Clone, Copy, PartialEq)]
 enum Limits {
     Checked,
