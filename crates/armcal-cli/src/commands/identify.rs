@@ -1,10 +1,10 @@
 //! `armcal identify`: calibrate the cell's free parameters from a data file.
 
-use super::output::{load_cell, load_data, Outputs};
+use super::output::{load_cell, load_data, load_estimate, AcceptUnconverged, Outputs};
 use super::progress::Progress;
 use anyhow::bail;
 use armcal::identify::{
-    identify, Estimate, IdentifySettings, LmSettings, Loss, Method, ToleranceSettings,
+    identify, Estimate, FramesRefit, IdentifySettings, LmSettings, Loss, Method, ToleranceSettings,
 };
 use std::path::{Path, PathBuf};
 
@@ -45,15 +45,34 @@ pub struct Args {
     /// No progress display.
     #[arg(long)]
     pub quiet: bool,
+    /// `frames`: keep every robot (link) parameter of --estimate and re-fit only the
+    /// instrument, base, tool and target frames (a re-installed tracker, a re-mounted
+    /// probe). Needs --estimate, of the same cell.
+    #[arg(long, value_parser = ["frames"], requires = "estimate")]
+    pub refit: Option<String>,
+    /// The estimate (estimate.json of the same cell) whose robot parameters --refit keeps.
+    #[arg(long, requires = "refit")]
+    pub estimate: Option<PathBuf>,
+    #[command(flatten)]
+    pub accept: AcceptUnconverged,
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let mut inputs = vec![Path::new(&a.cell), a.data.as_path()];
     inputs.extend(a.test.as_deref());
+    inputs.extend(a.estimate.as_deref());
     let outputs = Outputs::plan(a.force, &inputs, &[&a.out])?;
     let cell = load_cell(&a.cell)?;
     let data = load_data(&cell, &a.data)?;
     let test = a.test.as_deref().map(|t| load_data(&cell, t)).transpose()?;
+    let refit = match &a.estimate {
+        Some(path) => Some(FramesRefit {
+            estimate: load_estimate(path, &a.accept, Some(&cell.model))?.0,
+            origin: path.display().to_string(),
+            acceptance: a.accept.acceptance(),
+        }),
+        None => None,
+    };
     let opts = IdentifySettings {
         method: Method::from_name(&a.method).expect("clap checked"),
         robust: a.robust.as_deref().and_then(Loss::from_name),
@@ -67,6 +86,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
             },
             ..Default::default()
         },
+        refit,
     };
     let est = identify(&cell, &data, &opts, &mut Progress::new(a.quiet))?;
     outputs.commit(&[(&a.out, &serde_json::to_string_pretty(&est)?)])?;
@@ -129,6 +149,12 @@ pub fn print_summary(e: &Estimate) {
             println!("  - {r}");
         }
     }
+    if let Some(r) = &e.refit {
+        println!(
+            "\nframes refit: the {} robot parameters kept from {} (cell `{}`, fitted on {})",
+            r.kept, r.estimate, r.cell, r.data
+        );
+    }
     if let Some(d) = &e.rank_deficit {
         println!("\nbelow the generic count: {d}");
     }
@@ -168,6 +194,12 @@ pub fn print_summary(e: &Estimate) {
     println!("residuals (mm)      RMS        max        p95");
     for (n, s) in [("x", &r.x), ("y", &r.y), ("z", &r.z), ("|e|", &r.norm)] {
         println!("  {n:<6} {:>12.4} {:>10.4} {:>10.4}", s.rms, s.max, s.p95);
+    }
+    if let Some(s) = &r.orientation {
+        println!(
+            "orientation (deg)   mean {:.4}  RMS {:.4}  max {:.4}  p95 {:.4}",
+            s.mean, s.rms, s.max, s.p95
+        );
     }
     for (t, c) in e.tcp.iter().zip(&e.tcp_constrained) {
         println!(
@@ -213,16 +245,34 @@ pub fn print_summary(e: &Estimate) {
                 String::new()
             }
         );
+        let calibrated = if e.refit.is_some() {
+            "frames refitted"
+        } else {
+            "calibrated"
+        };
         println!("  model                     mean       RMS       max       p95   (mm)");
-        for (n, s) in [
+        print_stats_rows([
             ("nominal", &v.nominal),
             ("nominal + frames fitted", &v.frames_only),
-            ("calibrated", &v.calibrated),
-        ] {
-            println!(
-                "  {n:<24} {:>8.4} {:>9.4} {:>9.4} {:>9.4}",
-                s.mean, s.rms, s.max, s.p95
-            );
+            (calibrated, &v.calibrated),
+        ]);
+        if let Some(o) = &v.orientation {
+            println!("  orientation               mean       RMS       max       p95  (deg)");
+            print_stats_rows([
+                ("nominal", &o.nominal),
+                ("nominal + frames fitted", &o.frames_only),
+                (calibrated, &o.calibrated),
+            ]);
         }
+    }
+}
+
+/// One line per model of the held-out table: mean, RMS, max and p95.
+fn print_stats_rows(rows: [(&str, &armcal::accuracy::ErrorStats); 3]) {
+    for (n, s) in rows {
+        println!(
+            "  {n:<24} {:>8.4} {:>9.4} {:>9.4} {:>9.4}",
+            s.mean, s.rms, s.max, s.p95
+        );
     }
 }

@@ -12,5 +12,6 @@ mod measurable_cli;
 mod outputs_cli;
 mod pool_cli;
 mod readme;
+mod refit_cli;
 mod scale;
 mod workflow;

@@ -59,6 +59,11 @@ pub struct ResidualReport {
     pub z: ErrorStats,
     /// Euclidean position error per measurement (scalar error for distances and planes).
     pub norm: ErrorStats,
+    /// Orientation error of the pose measurements (degrees): the angle of the rotation
+    /// `R_model R_measᵀ` between predicted and measured orientation. `None` without pose
+    /// measurements (and in files of an older armcal).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orientation: Option<ErrorStats>,
     /// Every measurement's residual, in data order (for the report's histograms and
     /// per-pose plot).
     #[serde(default)]
@@ -108,6 +113,23 @@ pub struct Validation {
     /// measurements only); `None` in files of an older armcal.
     #[serde(default)]
     pub per_axis: Option<HeldOutAxes>,
+    /// The same three models' orientation errors (degrees, the angle of `R_model R_measᵀ`)
+    /// on the pose measurements; `None` without pose measurements.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orientation: Option<HeldOutOrientation>,
+}
+
+/// Held-out orientation error (degrees) before and after calibration
+/// ([`Validation::orientation`]): the angle of the rotation between the measured and the
+/// predicted orientation of every pose measurement.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct HeldOutOrientation {
+    /// Nominal model, nothing fitted (deg).
+    pub nominal: ErrorStats,
+    /// Only the frames fitted (deg).
+    pub frames_only: ErrorStats,
+    /// Full calibration (deg).
+    pub calibrated: ErrorStats,
 }
 
 /// Held-out error per axis before and after calibration ([`Validation::per_axis`]).
@@ -202,6 +224,11 @@ pub struct Estimate {
     /// (then only the parameter names are checked, [`Estimate::check_model`]).
     #[serde(default)]
     pub fingerprint: Option<ModelFingerprint>,
+    /// Set when this estimate is a frames refit (`identify` with
+    /// [`IdentifySettings::refit`](super::IdentifySettings::refit)): the estimate whose robot
+    /// parameters it kept.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refit: Option<super::RefitRecord>,
 }
 
 /// Whether the caller accepts an estimate whose fit did not converge (or that records no

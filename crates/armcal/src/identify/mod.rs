@@ -10,6 +10,7 @@ pub mod gauss_newton;
 pub mod kalman;
 pub mod lm;
 pub mod problem;
+pub mod refit;
 pub mod residuals;
 pub mod robust;
 pub mod solver;
@@ -18,14 +19,15 @@ pub mod uncertainty;
 pub mod verdicts;
 
 pub use estimate::{
-    Acceptance, AxisErrors, Estimate, HeldOutAxes, MeasurementResidual, ParameterEstimate,
-    ResidualReport, SolverReport, Usability, Validation,
+    Acceptance, AxisErrors, Estimate, HeldOutAxes, HeldOutOrientation, MeasurementResidual,
+    ParameterEstimate, ResidualReport, SolverReport, Usability, Validation,
 };
 pub use fingerprint::ModelFingerprint;
 pub use gauss_newton::gauss_newton;
 pub use kalman::{kalman_filter, KalmanSettings};
 pub use lm::{levenberg_marquardt, LmSettings};
 pub use problem::Problem;
+pub use refit::{FramesRefit, RefitRecord};
 pub use robust::{robust_fit, Loss, Outlier};
 pub use solver::{SolverResult, Status, ToleranceSettings};
 pub use uncertainty::{Chi2Outcome, Observability, ParameterUncertainty, TcpCovariance};
@@ -95,6 +97,9 @@ pub struct IdentifySettings {
     /// Settings of Levenberg–Marquardt (also inside a robust fit); Gauss–Newton stops by
     /// its tolerances.
     pub lm: LmSettings,
+    /// A frames refit ([`refit`]): keep the robot of this estimate and fit only the
+    /// instrument, base, tool and target frames. `None`: a full calibration.
+    pub refit: Option<FramesRefit>,
 }
 
 impl Default for IdentifySettings {
@@ -106,6 +111,7 @@ impl Default for IdentifySettings {
             test: None,
             seed: 1,
             lm: LmSettings::default(),
+            refit: None,
         }
     }
 }
@@ -188,21 +194,11 @@ pub fn frames_first_start(
     noise: &crate::measure::NoiseModel,
     opts: &IdentifySettings,
 ) -> Result<Vec<f64>, Error> {
-    let mut frames = frames_only(model);
+    let frames = frames_only(model);
     if frames.registry.free().is_empty() {
         return Ok(model.nominal());
     }
-    let measurement = data_measurement(data);
-    let report = crate::model::identifiability::analyze_at(
-        &frames,
-        &frames.nominal(),
-        &data.configurations,
-        &IdentifiabilitySettings {
-            measurement,
-            ..Default::default()
-        },
-    )?;
-    report.apply(&mut frames)?;
+    let (frames, _) = frames_model(&frames, data, &frames.nominal())?;
     let mut problem = Problem::new(&frames, data, noise)?;
     if problem.free.is_empty() {
         return Ok(model.nominal());
@@ -215,6 +211,27 @@ pub fn frames_first_start(
     };
     let (sol, _, _) = solve(&mut problem, &model.nominal(), &stage, &mut Silent)?;
     Ok(sol.params)
+}
+
+/// `frames` (a frames-only model, [`frames_only`]) with its free set reduced to what
+/// `data` identify at the parameters `at`, and the parameters left out with their reasons.
+fn frames_model(
+    frames: &Model,
+    data: &Dataset,
+    at: &[f64],
+) -> Result<(Model, Vec<crate::model::identifiability::Exclusion>), Error> {
+    let mut frames = frames.clone();
+    let report = crate::model::identifiability::analyze_at(
+        &frames,
+        at,
+        &data.configurations,
+        &IdentifiabilitySettings {
+            measurement: data_measurement(data),
+            ..Default::default()
+        },
+    )?;
+    report.apply(&mut frames)?;
+    Ok((frames, report.excluded))
 }
 
 /// The measurement type of a data set for the identifiability analysis, from its first
@@ -299,7 +316,10 @@ pub fn identify(
     let noise = cell.noise();
     let split = Split::of(data, opts)?;
     let train: &Dataset = &split.train;
-    let fit = fit_free_set(cell, train, &noise, opts, observer)?;
+    let fit = match &opts.refit {
+        Some(refit) => refit::fit_frames(cell, train, &noise, opts, refit, observer)?,
+        None => fit_free_set(cell, train, &noise, opts, observer)?,
+    };
     observer.start("uncertainty, observability and residuals", None);
     let estimate = estimate_of_fit(cell, data, opts, &split, fit, &noise, observer);
     observer.finish();
@@ -325,7 +345,12 @@ fn estimate_of_fit(
     let branch = crate::model::branch::nearest_branch(model, &sol.params);
     let sol = sol.in_branch(&branch, &problem.free);
     let names = problem.free_names();
-    let rank_deficit = if cell.auto_free {
+    let kept = (0..model.param_count())
+        .filter(|&i| !is_frame_parameter(model, i))
+        .count();
+    let rank_deficit = if let Some(refit) = &opts.refit {
+        refit::deficit(cell, refit, names.len(), kept)
+    } else if cell.auto_free {
         let declared = cell.declared_model();
         crate::model::rank_deficit::rank_deficit(
             &declared,
@@ -424,6 +449,7 @@ fn estimate_of_fit(
         validation,
         measurements: train.measurements.len(),
         configurations: train.configurations.len(),
+        refit: opts.refit.as_ref().map(|r| refit::record(r, kept)),
     })
 }
 

@@ -339,6 +339,24 @@ impl<'a> Problem<'a> {
         });
         errors
     }
+
+    /// Orientation error (rad) of every pose measurement at `params`: the angle of the
+    /// rotation `R_model R_measᵀ` between the predicted and the measured orientation, `‖φ‖`
+    /// of its rotation vector `φ = log(R_model R_measᵀ)` (the residual's rotation rows);
+    /// `None` for the measurements without an orientation. One entry per measurement.
+    pub fn orientation_errors(&self, ws: &mut Workspace, params: &[f64]) -> Vec<Option<f64>> {
+        let mut dummy = DMatrix::zeros(6, self.free.len());
+        let mut errors = vec![None; self.data.measurements.len()];
+        self.visit(ws, params, false, |i, a, b, block_r| {
+            let m = &self.data.measurements[i];
+            if let MeasurementKind::Pose { .. } = m.kind {
+                residual_rows(&m.kind, a, b, block_r, &mut dummy, 0);
+                let angle = (block_r[3].powi(2) + block_r[4].powi(2) + block_r[5].powi(2)).sqrt();
+                errors[i] = Some(angle);
+            }
+        });
+        errors
+    }
 }
 
 /// Measurement indices grouped by configuration (a counting sort, measurement order kept

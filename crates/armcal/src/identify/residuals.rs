@@ -63,10 +63,27 @@ pub fn residual_report(
         });
     }
     ResidualReport {
+        orientation: orientation_stats(problem, &mut ws, params),
         x: axes.x,
         y: axes.y,
         z: axes.z,
         norm: ErrorStats::of(&norms),
         per_measurement,
     }
+}
+
+/// Statistics of the orientation errors (degrees) of the pose measurements at `params`
+/// ([`Problem::orientation_errors`]); `None` when no measurement has an orientation.
+pub fn orientation_stats(
+    problem: &Problem,
+    ws: &mut Workspace,
+    params: &[f64],
+) -> Option<ErrorStats> {
+    let degrees: Vec<f64> = problem
+        .orientation_errors(ws, params)
+        .into_iter()
+        .flatten()
+        .map(f64::to_degrees)
+        .collect();
+    (!degrees.is_empty()).then(|| ErrorStats::of(&degrees))
 }

@@ -2,8 +2,8 @@
 //! on (a seeded random holdout, or the user's own test file).
 
 use super::{
-    frames_first_start, holdout_split, residuals, AxisErrors, HeldOutAxes, IdentifySettings,
-    Problem, Validation,
+    frames_first_start, holdout_split, residuals, AxisErrors, HeldOutAxes, HeldOutOrientation,
+    IdentifySettings, Problem, Validation,
 };
 use crate::accuracy::ErrorStats;
 use crate::measure::Dataset;
@@ -86,6 +86,21 @@ impl<'d> Split<'d> {
         let frames = frames_first_start(model, &self.train, noise, opts)?;
         let eval = Problem::new(model, test, noise)?;
         let mut ws = eval.workspace();
+        let orientation = |ws: &mut super::problem::Workspace, params: &[f64]| {
+            residuals::orientation_stats(&eval, ws, params)
+        };
+        let orientation = match (
+            orientation(&mut ws, &model.nominal()),
+            orientation(&mut ws, &frames),
+            orientation(&mut ws, calibrated),
+        ) {
+            (Some(nominal), Some(frames_only), Some(calibrated)) => Some(HeldOutOrientation {
+                nominal,
+                frames_only,
+                calibrated,
+            }),
+            _ => None,
+        };
         let mut axes = |params: &[f64]| {
             let xyz: Vec<[f64; 3]> = residuals::position_components(&eval, &mut ws, params)
                 .into_iter()
@@ -100,6 +115,7 @@ impl<'d> Split<'d> {
         };
         Ok(Some(Validation {
             per_axis: Some(per_axis),
+            orientation,
             test_data: source.clone(),
             train_configurations: self.train.configurations.len(),
             test_configurations: test.configurations.len(),

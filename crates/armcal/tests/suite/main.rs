@@ -15,6 +15,7 @@ mod model {
 mod identify {
     mod estimate_branch;
     mod estimate_checks;
+    mod frames_refit;
     mod honest_free_set;
     mod identification;
     mod identification_input;
