@@ -10,15 +10,13 @@
 //! world pose `T_f(q)` of each chain frame `f`; a robot capsule `(f, a, b, r)` is drawn from
 //! `T_f(q)·a` to `T_f(q)·b` with radius `r` (the same placement as
 //! [`ConstraintSet::evaluate`](crate::design::ConstraintSet::evaluate)). The beam runs from
-//! the instrument frame's origin (the tracker) to each target (reflector) position. A pose is
-//! marked violating, and its beam drawn red, when it lies outside the joint limits or any
-//! constraint of the planner's set (paper eq. 24b; [`constraint_set`]) is negative there; the
-//! capsules and obstacles named in the violated constraints are drawn red too.
-//!
-//! Half-spaces (wall, floor) are drawn as the polygon where their boundary plane `n·x = offset`
-//! cuts the scene's bounding box. The box holds every capsule (±radius) at every pose, the
-//! tracker and the targets, is stretched until each boundary plane crosses it, and gets a
-//! 200 mm margin.
+//! the instrument frame's origin (the tracker) to each target (reflector) position. A pose
+//! outside the joint limits or with a constraint of the planner's set (paper eq. 24b;
+//! [`constraint_set`]) negative is marked violating, its beam and the capsules and obstacles
+//! named drawn red; one that keeps less than the cell's `[design]` asks is listed as such.
+//! Half-spaces are drawn as the polygon where their plane `n·x = offset` cuts the scene's
+//! box: every capsule at every pose, the tracker and targets, stretched until each plane
+//! crosses it, plus 200 mm.
 
 use super::html::escape;
 use crate::cell::{half_space_unit_normal, Cell, Obstacle};
