@@ -53,6 +53,17 @@ fn series_b_robot_refitted_on_series_d_and_the_refusals() {
             .unwrap()
             < 0.1
     );
+    // The report shows the orientation errors, fitted and held out.
+    let report = dir.join("report");
+    let (ok, _, err) = armcal(&["report", &d, "--out", report.to_str().unwrap(), "--quiet"]);
+    assert!(ok, "{err}");
+    let page = std::fs::read_to_string(report.join("report.html")).unwrap();
+    assert!(
+        page.contains("<td>orientation</td>"),
+        "fitted orientation row"
+    );
+    assert!(page.contains("Orientation error of the held-out pose measurements"));
+    assert_eq!(page.matches("RMS (deg)").count(), 2);
     // An estimate of another cell (the paper robot) is refused, naming the file.
     let sim = dir.join("paper.csv").display().to_string();
     assert!(armcal(&simulate_paper_cell("1", &sim)).0);

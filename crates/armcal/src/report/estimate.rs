@@ -64,6 +64,16 @@ const STATS_HEAD: [&str; 6] = [
     "max (mm)",
 ];
 
+/// [`STATS_HEAD`] for angles.
+const STATS_HEAD_DEG: [&str; 6] = [
+    "",
+    "count",
+    "mean (deg)",
+    "RMS (deg)",
+    "95 % (deg)",
+    "max (deg)",
+];
+
 /// The section for `e`, labelled `label` (plain text), anchored at `id`.
 pub fn estimate_section(id: &str, label: &str, e: &Estimate) -> Result<Section, Error> {
     let mut s = Section::new(id, &format!("Estimate: {label}"));
@@ -247,6 +257,13 @@ pub fn estimate_section(id: &str, label: &str, e: &Estimate) -> Result<Section, 
         ],
         &[1, 2, 3, 4, 5],
     ));
+    if let Some(o) = &r.orientation {
+        s.html(table(
+            &STATS_HEAD_DEG,
+            &[stats_row("orientation", o)],
+            &[1, 2, 3, 4, 5],
+        ));
+    }
     let with_xyz: Vec<_> = r
         .per_measurement
         .iter()
@@ -341,6 +358,18 @@ pub fn estimate_section(id: &str, label: &str, e: &Estimate) -> Result<Section, 
                 v.test_configurations
             ),
         );
+        if let Some(o) = &v.orientation {
+            s.html("<p class=\"note\">Orientation error of the held-out pose measurements: the angle of the rotation between the measured and the predicted orientation (degrees).</p>\n");
+            s.html(table(
+                &STATS_HEAD_DEG,
+                &[
+                    stats_row("nominal", &o.nominal),
+                    stats_row("frames only", &o.frames_only),
+                    stats_row("calibrated", &o.calibrated),
+                ],
+                &[1, 2, 3, 4, 5],
+            ));
+        }
     }
     if !e.outliers.is_empty() {
         let orows: Vec<Vec<String>> = e
