@@ -104,8 +104,15 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         println!("{n}");
     }
     print_grouping(&rec.data, &rec.grouping);
-    let models = std::iter::once(&rec.before).chain(&rec.after);
-    for m in models {
+    println!();
+    print_report(&rec.before.model, &rec.before.report);
+    if rec.grouping.poses < FEW_POSES {
+        println!(
+            "  note: the frames were fitted to these {}: AP before is what they leave, and with fewer than {FEW_POSES} poses they take most of it",
+            count(rec.grouping.poses, "pose")
+        );
+    }
+    if let Some(m) = &rec.after {
         println!();
         print_report(&m.model, &m.report);
     }
@@ -114,6 +121,19 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     }
     Ok(())
 }
+
+/// `n` things, in the singular for one.
+fn count(n: usize, thing: &str) -> String {
+    if n == 1 {
+        format!("1 {thing}")
+    } else {
+        format!("{n} {thing}s")
+    }
+}
+
+/// Below this many commanded poses the frames fitted for "before" (up to 6 instrument and
+/// 6 tool parameters) take much of the AP with them.
+const FEW_POSES: usize = 12;
 
 /// "n poses approached k times", in words.
 fn times(k: usize) -> String {
@@ -131,9 +151,9 @@ fn print_grouping(data: &str, g: &GroupingSummary) {
         .map(|[k, n]| format!("{n} approached {}", times(*k)))
         .collect();
     println!(
-        "{data}: {} configurations, {} commanded poses (same pose within {} mm and {}°): {}",
+        "{data}: {} configurations, {} (same pose within {} mm and {}°): {}",
         g.configurations,
-        g.poses,
+        count(g.poses, "commanded pose"),
         g.tolerance.position_mm,
         g.tolerance.orientation_deg,
         counts.join(", ")
@@ -169,8 +189,8 @@ fn print_report(model: &str, r: &AccuracyReport) {
     }
     let s = &r.summary;
     println!(
-        "  ISO 9283 over {} poses: AP_P mean {:.4}, max {:.4} mm; RP_l mean {}, max {} mm ({} poses approached at least twice, {} at least {ISO_CYCLES} times)",
-        s.poses,
+        "  ISO 9283 over {}: AP_P mean {:.4}, max {:.4} mm; RP_l mean {}, max {} mm ({} approached at least twice, {} at least {ISO_CYCLES} times)",
+        count(s.poses, "pose"),
         s.ap.mean,
         s.ap.max,
         fig(s.rp.as_ref().map(|x| x.mean), 4),
@@ -196,8 +216,9 @@ fn print_report(model: &str, r: &AccuracyReport) {
     }
     if s.repeated < s.poses {
         println!(
-            "  {} poses approached once have AP only (RP needs at least 2 approaches; ISO 9283 asks {ISO_CYCLES})",
-            s.poses - s.repeated
+            "  {} approached once {} AP only (RP needs at least 2 approaches; ISO 9283 asks {ISO_CYCLES})",
+            count(s.poses - s.repeated, "pose"),
+            if s.poses - s.repeated == 1 { "has" } else { "have" }
         );
     }
     println!("  repeated poses (mm, deg):");
