@@ -57,6 +57,7 @@ pub mod json;
 pub mod linalg;
 pub mod measure;
 pub mod model;
+pub mod performance;
 pub mod progress;
 pub mod report;
 pub mod robots;

@@ -2,6 +2,7 @@
 
 mod common;
 
+mod accuracy_cli;
 mod browser;
 mod cli;
 mod compensate_cli;

@@ -172,7 +172,7 @@ fn compensate_export_and_accuracy() {
     ]);
     assert!(ok, "{err}");
     assert!(
-        out.contains("n = 18") && out.contains("= 0.0318 mm"),
+        out.contains("1 approached 18 times") && out.contains("RP_l mean 0.0318"),
         "{out}"
     );
 }

@@ -3,6 +3,7 @@
 
 pub mod iso9283;
 pub mod report;
+pub mod same_pose;
 pub mod stats;
 
 pub use stats::ErrorStats;

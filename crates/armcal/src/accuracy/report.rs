@@ -1,195 +1,277 @@
-//! Accuracy of a model against measurements, and ISO 9283 figures per commanded pose.
+//! Accuracy of a model against measurements, and the ISO 9283 pose characteristics of every
+//! commanded pose (§7.2 accuracy, §7.3 repeatability; position and, with pose measurements,
+//! orientation).
+//!
+//! The attained poses are the measurements brought into the robot's world (base) frame with
+//! the model's instrument pose; the command of a pose is the model's prediction at the
+//! joints the robot reported, averaged over the pose's approaches (they differ by the
+//! encoder and servo spread). With the nominal robot that is the pose the controller
+//! believes it reaches; with a calibrated model, the pose a controller compensated with the
+//! calibration would reach exactly. AP and RP components are along the world axes (ISO
+//! 9283's base coordinate system).
 
 use crate::accuracy::iso9283::{
-    position_accuracy, position_repeatability, Accuracy, Repeatability,
+    orientation_accuracy, orientation_repeatability, position_accuracy, position_repeatability,
+    Accuracy, OrientationAccuracy, OrientationRepeatability, Repeatability,
 };
+use crate::accuracy::same_pose::CommandedPoses;
 use crate::accuracy::ErrorStats;
 use crate::measure::{Dataset, MeasurementKind};
-use crate::model::{forward_kinematics, observed_position, Data, Model};
+use crate::model::jacobian::observed_world;
+use crate::model::pose::{rot_axis, rotation_log};
+use crate::model::{forward_kinematics, observed_position, Data, Model, Observed};
+use crate::Error;
+use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
-/// ISO 9283 figures of one commanded pose (a configuration measured several times).
+/// ISO 9283 figures of one commanded pose and observed frame.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct PoseFigures {
-    /// Configuration id (from the dataset) of the first measurement of the pose.
+    /// Configuration id (from the dataset) of the first approach of the pose.
     pub pose_id: String,
-    /// RP of the positions attained at this pose; `None` if measured only once.
-    pub repeatability: Option<Repeatability>,
-    /// AP against the model's prediction (the commanded position).
+    /// The frame measured: `tool` or a target's name.
+    pub observed: String,
+    /// Number of approaches `n` (measurements of this frame at this pose).
+    pub approaches: usize,
+    /// The commanded position `x_c` (mm, world frame).
+    pub command_mm: [f64; 3],
+    /// AP_P and AP_x, AP_y, AP_z against the command (§7.2.1).
     pub accuracy: Accuracy,
+    /// RP_l (§7.3.1); `None` for a pose approached once (RP needs at least two approaches;
+    /// ISO 9283 asks 30).
+    pub repeatability: Option<Repeatability>,
+    /// Orientation AP and RP; `None` without pose measurements of this frame here.
+    pub orientation: Option<OrientationFigures>,
 }
 
-/// Accuracy of a model on a dataset of position measurements.
+/// Orientation accuracy and repeatability of one pose.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct OrientationFigures {
+    /// AP_a, AP_b, AP_c (§7.2.2).
+    pub accuracy: OrientationAccuracy,
+    /// RP_a, RP_b, RP_c (§7.3.2); `None` for a pose approached once.
+    pub repeatability: Option<OrientationRepeatability>,
+}
+
+/// The figures over all poses.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Iso9283Summary {
+    /// Number of (pose, observed frame) entries.
+    pub poses: usize,
+    /// Of those, approached at least twice (with RP).
+    pub repeated: usize,
+    /// Of those, approached at least [`ISO_CYCLES`](crate::accuracy::iso9283::ISO_CYCLES)
+    /// times, as ISO 9283 asks.
+    pub iso_cycles: usize,
+    /// AP_P over the poses (mm).
+    pub ap: ErrorStats,
+    /// RP_l over the repeated poses (mm); `None` if no pose was approached twice.
+    pub rp: Option<ErrorStats>,
+    /// Largest |AP_a|, |AP_b|, |AP_c| over the poses (deg); `None` without orientation.
+    pub ap_abc_max_deg: Option<[f64; 3]>,
+    /// Largest RP_a, RP_b, RP_c over the repeated poses (deg); `None` without them.
+    pub rp_abc_max_deg: Option<[f64; 3]>,
+}
+
+/// Accuracy of a model on a dataset of position or pose measurements.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct AccuracyReport {
-    /// |measured − predicted| of every position measurement (mm).
+    /// |measured − predicted| of every position or pose measurement (mm).
     pub errors: ErrorStats,
-    /// ISO 9283 figures per commanded pose and observed point.
+    /// Angle between measured and predicted orientation of every pose measurement (deg);
+    /// `None` without pose measurements.
+    pub orientation_errors: Option<ErrorStats>,
+    /// ISO 9283 figures per commanded pose and observed frame, in data order.
     pub poses: Vec<PoseFigures>,
-    /// Largest RP over poses measured at least twice (mm).
-    pub worst_rp: Option<f64>,
+    /// The figures over all poses.
+    pub summary: Iso9283Summary,
 }
 
-/// Joint distance (rad or mm, largest over the joints) within which two configurations
-/// count as the same commanded pose: repeated approaches read slightly different encoder
-/// values.
-pub const SAME_POSE: f64 = 1e-3;
+/// Whether orientation figures must be given.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Orientation {
+    /// Orientation AP and RP where the data have pose measurements.
+    #[default]
+    IfMeasured,
+    /// Refuse data without pose measurements.
+    Required,
+}
 
-/// Groups configurations that are the same commanded pose: each configuration joins the
-/// first group whose first configuration is within [`SAME_POSE`] in every joint, else starts
-/// a group.
-///
-/// Linear in the number of configurations for measured data: the groups' first
-/// configurations are indexed by buckets of width [`SAME_POSE`] of the joint with the widest
-/// range, so a configuration is compared only with those in its own and the two neighbouring
-/// buckets (any group it can join is there). Hand-written because the query, "the earliest
-/// point within a box", is not what the k-d tree crates answer, and the buckets are ten lines.
-fn commanded_poses(data: &Dataset) -> Vec<Vec<usize>> {
-    let qs = &data.configurations;
-    let joints = qs.first().map_or(0, Vec::len);
-    let range = |j: usize| {
-        let (lo, hi) = qs
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| {
-                (lo.min(q[j]), hi.max(q[j]))
-            });
-        hi - lo
+/// `exp([φ])`, the rotation of rotation vector φ.
+fn rotation_exp(phi: &Vector3<f64>) -> Matrix3<f64> {
+    let angle = phi.norm();
+    if angle == 0.0 {
+        return Matrix3::identity();
+    }
+    rot_axis(&(phi / angle), angle)
+}
+
+/// The mean of rotations close to each other: `exp(mean log(R_j R_0ᵀ)) R_0`.
+fn mean_rotation(rots: &[Matrix3<f64>]) -> Matrix3<f64> {
+    let r0 = rots[0];
+    let mean = rots.iter().fold(Vector3::zeros(), |a, r| {
+        a + rotation_log(&(r * r0.transpose()))
+    }) / rots.len() as f64;
+    rotation_exp(&mean) * r0
+}
+
+/// The predictions and measurements of one observed frame at one commanded pose, in the
+/// world frame.
+#[derive(Default)]
+struct Samples {
+    predicted: Vec<Vector3<f64>>,
+    attained: Vec<Vector3<f64>>,
+    predicted_rot: Vec<Matrix3<f64>>,
+    attained_rot: Vec<Matrix3<f64>>,
+}
+
+/// The name of an observed frame.
+fn observed_name(model: &Model, o: Observed) -> String {
+    match o {
+        Observed::Tool => "tool".into(),
+        Observed::Target(k) => model.targets[k].spec.name.clone(),
+    }
+}
+
+/// Compares the model with parameters `params` with every position and pose measurement of
+/// `data` and gives the ISO 9283 figures of each of the commanded `poses` (found by
+/// [`commanded_poses`](crate::accuracy::same_pose::commanded_poses)). Fails on data with no
+/// position or pose measurement, and on data without pose measurements if orientation is
+/// [`Orientation::Required`].
+pub fn accuracy_report(
+    model: &Model,
+    params: &[f64],
+    data: &Dataset,
+    poses: &CommandedPoses,
+    orientation: Orientation,
+) -> Result<AccuracyReport, Error> {
+    let has = |pose: bool| {
+        data.measurements.iter().any(|m| match m.kind {
+            MeasurementKind::Pose { .. } => true,
+            MeasurementKind::Position { .. } => !pose,
+            _ => false,
+        })
     };
-    let key = (0..joints)
-        .max_by(|&a, &b| range(a).total_cmp(&range(b)))
-        .unwrap_or(0);
-    // Bucket of a joint value; finite joint values (checked on reading) keep it in range.
-    let bucket = |q: &[f64]| q.get(key).map_or(0, |v| (v / SAME_POSE).floor() as i64);
-    let mut groups: Vec<Vec<usize>> = Vec::new();
-    let mut firsts: std::collections::HashMap<i64, Vec<usize>> = Default::default();
-    for (c, q) in qs.iter().enumerate() {
-        let b = bucket(q);
-        let same = |g: &usize| {
-            qs[groups[*g][0]]
-                .iter()
-                .zip(q)
-                .all(|(a, b)| (a - b).abs() <= SAME_POSE)
-        };
-        let joined = (b - 1..=b + 1)
-            .filter_map(|k| firsts.get(&k))
-            .flat_map(|gs| gs.iter().filter(|g| same(g)))
-            .min()
-            .copied();
-        match joined {
-            Some(g) => groups[g].push(c),
-            None => {
-                firsts.entry(b).or_default().push(groups.len());
-                groups.push(vec![c]);
+    if !has(false) {
+        return Err(Error::Input(format!(
+            "{}: ISO 9283 accuracy and repeatability need position or pose measurements; \
+             these data have none (distances and planes give no attained position)",
+            data.source
+        )));
+    }
+    if orientation == Orientation::Required && !has(true) {
+        return Err(Error::Input(format!(
+            "{}: orientation accuracy and repeatability (ISO 9283 AP_a, AP_b, AP_c, RP_a, \
+             RP_b, RP_c) need pose measurements, and these data measure positions only: \
+             measure the tool's full pose (a 6-D probe, or three points per pose), or ask \
+             for position figures only",
+            data.source
+        )));
+    }
+    let mut by_config = vec![Vec::new(); data.configurations.len()];
+    for m in &data.measurements {
+        by_config[m.config].push(m);
+    }
+    let mut fk = Data::new(model);
+    let (mut errors, mut angle_errors) = (Vec::new(), Vec::new());
+    let mut figures = Vec::new();
+    for group in &poses.groups {
+        let mut samples: Vec<(Observed, Samples)> = Vec::new();
+        for &c in group {
+            forward_kinematics(model, &mut fk, params, &data.configurations[c]);
+            for m in &by_config[c] {
+                let (value, rot) = match &m.kind {
+                    MeasurementKind::Position { value, .. } => (*value, None),
+                    MeasurementKind::Pose { value, .. } => (value.trans, Some(value.rot)),
+                    _ => continue,
+                };
+                errors.push((value - observed_position(&fk, m.observed)).norm());
+                let world = *observed_world(&fk, m.observed);
+                let s = match samples.iter().position(|(o, _)| *o == m.observed) {
+                    Some(k) => &mut samples[k].1,
+                    None => {
+                        samples.push((m.observed, Samples::default()));
+                        &mut samples.last_mut().expect("just pushed").1
+                    }
+                };
+                s.predicted.push(world.trans);
+                s.attained.push(fk.instrument.transform_point(&value));
+                if let Some(r) = rot {
+                    let attained = fk.instrument.rot * r;
+                    angle_errors.push(
+                        rotation_log(&(attained * world.rot.transpose()))
+                            .norm()
+                            .to_degrees(),
+                    );
+                    s.predicted_rot.push(world.rot);
+                    s.attained_rot.push(attained);
+                }
             }
         }
+        for (obs, s) in samples {
+            let n = s.attained.len();
+            let command = s.predicted.iter().fold(Vector3::zeros(), |a, p| a + p) / n as f64;
+            let Some(accuracy) = position_accuracy(&command, &s.attained) else {
+                continue;
+            };
+            let orientation = (!s.attained_rot.is_empty()).then(|| {
+                let c = mean_rotation(&s.predicted_rot);
+                OrientationFigures {
+                    accuracy: orientation_accuracy(&c, &s.attained_rot)
+                        .expect("non-empty attained rotations"),
+                    repeatability: orientation_repeatability(&c, &s.attained_rot),
+                }
+            });
+            figures.push(PoseFigures {
+                pose_id: data.config_ids[group[0]].clone(),
+                observed: observed_name(model, obs),
+                approaches: n,
+                command_mm: [command[0], command[1], command[2]],
+                accuracy,
+                repeatability: position_repeatability(&s.attained),
+                orientation,
+            });
+        }
     }
-    groups
+    let summary = summarise(&figures);
+    Ok(AccuracyReport {
+        errors: ErrorStats::of(&errors),
+        orientation_errors: (!angle_errors.is_empty()).then(|| ErrorStats::of(&angle_errors)),
+        poses: figures,
+        summary,
+    })
 }
 
-/// Compares the model with parameters `params` with every position measurement of `data`;
-/// configurations within [`SAME_POSE`] of each other are one commanded pose (ISO 9283 RP
-/// and AP, the command being the model's prediction at the first of them).
-pub fn accuracy_report(model: &Model, params: &[f64], data: &Dataset) -> AccuracyReport {
-    let mut fk = Data::new(model);
-    let mut errors = Vec::new();
-    let mut poses = Vec::new();
-    let groups = commanded_poses(data);
-    // The measurements of each group, in the data's order (one pass, not one per group).
-    let mut group_of = vec![0; data.configurations.len()];
-    for (g, group) in groups.iter().enumerate() {
-        for &c in group {
-            group_of[c] = g;
-        }
-    }
-    let mut measurements = vec![Vec::new(); groups.len()];
-    for m in &data.measurements {
-        measurements[group_of[m.config]].push(m);
-    }
-    for (group, measured) in groups.iter().zip(measurements) {
-        let c = group[0];
-        forward_kinematics(model, &mut fk, params, &data.configurations[c]);
-        let mut by_target: Vec<(crate::model::Observed, Vec<nalgebra::Vector3<f64>>)> = Vec::new();
-        for m in measured {
-            let value = match &m.kind {
-                MeasurementKind::Position { value, .. } => *value,
-                MeasurementKind::Pose { value, .. } => value.trans,
-                _ => continue,
-            };
-            errors.push((value - observed_position(&fk, m.observed)).norm());
-            match by_target.iter_mut().find(|(o, _)| *o == m.observed) {
-                Some((_, v)) => v.push(value),
-                None => by_target.push((m.observed, vec![value])),
-            }
-        }
-        for (obs, pts) in by_target {
-            let commanded = observed_position(&fk, obs);
-            if let Some(accuracy) = position_accuracy(&commanded, &pts) {
-                poses.push(PoseFigures {
-                    pose_id: data.config_ids[c].clone(),
-                    repeatability: position_repeatability(&pts),
-                    accuracy,
-                });
-            }
-        }
-    }
-    let worst_rp = poses
+/// The largest of each of three values over the items that have them.
+fn max3(values: impl Iterator<Item = [f64; 3]>) -> Option<[f64; 3]> {
+    values.fold(None, |acc, v| {
+        Some(acc.map_or(v, |a: [f64; 3]| [0, 1, 2].map(|k| a[k].max(v[k]))))
+    })
+}
+
+fn summarise(figures: &[PoseFigures]) -> Iso9283Summary {
+    let rp: Vec<f64> = figures
         .iter()
         .filter_map(|p| p.repeatability.as_ref().map(|r| r.rp))
-        .fold(None, |a: Option<f64>, b| Some(a.map_or(b, |a| a.max(b))));
-    AccuracyReport {
-        errors: ErrorStats::of(&errors),
-        poses,
-        worst_rp,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use rand::{Rng, SeedableRng};
-
-    /// The grouping as first written: every configuration against every group (quadratic).
-    fn commanded_poses_by_scan(data: &Dataset) -> Vec<Vec<usize>> {
-        let mut groups: Vec<Vec<usize>> = Vec::new();
-        for (c, q) in data.configurations.iter().enumerate() {
-            let same = |g: &Vec<usize>| {
-                data.configurations[g[0]]
-                    .iter()
-                    .zip(q)
-                    .all(|(a, b)| (a - b).abs() <= SAME_POSE)
-            };
-            match groups.iter_mut().find(|g| same(g)) {
-                Some(g) => g.push(c),
-                None => groups.push(vec![c]),
-            }
-        }
-        groups
-    }
-
-    #[test]
-    fn bucketed_grouping_is_the_scan() {
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
-        for round in 0..20 {
-            let mut data = Dataset::default();
-            // Commanded poses on a coarse grid (so some lie within a few SAME_POSE of each
-            // other), each approached several times with encoder noise around SAME_POSE.
-            let commanded: Vec<Vec<f64>> = (0..30)
-                .map(|_| {
-                    (0..6)
-                        .map(|_| rng.random_range(0..4) as f64 * 1.5e-3)
-                        .collect()
-                })
-                .collect();
-            for k in 0..200 {
-                let base = &commanded[rng.random_range(0..commanded.len())];
-                let spread = if round % 2 == 0 { 0.6e-3 } else { 2e-3 };
-                let q = base
-                    .iter()
-                    .map(|v| v + rng.random_range(-spread..spread))
-                    .collect();
-                data.push_configuration(format!("p{k}"), q);
-            }
-            assert_eq!(commanded_poses(&data), commanded_poses_by_scan(&data));
-        }
+        .collect();
+    let orient = || figures.iter().filter_map(|p| p.orientation.as_ref());
+    Iso9283Summary {
+        poses: figures.len(),
+        repeated: rp.len(),
+        iso_cycles: figures
+            .iter()
+            .filter(|p| p.approaches >= crate::accuracy::iso9283::ISO_CYCLES)
+            .count(),
+        ap: ErrorStats::of(&figures.iter().map(|p| p.accuracy.ap).collect::<Vec<_>>()),
+        rp: (!rp.is_empty()).then(|| ErrorStats::of(&rp)),
+        ap_abc_max_deg: max3(orient().map(|o| {
+            let a = &o.accuracy;
+            [a.apa_deg.abs(), a.apb_deg.abs(), a.apc_deg.abs()]
+        })),
+        rp_abc_max_deg: max3(
+            orient()
+                .filter_map(|o| o.repeatability.as_ref())
+                .map(|r| [r.rpa_deg, r.rpb_deg, r.rpc_deg]),
+        ),
     }
 }

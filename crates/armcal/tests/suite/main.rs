@@ -48,9 +48,13 @@ mod book {
 mod files {
     mod read_back;
 }
+mod accuracy {
+    mod iso9283_cubes;
+}
 mod real_data {
     mod motoman_calibration;
     mod motoman_nominal;
+    mod ur10_cubes;
     mod ur10_import;
 }
 mod hostile {

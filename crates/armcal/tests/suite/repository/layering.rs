@@ -25,7 +25,7 @@ const LAYERS: &[&[&str]] = &[
     &["robots", "measure"],
     &["cell", "sim", "accuracy"],
     &["identify", "compensate"],
-    &["design"],
+    &["design", "performance"],
     &["study"],
     &["report"],
     &["workflow"],
