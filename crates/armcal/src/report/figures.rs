@@ -645,7 +645,7 @@ pub struct JointTrace {
 }
 
 /// The design's joint values pose by pose, one panel per joint, the joint limits drawn as
-/// red lines at the panel's edges.
+/// red lines (at the panel's edges when every value is within them).
 pub fn joint_figure(title: &str, joints: &[JointTrace]) -> Result<String, Error> {
     let cols = 3usize;
     let rows = joints.len().div_ceil(cols).max(1);
@@ -654,13 +654,19 @@ pub fn joint_figure(title: &str, joints: &[JointTrace]) -> Result<String, Error>
         let cells = body.split_evenly((rows, cols));
         for (i, (j, area)) in joints.iter().zip(&cells).enumerate() {
             let n = j.values.len().max(1) as f64;
-            let pad = 0.06 * (j.upper - j.lower).abs().max(1e-9);
+            // The axis spans the limits and every value: a value past a limit is drawn
+            // where it is (and a far one cannot map outside plotters' pixel range).
+            let (lo, hi) = j
+                .values
+                .iter()
+                .fold((j.lower, j.upper), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
+            let pad = 0.06 * (hi - lo).abs().max(1e-9);
             let mut chart = ChartBuilder::on(area)
                 .caption(format!("{} ({})", j.name, j.unit), (FAMILY, DESC))
                 .margin(8)
                 .x_label_area_size(40)
                 .y_label_area_size(56)
-                .build_cartesian_2d(0.5..(n + 0.5), axis(j.lower - pad, j.upper + pad)?)
+                .build_cartesian_2d(0.5..(n + 0.5), axis(lo - pad, hi + pad)?)
                 .map_err(drawing_error)?;
             styled_mesh(&mut chart)
                 .x_desc("pose")

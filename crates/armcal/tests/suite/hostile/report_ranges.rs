@@ -68,3 +68,32 @@ fn a_design_with_an_overflowing_joint_range_is_refused() {
         "{e}"
     );
 }
+
+/// Found by `fuzz/records`: a design whose joint value lies far outside the joint's limits
+/// (finite: −6.1e17 deg) overflowed plotters' pixel coordinates (the axis was the limits alone).
+#[test]
+fn a_joint_value_far_past_its_limits_draws() {
+    let joint = JointTrace {
+        name: "q1".into(),
+        unit: "deg".into(),
+        lower: -180.0,
+        upper: 180.0,
+        values: vec![0.0, -6.1e17, 1e300, -45.0],
+    };
+    let svg = joint_figure("j", &[joint]).expect("the figure draws");
+    // Every pose's dot lies inside the drawing (a wrapped pixel coordinate lies far out).
+    let coordinate = |attr: &str| -> Vec<f64> {
+        svg.split(&format!("{attr}=\""))
+            .skip(1)
+            .map(|rest| rest[..rest.find('"').unwrap()].parse().unwrap())
+            .collect()
+    };
+    let (cx, cy) = (coordinate("cx"), coordinate("cy"));
+    assert_eq!(cx.len(), 4, "{svg}");
+    for (x, y) in cx.iter().zip(&cy) {
+        assert!(
+            (0.0..=2000.0).contains(x) && (0.0..=2000.0).contains(y),
+            "dot at ({x}, {y})"
+        );
+    }
+}
