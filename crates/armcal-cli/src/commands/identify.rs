@@ -67,6 +67,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
             },
             ..Default::default()
         },
+        start: None,
     };
     let est = identify(&cell, &data, &opts, &mut Progress::new(a.quiet))?;
     outputs.commit(&[(&a.out, &serde_json::to_string_pretty(&est)?)])?;

@@ -95,6 +95,11 @@ pub struct IdentifySettings {
     /// Settings of Levenberg–Marquardt (also inside a robust fit); Gauss–Newton stops by
     /// its tolerances.
     pub lm: LmSettings,
+    /// Warm start: every parameter of the cell's model (internal units), e.g. a previous
+    /// estimate of the same cell on part of these data ([`Estimate::params_for`]); the fit
+    /// starts there instead of at the frames-first start ([`frames_first_start`]), and the
+    /// free set is decided there. `None`: the frames-first start.
+    pub start: Option<Vec<f64>>,
 }
 
 impl Default for IdentifySettings {
@@ -106,6 +111,7 @@ impl Default for IdentifySettings {
             test: None,
             seed: 1,
             lm: LmSettings::default(),
+            start: None,
         }
     }
 }
@@ -472,9 +478,20 @@ fn fit_free_set(
         Some(g) => identifiable_model_given(cell, train, at, g),
         None => Ok((cell.model.clone(), Vec::new())),
     };
-    let mut at = phase(observer, "fitting the frames first", || {
-        frames_first_start(&declared, train, noise, opts)
-    })?;
+    let mut at = match &opts.start {
+        Some(start) if start.len() == declared.param_count() => start.clone(),
+        Some(start) => {
+            return Err(Error::Input(format!(
+                "the warm start has {} parameters; the model of cell `{}` has {}",
+                start.len(),
+                cell.name,
+                declared.param_count()
+            )))
+        }
+        None => phase(observer, "fitting the frames first", || {
+            frames_first_start(&declared, train, noise, opts)
+        })?,
+    };
     let mut decided = phase(observer, "choosing the identifiable parameters", || {
         decide(&at)
     })?;

@@ -19,6 +19,7 @@ const LAYERS: &[&[&str]] = &[
     &["cell", "sim", "accuracy"],
     &["identify", "compensate"],
     &["design"],
+    &["campaign"],
     &["study"],
     &["report"],
     &["workflow"],
