@@ -3,6 +3,7 @@
 mod common;
 
 mod browser;
+mod campaign_cli;
 mod cli;
 mod compensate_cli;
 mod error_causes;

@@ -14,10 +14,10 @@ use statrs::distribution::{ChiSquared, ContinuousCDF};
 pub const CONFIDENCE: f64 = 0.95;
 
 /// What "TCP σ" means in a campaign.
-pub const SIGMA_DEFINITION: &str = "σ = √((1/3) tr C_s) (mm), the RMS of the three axis σ's of the TCP position (tool origin in the instrument frame) at the working pose: the square root of the paper's KPI φ_A(C_s); C_s = s·G C_p Gᵀ with s the variance-factor scale";
+pub const SIGMA_DEFINITION: &str = "σ = √((1/3) tr C_s) (mm), the RMS of the three axis σ's of the TCP position (tool origin in the instrument frame) at the working pose: the square root of the paper's KPI φ_A(C_s); C_s = s·G C_p Gᵀ with s the variance-factor scale.";
 
 /// How σ̂₀² enters C_s.
-pub const VARIANCE_RULE: &str = "C_s is scaled by s = max(1, σ̂₀²) (s = 1 without redundancy): residuals larger than the stated instrument σ widen C_s, smaller ones never narrow it — σ̂₀² from a few dozen degrees of freedom scatters by ±√(2/dof) (±26 % at 30 dof), and a campaign that stopped on a low draw of σ̂₀² would claim more precision than it has";
+pub const VARIANCE_RULE: &str = "C_s is scaled by s = max(1, σ̂₀²) (s = 1 without redundancy): residuals larger than the stated instrument σ widen C_s, smaller ones never narrow it — σ̂₀² from a few dozen degrees of freedom scatters by ±√(2/dof) (±26 % at 30 dof), and a campaign that stopped on a low draw of σ̂₀² would claim more precision than it has.";
 
 /// χ²₃ quantile at [`CONFIDENCE`]: the 95 % ellipsoid of a 3-D Gaussian error e with
 /// covariance C is eᵀ C⁻¹ e ≤ 7.815.
