@@ -348,11 +348,10 @@ fn print_decision(state: &CampaignState, files: &Files) {
             last.predicted_total_poses.unwrap_or(0)
         ),
         _ => println!(
-            "→ {} after {} poses: {} (σ as {}; {:.0} % ellipsoids eᵀC_s⁻¹e ≤ {:.3})",
+            "→ {} after {} poses: {} (σ as √((1/3) tr C_s), C_s scaled by max(1, σ̂₀²); {:.0} % ellipsoids eᵀC_s⁻¹e ≤ {:.3})",
             state.decision.words(),
             state.measured(),
             last.reason,
-            "√((1/3) tr C_s), C_s scaled by max(1, σ̂₀²)",
             100.0 * state.confidence,
             state.chi2_quantile
         ),
