@@ -37,6 +37,10 @@ enum Command {
     Plan(commands::plan::PlanArgs),
     /// Predicted C_p, C_s, criteria and constraint margins of any design.
     Evaluate(commands::plan::EvaluateArgs),
+    /// The adaptive measurement campaign (paper §6): measure a batch, identify, stop at the
+    /// target TCP precision or plan the next batch.
+    #[command(subcommand_required = true)]
+    Campaign(commands::campaign::Args),
     /// Filter a joint program or Cartesian targets through the calibrated model.
     Compensate(commands::compensate::Args),
     /// ISO 9283 accuracy and repeatability, and a model's errors, from a data file.
@@ -78,6 +82,7 @@ fn main() {
         Command::Study(a) => commands::study::run_study(&a),
         Command::Report(a) => commands::report::run(&a),
         Command::Export(a) => commands::export::run(&a),
+        Command::Campaign(a) => commands::campaign::run(&a),
         Command::Compensate(a) => commands::compensate::run(&a),
         Command::Accuracy(a) => commands::accuracy::run(&a),
         Command::Axes(a) => commands::axes::run(&a),

@@ -46,6 +46,7 @@
 #![warn(missing_docs)]
 
 pub mod accuracy;
+pub mod campaign;
 pub mod cell;
 pub mod compensate;
 pub mod design;

@@ -87,6 +87,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
             ..Default::default()
         },
         refit,
+        start: None,
     };
     let est = identify(&cell, &data, &opts, &mut Progress::new(a.quiet))?;
     outputs.commit(&[(&a.out, &serde_json::to_string_pretty(&est)?)])?;

@@ -2,6 +2,7 @@
 
 pub mod accuracy;
 pub mod axes;
+pub mod campaign;
 pub mod compensate;
 pub mod demo;
 pub mod export;

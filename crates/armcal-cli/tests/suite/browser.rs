@@ -275,3 +275,67 @@ fn demo_report_draws_in_headless_chromium() {
         100.0 * share
     );
 }
+
+/// Issue 16: the report of a campaign's state draws its σ-vs-poses figure — a point per step
+/// that has a fit, and the dashed target and decision lines — in the browser.
+#[test]
+fn campaign_report_draws_in_headless_chromium() {
+    let Some(exe) = chromium() else {
+        if std::env::var("ARMCAL_REQUIRE_BROWSER").as_deref() == Ok("1") {
+            panic!("Chromium not found (ARMCAL_REQUIRE_BROWSER=1)");
+        }
+        eprintln!("skipped: Chromium not found (install Debian package `chromium`)");
+        return;
+    };
+    let work = Path::new(env!("CARGO_TARGET_TMPDIR")).join("browser-campaign");
+    let _ = std::fs::remove_dir_all(&work);
+    std::fs::create_dir_all(&work).expect("work dir");
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
+    let mut sim = Command::new(env!("CARGO_BIN_EXE_armcal"));
+    sim.current_dir(root)
+        .args(["campaign", "simulate", "--cell", "examples/paper-cell.toml"])
+        .args([
+            "--target-sigma-mm",
+            "0.7",
+            "--seed",
+            "3",
+            "--quiet",
+            "--out",
+        ])
+        .arg(work.join("c"));
+    run(sim, &work, "campaign-simulate");
+    let state = std::fs::read_to_string(work.join("c/campaign.json")).expect("campaign.json");
+    let steps = state.matches("\"decision\": ").count() - 1;
+    let mut report = Command::new(env!("CARGO_BIN_EXE_armcal"));
+    report
+        .arg("report")
+        .arg(work.join("c/campaign.json"))
+        .args(["--quiet", "--out"])
+        .arg(work.join("r"));
+    run(report, &work, "report");
+    let url = format!(
+        "file://{}",
+        work.join("r/report.html")
+            .canonicalize()
+            .expect("report path")
+            .display()
+    );
+    let dom = run(
+        browser(
+            &exe,
+            &work.join("profile-dom"),
+            &["--dump-dom".into()],
+            &url,
+        ),
+        &work,
+        "chromium-dump-dom",
+    );
+    let tag = "<svg data-figure=\"campaign-sigma\"";
+    let at = dom.find(tag).expect("the campaign's σ-vs-poses figure");
+    let svg = &dom[at..at + dom[at..].find("</svg>").expect("svg closes")];
+    let points = svg.matches("<circle").count();
+    assert!(points >= steps, "{points} points for {steps} steps");
+    assert!(svg.contains("target 0.700 mm"), "no target line");
+    assert!(svg.contains("stop: target reached"), "no stopping decision");
+    eprintln!("campaign figure: {points} points for {steps} steps");
+}

@@ -100,6 +100,11 @@ pub struct IdentifySettings {
     /// A frames refit ([`refit`]): keep the robot of this estimate and fit only the
     /// instrument, base, tool and target frames. `None`: a full calibration.
     pub refit: Option<FramesRefit>,
+    /// Warm start: every parameter of the cell's model (internal units), e.g. a previous
+    /// estimate of the same cell on part of these data ([`Estimate::params_for`]); the fit
+    /// starts there instead of at the frames-first start ([`frames_first_start`]), and the
+    /// free set is decided there. `None`: the frames-first start.
+    pub start: Option<Vec<f64>>,
 }
 
 impl Default for IdentifySettings {
@@ -112,6 +117,7 @@ impl Default for IdentifySettings {
             seed: 1,
             lm: LmSettings::default(),
             refit: None,
+            start: None,
         }
     }
 }
@@ -498,9 +504,20 @@ fn fit_free_set(
         Some(g) => identifiable_model_given(cell, train, at, g),
         None => Ok((cell.model.clone(), Vec::new())),
     };
-    let mut at = phase(observer, "fitting the frames first", || {
-        frames_first_start(&declared, train, noise, opts)
-    })?;
+    let mut at = match &opts.start {
+        Some(start) if start.len() == declared.param_count() => start.clone(),
+        Some(start) => {
+            return Err(Error::Input(format!(
+                "the warm start has {} parameters; the model of cell `{}` has {}",
+                start.len(),
+                cell.name,
+                declared.param_count()
+            )))
+        }
+        None => phase(observer, "fitting the frames first", || {
+            frames_first_start(&declared, train, noise, opts)
+        })?,
+    };
     let mut decided = phase(observer, "choosing the identifiable parameters", || {
         decide(&at)
     })?;

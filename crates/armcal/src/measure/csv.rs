@@ -652,13 +652,24 @@ pub fn joint_display(joint: &Joint, q: f64) -> f64 {
 /// and one column per joint, `_deg` for revolute and `_mm` for prismatic joints — the format
 /// [`read_configurations`] reads.
 pub fn write_configurations(model: &Model, qs: &[Vec<f64>]) -> String {
+    let numbered: Vec<(String, &[f64])> = qs
+        .iter()
+        .enumerate()
+        .map(|(i, q)| ((i + 1).to_string(), q.as_slice()))
+        .collect();
+    write_poses(model, &numbered)
+}
+
+/// Writes joint configurations with their own `pose_id`s, in the format of
+/// [`write_configurations`].
+pub fn write_poses(model: &Model, poses: &[(String, &[f64])]) -> String {
     let mut t = table::Table::new(
         std::iter::once("pose_id".to_string()).chain(model.joints.iter().map(joint_column)),
     );
-    for (i, q) in qs.iter().enumerate() {
+    for (id, q) in poses {
         let values = q.iter().zip(&model.joints);
         t.row(
-            std::iter::once((i + 1).to_string())
+            std::iter::once(id.clone())
                 .chain(values.map(|(v, j)| format!("{:.6}", joint_display(j, *v)))),
         );
     }

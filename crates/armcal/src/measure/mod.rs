@@ -152,6 +152,23 @@ impl Dataset {
         self.configurations.len() - 1
     }
 
+    /// Appends `other`'s configurations (with their ids) and measurements, which then refer
+    /// to the appended configurations.
+    pub fn append(&mut self, other: &Dataset) {
+        let offset = self.configurations.len();
+        self.configurations
+            .extend(other.configurations.iter().cloned());
+        self.config_ids.extend(other.config_ids.iter().cloned());
+        for m in &other.measurements {
+            let mut m = m.clone();
+            m.config += offset;
+            if let MeasurementKind::Distance { other, .. } = &mut m.kind {
+                *other += offset;
+            }
+            self.measurements.push(m);
+        }
+    }
+
     /// The dataset restricted to the given configurations (measurements that refer to a
     /// dropped configuration through `Distance::other` are dropped too).
     pub fn subset(&self, configs: &[usize]) -> Dataset {

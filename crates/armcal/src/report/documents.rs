@@ -1,8 +1,9 @@
 //! The inputs of a report: armcal's JSON files, recognised by their content — an estimate
 //! (`armcal identify`, `armcal demo`), a design (`armcal plan`, `armcal demo`), a study
 //! (`armcal study paper`), the demo's summary or a simulation's truth record (`armcal
-//! simulate`'s truth file).
+//! simulate`'s truth file) or a campaign's state (`armcal campaign`).
 
+use crate::campaign::CampaignState;
 use crate::design::DesignRecord;
 use crate::identify::Estimate;
 use crate::sim::TruthRecord;
@@ -24,11 +25,14 @@ pub enum Document {
     Demo(Box<DemoSummary>),
     /// The true parameters of a simulation: estimates of its cell are compared with them.
     Truth(TruthRecord),
+    /// The state of an adaptive campaign (`campaign.json` of `armcal campaign`).
+    Campaign(Box<CampaignState>),
 }
 
 const EXPECTED: &str = "expected an armcal estimate (from `armcal identify`), design (the .json \
     `armcal plan` writes beside the design CSV), study result (`armcal study paper`), demo \
-    summary (`armcal demo`) or truth record (the truth file of `armcal simulate`)";
+    summary (`armcal demo`), truth record (the truth file of `armcal simulate`) or campaign \
+    state (the campaign.json of `armcal campaign`)";
 
 impl Document {
     /// Recognises and reads an armcal JSON document; `file` names it in errors.
@@ -57,6 +61,11 @@ impl Document {
                     other.unwrap_or("?")
                 ))),
             };
+        }
+        if obj.get("campaign").and_then(|c| c.as_str()) == Some("adaptive") {
+            return Ok(Document::Campaign(Box::new(
+                serde_json::from_value(value).map_err(read("campaign state"))?,
+            )));
         }
         if has(&["parameters", "solver", "uncertainty", "model"]) {
             return Ok(Document::Estimate(Box::new(
@@ -117,6 +126,7 @@ impl Document {
             Document::Study(_) => "study",
             Document::Demo(_) => "demo summary",
             Document::Truth(_) => "truth",
+            Document::Campaign(_) => "campaign",
         }
     }
 }

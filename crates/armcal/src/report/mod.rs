@@ -8,6 +8,7 @@
 //! [`parameter_charts`] draw plain data to SVG; [`html`] assembles the page. A design (and
 //! the estimate made from it) keeps one colour in every figure ([`design_key`]).
 
+pub mod campaign;
 pub mod cell_view;
 pub mod compensation;
 pub mod decimate;
@@ -95,6 +96,13 @@ fn inputs_section(inputs: &[Input], notes: &[String]) -> Section {
                     t.parameters.len(),
                     t.seed
                 ),
+                Document::Campaign(c) => format!(
+                    "campaign on cell <em>{}</em>, {} poses in {} steps, {}",
+                    escape(&c.cell),
+                    c.measured(),
+                    c.steps.len(),
+                    escape(c.decision.words())
+                ),
             };
             vec![
                 escape(&i.label),
@@ -151,7 +159,7 @@ impl Colours {
 }
 
 /// The page for `c`: the verdict panels, the demo summary and its compensated program, the
-/// inputs, the TCP comparison (Figure 7), each design, the 3D view, each estimate, the
+/// inputs, the TCP comparison (Figure 7), each design, the 3D view, each estimate, each campaign, the
 /// studies.
 pub fn page(c: &ReportContent) -> Result<Page, Error> {
     let mut sections = Vec::new();
@@ -221,7 +229,9 @@ pub fn page(c: &ReportContent) -> Result<Page, Error> {
         let (tcp, predicted) = match &i.document {
             Document::Design(d) => (d.assessment.tcp.first(), true),
             Document::Estimate(e) => (e.tcp.first(), false),
-            Document::Study(_) | Document::Demo(_) | Document::Truth(_) => (None, false),
+            Document::Study(_) | Document::Demo(_) | Document::Truth(_) | Document::Campaign(_) => {
+                (None, false)
+            }
         };
         if let Some(t) = tcp {
             items.push(TcpItem {
@@ -260,6 +270,14 @@ pub fn page(c: &ReportContent) -> Result<Page, Error> {
             parameter_view::parameter_blocks(&mut section, &i.label, e, truth, fill)
                 .map_err(of(i))?;
             sections.push(section);
+        }
+    }
+    for (k, i) in c.inputs.iter().enumerate() {
+        if let Document::Campaign(st) = &i.document {
+            sections.push(
+                campaign::campaign_section(&format!("campaign-{}", k + 1), &i.label, st)
+                    .map_err(of(i))?,
+            );
         }
     }
     let studies: Vec<(String, &StudyRecord)> = c

@@ -23,6 +23,9 @@ mod identify {
     mod mixed_measurements;
     mod priors_and_noise;
 }
+mod campaign {
+    mod adaptive;
+}
 mod design {
     mod clearance;
     mod design_bound;

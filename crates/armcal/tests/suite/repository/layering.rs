@@ -26,6 +26,7 @@ const LAYERS: &[&[&str]] = &[
     &["cell", "sim", "accuracy"],
     &["identify", "compensate"],
     &["design", "performance"],
+    &["campaign"],
     &["study"],
     &["report"],
     &["workflow"],

@@ -1,0 +1,488 @@
+//! `armcal campaign`: the adaptive measurement campaign (paper §6) — `start` plans the
+//! first batch, `step` takes a measured batch and stops or plans the next, `status` says
+//! where a campaign stands, `simulate` runs the loop against a virtual robot, `study`
+//! compares it with one-shot and random designs over seeded runs.
+
+use super::output::{load_cell, load_data, with_note, NoteStyle, Outputs};
+use super::progress::Progress;
+use anyhow::Context;
+use armcal::campaign::study::{coverage, poses_summary, StudySettings};
+use armcal::campaign::{self, CampaignSettings, CampaignState, CampaignStep, Decision, Planner};
+use armcal::measure::csv;
+use armcal::sim::Perturbation;
+use std::path::{Path, PathBuf};
+
+#[derive(clap::Subcommand)]
+pub enum Command {
+    /// Plan the first batch (the fewest poses that identify the free set, KPI criterion,
+    /// every cell constraint); writes DIR/next.csv and DIR/campaign.json.
+    Start(StartArgs),
+    /// Add the measured batch (the poses of DIR/next.csv), identify, and stop at the target
+    /// or write the next batch to DIR/next.csv.
+    Step(StepArgs),
+    /// Poses measured, σ per working pose, predicted poses still needed.
+    Status(StatusArgs),
+    /// The same loop against a simulated robot and instrument; writes DIR/campaign.json.
+    Simulate(SimulateArgs),
+    /// Poses needed by the adaptive campaign vs a one-shot KPI design sized to the target vs
+    /// random poses, and the coverage of the stopping claim, over seeded virtual robots.
+    Study(StudyArgs),
+}
+
+#[derive(clap::Args)]
+pub struct Args {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// What every campaign takes: the cell, the target, batch and budget.
+#[derive(clap::Args)]
+pub struct Target {
+    /// Cell file or built-in robot.
+    #[arg(long)]
+    pub cell: String,
+    /// Stop when every working pose's TCP σ = √((1/3) tr C_s) is at or below this (mm).
+    #[arg(long)]
+    pub target_sigma_mm: f64,
+    /// Poses per batch after the first.
+    #[arg(long, default_value_t = 5)]
+    pub batch: usize,
+    /// The most poses to measure in all (default: no limit; `simulate`: 2000).
+    #[arg(long)]
+    pub budget: Option<usize>,
+}
+
+impl Target {
+    fn settings(&self, seed: u64) -> CampaignSettings {
+        CampaignSettings {
+            target_sigma_mm: self.target_sigma_mm,
+            batch: self.batch,
+            budget: self.budget,
+            seed,
+            planner: Planner::Kpi,
+        }
+    }
+
+    /// The cell's file as an absolute path (so `step` finds it from any directory), or the
+    /// built-in name.
+    fn source(&self) -> String {
+        std::fs::canonicalize(&self.cell)
+            .map(|p| p.display().to_string())
+            .unwrap_or_else(|_| self.cell.clone())
+    }
+}
+
+#[derive(clap::Args)]
+pub struct StartArgs {
+    #[command(flatten)]
+    pub target: Target,
+    /// Seed of the planner's candidate pools.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// The campaign's directory (campaign.json, next.csv, estimate.json).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Overwrite an existing campaign in DIR.
+    #[arg(long)]
+    pub force: bool,
+    /// No progress display.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+#[derive(clap::Args)]
+pub struct StepArgs {
+    /// The campaign's directory.
+    pub dir: PathBuf,
+    /// The measured batch: a data file of the cell with the poses of DIR/next.csv.
+    #[arg(long)]
+    pub data: PathBuf,
+    /// No progress display.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+#[derive(clap::Args)]
+pub struct StatusArgs {
+    /// The campaign's directory.
+    pub dir: PathBuf,
+}
+
+#[derive(clap::Args)]
+pub struct SimulateArgs {
+    #[command(flatten)]
+    pub target: Target,
+    /// Seed of the virtual robot, its measurement noise and the planner.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Output directory (campaign.json, estimate.json, truth.json).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Overwrite existing output files.
+    #[arg(long)]
+    pub force: bool,
+    /// No progress display.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+#[derive(clap::Args)]
+pub struct StudyArgs {
+    /// Cell file or built-in robot.
+    #[arg(long)]
+    pub cell: String,
+    /// Target TCP σ's (mm), comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "0.7,0.6,0.5")]
+    pub targets: Vec<f64>,
+    /// Seeded runs per target.
+    #[arg(long, default_value_t = 20)]
+    pub runs: usize,
+    /// Poses per batch of the adaptive and the random campaign.
+    #[arg(long, default_value_t = 5)]
+    pub batch: usize,
+    /// Output record (JSON).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Overwrite an existing output file.
+    #[arg(long)]
+    pub force: bool,
+    /// No progress display.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+pub fn run(a: &Args) -> anyhow::Result<()> {
+    match &a.command {
+        Command::Start(a) => run_start(a),
+        Command::Step(a) => run_step(a),
+        Command::Status(a) => run_status(a),
+        Command::Simulate(a) => run_simulate(a),
+        Command::Study(a) => run_study(a),
+    }
+}
+
+/// The campaign's files in `dir`.
+struct Files {
+    state: PathBuf,
+    next: PathBuf,
+    estimate: PathBuf,
+}
+
+impl Files {
+    fn of(dir: &Path) -> Files {
+        Files {
+            state: dir.join("campaign.json"),
+            next: dir.join("next.csv"),
+            estimate: dir.join("estimate.json"),
+        }
+    }
+}
+
+/// `next.csv` of a state: the poses to measure, or (stopped) none, with a note saying why.
+fn next_csv(cell: &armcal::Cell, state: &CampaignState) -> String {
+    let poses: Vec<(String, Vec<f64>)> = state
+        .next
+        .iter()
+        .map(|p| (p.id.clone(), p.q(&cell.model)))
+        .collect();
+    let refs: Vec<(String, &[f64])> = poses
+        .iter()
+        .map(|(id, q)| (id.clone(), q.as_slice()))
+        .collect();
+    let text = csv::write_poses(&cell.model, &refs);
+    let note = (state.decision != Decision::Measure).then(|| {
+        format!(
+            "armcal: the campaign has stopped ({}); nothing more to measure",
+            state.decision.words()
+        )
+    });
+    with_note(text, note.as_deref(), NoteStyle::Hash)
+}
+
+fn run_start(a: &StartArgs) -> anyhow::Result<()> {
+    let files = Files::of(&a.out);
+    let outputs = Outputs::plan(
+        a.force,
+        &[Path::new(&a.target.cell)],
+        &[&files.state, &files.next],
+    )?;
+    let cell = load_cell(&a.target.cell)?;
+    let state = campaign::start(
+        &cell,
+        &a.target.source(),
+        &a.target.settings(a.seed),
+        &mut Progress::new(a.quiet),
+    )?;
+    outputs.commit(&[
+        (&files.state, &state.to_json()?),
+        (&files.next, &next_csv(&cell, &state)),
+    ])?;
+    println!(
+        "campaign on `{}`: target TCP σ ≤ {} mm at {}; first batch: {} poses (the fewest that identify the free set), predicted σ {} mm",
+        cell.name,
+        state.settings.target_sigma_mm,
+        state.working.join(", "),
+        state.first_batch,
+        mm_list(&state.first_predicted_sigma_mm)
+    );
+    println!(
+        "measure {} → then `armcal campaign step {} --data MEASURED.csv`",
+        files.next.display(),
+        a.out.display()
+    );
+    Ok(())
+}
+
+fn read_state(dir: &Path) -> anyhow::Result<CampaignState> {
+    let path = Files::of(dir).state;
+    let text = armcal::input::read_capped(&path, armcal::input::TEXT_CAP).with_context(|| {
+        format!(
+            "reading {} (is {} a campaign directory?)",
+            path.display(),
+            dir.display()
+        )
+    })?;
+    Ok(CampaignState::from_json(
+        &text,
+        &path.display().to_string(),
+    )?)
+}
+
+fn run_step(a: &StepArgs) -> anyhow::Result<()> {
+    let files = Files::of(&a.dir);
+    let state = read_state(&a.dir)?;
+    let outputs = Outputs::plan(
+        true,
+        &[a.data.as_path()],
+        &[&files.state, &files.next, &files.estimate],
+    )?;
+    let cell = load_cell(&state.cell_source)?;
+    let batch = load_data(&cell, &a.data)?;
+    let r = campaign::step(&cell, &state, &batch, &mut Progress::new(a.quiet))?;
+    let state_json = r.state.to_json()?;
+    let next = next_csv(&cell, &r.state);
+    let mut written = vec![
+        (files.state.as_path(), state_json.as_str()),
+        (files.next.as_path(), next.as_str()),
+    ];
+    let estimate = r
+        .estimate
+        .as_ref()
+        .map(serde_json::to_string_pretty)
+        .transpose()?;
+    written.extend(estimate.as_deref().map(|e| (files.estimate.as_path(), e)));
+    outputs.commit(&written)?;
+    let last = r.state.steps.last().expect("a step");
+    print_step(r.state.steps.len(), last);
+    print_decision(&r.state, &files);
+    Ok(())
+}
+
+fn mm_list(v: &[f64]) -> String {
+    v.iter()
+        .map(|s| format!("{s:.4}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// One line (two with a fit) per step: poses, fit, σ per working pose.
+fn print_step(k: usize, s: &CampaignStep) {
+    let fit = match (&s.fit, &s.fit_error) {
+        (Some(f), _) => format!(
+            "fit {} after {} iterations{}, σ̂₀² = {} ({} dof), C_s × {:.3}",
+            if f.status.is_converged() {
+                "converged".to_string()
+            } else {
+                format!("not converged ({})", f.status)
+            },
+            f.iterations,
+            if f.warm_start { " (warm start)" } else { "" },
+            f.variance_factor
+                .map_or("–".to_string(), |v| format!("{v:.3}")),
+            f.dof,
+            f.covariance_scale
+        ),
+        (None, Some(e)) => format!("no fit: {e}"),
+        (None, None) => "no fit".into(),
+    };
+    println!(
+        "step {k}: {} poses measured (+{}); {fit}",
+        s.measured,
+        s.poses.len()
+    );
+    for w in &s.working {
+        println!(
+            "  `{}`: σ = {:.4} mm (axes {:.4}, {:.4}, {:.4}; 95 % ellipsoid semi-axes {:.3}, {:.3}, {:.3} mm){}",
+            w.name,
+            w.sigma_mm,
+            w.axes_mm[0],
+            w.axes_mm[1],
+            w.axes_mm[2],
+            w.ellipsoid_95_mm[0],
+            w.ellipsoid_95_mm[1],
+            w.ellipsoid_95_mm[2],
+            match (w.true_error_mm, w.true_error_inside_95) {
+                (Some(e), Some(inside)) => format!(
+                    "; true error {:.3} mm, {} the ellipsoid",
+                    (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt(),
+                    if inside { "inside" } else { "outside" }
+                ),
+                _ => String::new(),
+            }
+        );
+    }
+}
+
+fn print_decision(state: &CampaignState, files: &Files) {
+    let Some(last) = state.steps.last() else {
+        return;
+    };
+    match state.decision {
+        Decision::Measure => println!(
+            "→ {}: {}; measure the {} poses of {} (predicted σ {} mm after them; about {} poses in all)",
+            state.decision.words(),
+            last.reason,
+            state.next.len(),
+            files.next.display(),
+            mm_list(&last.predicted_next_sigma_mm),
+            last.predicted_total_poses.unwrap_or(0)
+        ),
+        _ => println!(
+            "→ {} after {} poses: {} (σ as √((1/3) tr C_s), C_s scaled by max(1, σ̂₀²); {:.0} % ellipsoids eᵀC_s⁻¹e ≤ {:.3})",
+            state.decision.words(),
+            state.measured(),
+            last.reason,
+            100.0 * state.confidence,
+            state.chi2_quantile
+        ),
+    }
+}
+
+fn run_status(a: &StatusArgs) -> anyhow::Result<()> {
+    let state = read_state(&a.dir)?;
+    let files = Files::of(&a.dir);
+    println!(
+        "campaign on `{}`: target TCP σ ≤ {} mm; {} poses measured in {} steps{}",
+        state.cell,
+        state.settings.target_sigma_mm,
+        state.measured(),
+        state.steps.len(),
+        state
+            .settings
+            .budget
+            .map(|b| format!(" (budget {b})"))
+            .unwrap_or_default()
+    );
+    for (k, s) in state.steps.iter().enumerate() {
+        print_step(k + 1, s);
+    }
+    match state.steps.last() {
+        None => println!(
+            "→ measure the first batch: the {} poses of {} (predicted σ {} mm)",
+            state.next.len(),
+            files.next.display(),
+            mm_list(&state.first_predicted_sigma_mm)
+        ),
+        Some(last) => {
+            print_decision(&state, &files);
+            if let Some(total) = last.predicted_total_poses {
+                println!(
+                    "predicted poses still needed: about {} (from the design's predicted C_s, ∝ 1/N)",
+                    total.saturating_sub(state.measured())
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+fn run_simulate(a: &SimulateArgs) -> anyhow::Result<()> {
+    let files = Files::of(&a.out);
+    let truth_path = a.out.join("truth.json");
+    let outputs = Outputs::plan(
+        a.force,
+        &[Path::new(&a.target.cell)],
+        &[&files.state, &files.estimate, &truth_path],
+    )?;
+    let cell = load_cell(&a.target.cell)?;
+    let sim = campaign::simulate(
+        &cell,
+        &a.target.source(),
+        &a.target.settings(a.seed),
+        &Perturbation::default(),
+        a.seed,
+        &mut Progress::new(a.quiet),
+    )?;
+    let state_json = sim.state.to_json()?;
+    let truth = sim.truth.to_json()?;
+    let mut written = vec![
+        (files.state.as_path(), state_json.as_str()),
+        (truth_path.as_path(), truth.as_str()),
+    ];
+    let estimate = sim
+        .estimate
+        .as_ref()
+        .map(serde_json::to_string_pretty)
+        .transpose()?;
+    written.extend(estimate.as_deref().map(|e| (files.estimate.as_path(), e)));
+    outputs.commit(&written)?;
+    println!(
+        "simulated campaign on `{}` (virtual robot seed {}), target TCP σ ≤ {} mm",
+        cell.name, a.seed, a.target.target_sigma_mm
+    );
+    for (k, s) in sim.state.steps.iter().enumerate() {
+        print_step(k + 1, s);
+    }
+    print_decision(&sim.state, &files);
+    println!("state → {}", files.state.display());
+    Ok(())
+}
+
+fn run_study(a: &StudyArgs) -> anyhow::Result<()> {
+    let outputs = Outputs::plan(a.force, &[Path::new(&a.cell)], &[&a.out])?;
+    let cell = load_cell(&a.cell)?;
+    let record = campaign::study::run(
+        &cell,
+        &StudySettings {
+            targets: a.targets.clone(),
+            runs: a.runs,
+            batch: a.batch,
+            ..StudySettings::default()
+        },
+        &mut Progress::new(a.quiet),
+    )?;
+    outputs.commit(&[(&a.out, &record.to_json()?)])?;
+    println!(
+        "{} seeded runs per target on `{}`, batches of {} ({:.0} s)",
+        a.runs, cell.name, a.batch, record.time_s
+    );
+    println!("target σ  adaptive: poses mean (min–max), reached, coverage 95 %   one-shot KPI: poses (predicted σ), reached, coverage   random: poses mean (min–max), reached");
+    for r in &record.rows {
+        let (am, amin, amax) = poses_summary(&r.adaptive);
+        let (rm, rmin, rmax) = poses_summary(&r.random);
+        let reached = |runs: &[campaign::study::RunOutcome]| {
+            format!(
+                "{}/{}",
+                runs.iter().filter(|x| x.reached).count(),
+                runs.len()
+            )
+        };
+        let cover = |runs: &[campaign::study::RunOutcome]| {
+            let (c, n) = coverage(runs);
+            format!("{:.0} % of {n}", 100.0 * c)
+        };
+        println!(
+            "{:.2} mm   {am:.1} ({amin}–{amax}), {}, {}   {} ({:.4} mm), {}, {}   {rm:.1} ({rmin}–{rmax}), {}",
+            r.target_sigma_mm,
+            reached(&r.adaptive),
+            cover(&r.adaptive),
+            r.one_shot_poses,
+            r.one_shot_predicted_sigma_mm,
+            reached(&r.one_shot),
+            cover(&r.one_shot),
+            reached(&r.random)
+        );
+    }
+    println!("record → {}", a.out.display());
+    Ok(())
+}

@@ -1,0 +1,102 @@
+//! `armcal campaign start | step | status` on the paper cell: a step takes exactly the
+//! poses of next.csv (a batch with a pose missing or extra is refused, naming them, and the
+//! campaign's files stay as they were), rewrites the state and next.csv, and `status`
+//! prints where the campaign stands.
+
+use crate::common::{armcal, scratch};
+
+#[test]
+fn a_campaign_steps_through_its_files_and_refuses_a_wrong_batch() {
+    let dir = scratch("campaign-cli");
+    let c = dir.join("c");
+    let c_s = c.to_str().unwrap();
+    let next = c.join("next.csv");
+    let state = c.join("campaign.json");
+    let (ok, out, err) = armcal(&[
+        "campaign",
+        "start",
+        "--cell",
+        "examples/paper-cell.toml",
+        "--target-sigma-mm",
+        "0.7",
+        "--out",
+        c_s,
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("first batch: 9 poses"), "{out}");
+    let batch = dir.join("b1.csv");
+    let simulate = |poses: &std::path::Path, out: &std::path::Path| {
+        let (ok, _, err) = armcal(&[
+            "simulate",
+            "--cell",
+            "examples/paper-cell.toml",
+            "--poses",
+            poses.to_str().unwrap(),
+            "--seed",
+            "3",
+            "--out",
+            out.to_str().unwrap(),
+            "--force",
+        ]);
+        assert!(ok, "{err}");
+    };
+    simulate(&next, &batch);
+
+    // A batch with pose 9 left out and a pose 99 in its place is refused.
+    let text = std::fs::read_to_string(&batch).unwrap();
+    let wrong: String = text
+        .lines()
+        .map(|l| match l.strip_prefix("9,") {
+            Some(rest) => format!("99,{rest}"),
+            None => l.to_string(),
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let wrong_path = dir.join("wrong.csv");
+    std::fs::write(&wrong_path, wrong + "\n").unwrap();
+    let before = (
+        std::fs::read_to_string(&state).unwrap(),
+        std::fs::read_to_string(&next).unwrap(),
+    );
+    let (ok, _, err) = armcal(&[
+        "campaign",
+        "step",
+        c_s,
+        "--data",
+        wrong_path.to_str().unwrap(),
+    ]);
+    assert!(!ok);
+    assert!(
+        err.contains("missing poses 9") && err.contains("poses not in next.csv: 99"),
+        "{err}"
+    );
+    let after = (
+        std::fs::read_to_string(&state).unwrap(),
+        std::fs::read_to_string(&next).unwrap(),
+    );
+    assert_eq!(before, after, "a failed step changed the campaign");
+    assert!(!c.join("estimate.json").exists());
+
+    // The right batch: a step, a new next.csv of 5 poses numbered on from 10.
+    let (ok, out, err) = armcal(&["campaign", "step", c_s, "--data", batch.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(out.contains("step 1: 9 poses measured"), "{out}");
+    assert!(out.contains("measure the next batch"), "{out}");
+    let next_text = std::fs::read_to_string(&next).unwrap();
+    let ids: Vec<&str> = next_text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap())
+        .collect();
+    assert_eq!(ids, ["10", "11", "12", "13", "14"]);
+    assert!(c.join("estimate.json").exists());
+    // The same batch again is not the new next.csv.
+    let (ok, _, err) = armcal(&["campaign", "step", c_s, "--data", batch.to_str().unwrap()]);
+    assert!(!ok);
+    assert!(err.contains("missing poses 10, 11, 12, 13, 14"), "{err}");
+
+    let (ok, out, err) = armcal(&["campaign", "status", c_s]);
+    assert!(ok, "{err}");
+    assert!(out.contains("9 poses measured in 1 steps"), "{out}");
+    assert!(out.contains("predicted poses still needed: about"), "{out}");
+}

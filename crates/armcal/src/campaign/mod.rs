@@ -1,0 +1,386 @@
+//! The adaptive measurement campaign (paper §6: "an online approach of parameter estimation
+//! and optimum experimental design … which monitors the current precision … the parameter
+//! identification can be stopped when a certain level of TCP precision is reached"): plan a
+//! first batch, measure it, identify (warm start from the previous estimate), compute the
+//! TCP covariance at every working pose from what was measured, and either stop at the
+//! target precision or plan the next batch given everything measured.
+//!
+//! [`start`] plans the first batch, [`step`] takes a measured batch; the state
+//! ([`CampaignState`]) holds everything, so a campaign can be resumed at any time.
+//! [`simulate`] runs the whole loop against a virtual robot and instrument; [`study`]
+//! compares it with one-shot and random designs over seeded runs.
+
+pub mod precision;
+pub mod simulate;
+pub mod state;
+pub mod study;
+
+pub use simulate::{simulate, SimulatedCampaign};
+pub use state::{
+    CampaignPose, CampaignSettings, CampaignState, CampaignStep, Decision, FitSummary, Planner,
+};
+
+use crate::cell::Cell;
+use crate::design::plan::{constraint_set, plan, CellConstraints, PlanSettings};
+use crate::design::DesignModel;
+use crate::identify::{identify, Estimate, IdentifySettings, ModelFingerprint};
+use crate::measure::Dataset;
+use crate::progress::Observer;
+use crate::Error;
+use precision::{poses_needed, predicted_sigmas, working_sigmas, WorkingSigma};
+
+/// Joint values of a measured pose may differ from the planned ones by this much (deg, mm
+/// for a prismatic joint): `next.csv` holds them to 1e-6, a controller reports its own.
+pub const JOINT_TOLERANCE: f64 = 0.01;
+
+/// The fewest poses that identify the cell's free set: ⌈n_p / rows per pose⌉.
+pub fn fewest_poses(cell: &Cell) -> Result<usize, Error> {
+    let d = DesignModel::from_cell(cell)?;
+    Ok(d.n().div_ceil(d.rows()))
+}
+
+/// Starts a campaign on `cell` (`cell_source`: its file or built-in name, kept in the
+/// state): checks the settings and plans the first batch, the fewest poses that identify
+/// the free set ([`fewest_poses`]), chosen by the settings' planner under every cell
+/// constraint.
+pub fn start(
+    cell: &Cell,
+    cell_source: &str,
+    settings: &CampaignSettings,
+    observer: &mut dyn Observer,
+) -> Result<CampaignState, Error> {
+    if !(settings.target_sigma_mm > 0.0 && settings.target_sigma_mm.is_finite()) {
+        return Err(Error::Input(format!(
+            "the target TCP σ must be a positive number of mm, not {}",
+            settings.target_sigma_mm
+        )));
+    }
+    if settings.batch == 0 {
+        return Err(Error::Input(
+            "a batch of 0 poses measures nothing; give at least 1".into(),
+        ));
+    }
+    if cell.working.is_empty() {
+        return Err(Error::Input(format!(
+            "cell `{}` has no working pose ([[working]]): a campaign stops at a TCP precision at the working poses, so give at least one",
+            cell.name
+        )));
+    }
+    let first = fewest_poses(cell)?;
+    if let Some(b) = settings.budget {
+        if b < first {
+            return Err(Error::Input(format!(
+                "a budget of {b} poses cannot identify the {} free parameters of `{}`: the first batch alone needs {first} poses",
+                DesignModel::from_cell(cell)?.n(),
+                cell.name
+            )));
+        }
+    }
+    let qs = plan_batch(cell, settings, &[], first, 0, observer)?;
+    let first_predicted_sigma_mm = predicted_sigmas(cell, &qs, 1.0)?;
+    Ok(CampaignState {
+        campaign: "adaptive".into(),
+        cell: cell.name.clone(),
+        cell_source: cell_source.into(),
+        fingerprint: ModelFingerprint::of(&cell.model),
+        settings: settings.clone(),
+        sigma_definition: precision::SIGMA_DEFINITION.into(),
+        confidence: precision::CONFIDENCE,
+        chi2_quantile: precision::chi2_quantile(),
+        variance_rule: precision::VARIANCE_RULE.into(),
+        first_batch: first,
+        first_predicted_sigma_mm,
+        working: cell.working.iter().map(|w| w.name.clone()).collect(),
+        steps: Vec::new(),
+        next: numbered(cell, &qs, 0),
+        decision: Decision::Measure,
+        simulation_seed: None,
+    })
+}
+
+/// The poses `qs` named `offset + 1`, `offset + 2`, ….
+fn numbered(cell: &Cell, qs: &[Vec<f64>], offset: usize) -> Vec<CampaignPose> {
+    qs.iter()
+        .enumerate()
+        .map(|(i, q)| CampaignPose::of(&cell.model, (offset + i + 1).to_string(), q))
+        .collect()
+}
+
+/// `n` poses chosen by the settings' planner given the configurations `measured`, with the
+/// seed of step `k`.
+fn plan_batch(
+    cell: &Cell,
+    settings: &CampaignSettings,
+    measured: &[Vec<f64>],
+    n: usize,
+    k: usize,
+    observer: &mut dyn Observer,
+) -> Result<Vec<Vec<f64>>, Error> {
+    let seed = settings.seed.wrapping_add(k as u64);
+    match settings.planner {
+        Planner::Kpi => {
+            let r = plan(
+                cell,
+                &PlanSettings {
+                    poses: n,
+                    seed,
+                    ..PlanSettings::default()
+                },
+                measured,
+                observer,
+            )?;
+            if !r.feasible {
+                return Err(Error::Input(format!(
+                    "no feasible batch of {n} poses for `{}`: its constraints block {}",
+                    cell.name,
+                    r.blocking
+                        .iter()
+                        .map(|(c, f)| format!("{c} ({:.0} % of draws)", 100.0 * f))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )));
+            }
+            Ok(r.design)
+        }
+        Planner::Random => {
+            let set = constraint_set(cell, true)?;
+            let params = cell.model.nominal();
+            let cons = CellConstraints::new(&set, &params);
+            let (qs, _) = crate::design::baselines::random_feasible(
+                &cell.model,
+                n,
+                seed,
+                PlanSettings::default().max_draws,
+                |q| cons.feasible(q),
+            )?;
+            Ok(qs)
+        }
+    }
+}
+
+/// What a step made: the new state and the estimate of its fit (if any).
+#[derive(Clone, Debug)]
+pub struct StepResult {
+    /// The state after the step.
+    pub state: CampaignState,
+    /// The fit on everything measured; `None` when it failed (the state says why).
+    pub estimate: Option<Estimate>,
+}
+
+/// Checks that `batch` measured exactly the poses of `state.next`: the same ids, joint
+/// values within [`JOINT_TOLERANCE`]. The error lists what is missing, extra or moved.
+fn check_batch(cell: &Cell, state: &CampaignState, batch: &Dataset) -> Result<(), Error> {
+    let mut problems = Vec::new();
+    let missing: Vec<&str> = state
+        .next
+        .iter()
+        .filter(|p| !batch.config_ids.contains(&p.id))
+        .map(|p| p.id.as_str())
+        .collect();
+    if !missing.is_empty() {
+        problems.push(format!("missing poses {}", missing.join(", ")));
+    }
+    let extra: Vec<&str> = batch
+        .config_ids
+        .iter()
+        .filter(|id| !state.next.iter().any(|p| &p.id == *id))
+        .map(String::as_str)
+        .collect();
+    if !extra.is_empty() {
+        problems.push(format!("poses not in next.csv: {}", extra.join(", ")));
+    }
+    for (id, q) in batch.config_ids.iter().zip(&batch.configurations) {
+        let Some(planned) = state.next.iter().find(|p| &p.id == id) else {
+            continue;
+        };
+        let measured = CampaignPose::of(&cell.model, id.clone(), q);
+        let worst = measured
+            .joints
+            .iter()
+            .zip(&planned.joints)
+            .zip(&cell.model.joints)
+            .map(|((a, b), j)| ((a - b).abs(), j.name.as_str()))
+            .max_by(|a, b| a.0.total_cmp(&b.0));
+        if let Some((d, joint)) = worst.filter(|w| w.0 > JOINT_TOLERANCE) {
+            problems.push(format!(
+                "pose {id}: joint `{joint}` is {d:.4} from the planned value (more than {JOINT_TOLERANCE})"
+            ));
+        }
+    }
+    if batch.measurements.is_empty() {
+        problems.push("no measurements".into());
+    }
+    if problems.is_empty() {
+        return Ok(());
+    }
+    Err(Error::Input(format!(
+        "{}: not the batch of next.csv ({} poses, ids {}): {}; measure exactly the poses of next.csv",
+        batch.source,
+        state.next.len(),
+        state
+            .next
+            .iter()
+            .map(|p| p.id.as_str())
+            .collect::<Vec<_>>()
+            .join(", "),
+        problems.join("; ")
+    )))
+}
+
+/// Takes the measured batch `batch` (the poses of `state.next`): identifies the free
+/// parameters on everything measured (warm start from the last converged fit), computes
+/// the TCP precision at every working pose ([`precision`]), and decides: stop when every
+/// working pose's σ is at or below the target and the fit converged (an unconverged fit
+/// never stops the campaign), stop when the budget is spent, or plan the next batch given
+/// everything measured. `state` itself is not changed: a step that fails leaves it as it
+/// was. `cell` must be the campaign's cell (its fingerprint is checked).
+pub fn step(
+    cell: &Cell,
+    state: &CampaignState,
+    batch: &Dataset,
+    observer: &mut dyn Observer,
+) -> Result<StepResult, Error> {
+    let differences = state.fingerprint.differences(&cell.model);
+    if !differences.is_empty() {
+        return Err(Error::Input(format!(
+            "the cell `{}` differs from the one this campaign started with: {}; restore it, or start a new campaign",
+            cell.name,
+            differences.join("; ")
+        )));
+    }
+    if state.decision != Decision::Measure {
+        return Err(Error::Input(format!(
+            "the campaign has stopped ({} after {} poses); start a new campaign to measure more",
+            state.decision.words(),
+            state.measured()
+        )));
+    }
+    check_batch(cell, state, batch)?;
+    let mut data = state.data();
+    data.append(batch);
+    data.source = format!(
+        "campaign, {} poses in {} steps",
+        data.configurations.len(),
+        state.steps.len() + 1
+    );
+    let warm = state.warm_start().map(<[f64]>::to_vec);
+    let settings = IdentifySettings {
+        start: warm.clone(),
+        ..IdentifySettings::default()
+    };
+    let (estimate, fit, fit_error, working) = match identify(cell, &data, &settings, observer) {
+        Ok(e) => {
+            let s = precision::scale(&e);
+            let params = e.params_for(&cell.model)?;
+            let fit = FitSummary {
+                status: e.solver.status.clone(),
+                iterations: e.solver.iterations,
+                warm_start: warm.is_some(),
+                free: e.free.len(),
+                variance_factor: Some(e.uncertainty.variance_factor).filter(|v| v.is_finite()),
+                dof: e.uncertainty.dof,
+                p_value: Some(e.uncertainty.p_value).filter(|v| v.is_finite()),
+                covariance_scale: s,
+                params,
+            };
+            let working = working_sigmas(&e, s);
+            (Some(e), Some(fit), None, working)
+        }
+        Err(e) => (None, None, Some(e.to_string()), Vec::new()),
+    };
+    let mut next_state = state.clone();
+    let measured = data.configurations.len();
+    let target = state.settings.target_sigma_mm;
+    let worst = largest_sigma(&working);
+    let converged = fit.as_ref().is_some_and(|f| f.status.is_converged());
+    let sigmas = || {
+        working
+            .iter()
+            .map(|w| format!("`{}` {:.4} mm", w.name, w.sigma_mm))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let (decision, reason) = if converged && worst <= target {
+        (
+            Decision::TargetReached,
+            format!("every working pose at or below {target} mm: {}", sigmas()),
+        )
+    } else if state.settings.budget.is_some_and(|b| measured >= b) {
+        (
+            Decision::BudgetExhausted,
+            format!(
+                "{measured} poses measured, the budget; target {target} mm not reached: {}",
+                if working.is_empty() {
+                    "no fit".to_string()
+                } else {
+                    sigmas()
+                }
+            ),
+        )
+    } else if let Some(e) = &fit_error {
+        (Decision::Measure, format!("no fit ({e}); measuring more"))
+    } else if !converged {
+        (
+            Decision::Measure,
+            format!(
+                "the fit did not converge ({}), so it cannot stop the campaign; measuring more",
+                fit.as_ref()
+                    .map(|f| f.status.to_string())
+                    .unwrap_or_default()
+            ),
+        )
+    } else {
+        (
+            Decision::Measure,
+            format!("largest σ {worst:.4} mm > target {target} mm"),
+        )
+    };
+    let k = state.steps.len() + 1;
+    let (next, predicted, total) = if decision == Decision::Measure {
+        let n = state.settings.budget.map_or(state.settings.batch, |b| {
+            state.settings.batch.min(b - measured)
+        });
+        let qs = plan_batch(cell, &state.settings, &data.configurations, n, k, observer)?;
+        let mut all = data.configurations.clone();
+        all.extend(qs.iter().cloned());
+        let s = fit.as_ref().map_or(1.0, |f| f.covariance_scale);
+        let predicted = predicted_sigmas(cell, &all, s)?;
+        let largest = predicted.iter().copied().fold(0.0, f64::max);
+        let total = poses_needed(all.len(), largest, target);
+        (numbered(cell, &qs, measured), predicted, Some(total))
+    } else {
+        (Vec::new(), Vec::new(), None)
+    };
+    next_state.steps.push(CampaignStep {
+        source: batch.source.clone(),
+        poses: batch
+            .config_ids
+            .iter()
+            .zip(&batch.configurations)
+            .map(|(id, q)| CampaignPose::of(&cell.model, id.clone(), q))
+            .collect(),
+        data: batch.clone(),
+        measured,
+        fit,
+        fit_error,
+        working,
+        decision,
+        reason,
+        predicted_next_sigma_mm: predicted,
+        predicted_total_poses: total,
+    });
+    next_state.next = next;
+    next_state.decision = decision;
+    Ok(StepResult {
+        state: next_state,
+        estimate,
+    })
+}
+
+/// The largest σ over the working poses of a step (NaN without a fit).
+pub fn largest_sigma(working: &[WorkingSigma]) -> f64 {
+    if working.is_empty() {
+        return f64::NAN;
+    }
+    working.iter().map(|w| w.sigma_mm).fold(0.0, f64::max)
+}

@@ -1,0 +1,75 @@
+//! A campaign against a virtual robot and instrument ([`crate::sim`]): the same
+//! [`start`](super::start) and [`step`](super::step) loop, each batch measured on a robot
+//! perturbed from the nominal with the instrument's noise, for planning a campaign before
+//! the robot is free. The true robot is known, so every step also records the true TCP
+//! error and whether it lies in the stated 95 % ellipsoid.
+
+use super::precision::tcp_position;
+use super::{start, step, CampaignSettings, CampaignState, Decision};
+use crate::cell::Cell;
+use crate::identify::Estimate;
+use crate::progress::Observer;
+use crate::sim::{perturbed_truth, Perturbation, TruthRecord};
+use crate::Error;
+
+/// What a simulated campaign made.
+#[derive(Clone, Debug)]
+pub struct SimulatedCampaign {
+    /// The final state (stopped: target reached or budget exhausted).
+    pub state: CampaignState,
+    /// The last fit's estimate.
+    pub estimate: Option<Estimate>,
+    /// The virtual robot.
+    pub truth: TruthRecord,
+}
+
+/// Runs a campaign on `cell` against a robot perturbed by `perturbation` (seed `seed`)
+/// measured with the cell's instrument noise (batch `k` with noise seed
+/// `seed · 1000 + k`); `observer` follows each step. Without a budget in `settings` the
+/// run stops at the target or at 2 000 poses.
+pub fn simulate(
+    cell: &Cell,
+    cell_source: &str,
+    settings: &CampaignSettings,
+    perturbation: &Perturbation,
+    seed: u64,
+    observer: &mut dyn Observer,
+) -> Result<SimulatedCampaign, Error> {
+    let model = &cell.model;
+    let mut settings = settings.clone();
+    settings.budget = Some(settings.budget.unwrap_or(2_000));
+    let truth = perturbed_truth(model, perturbation, seed);
+    let noise = cell.noise();
+    let mut state = start(cell, cell_source, &settings, observer)?;
+    state.simulation_seed = Some(seed);
+    let mut estimate = None;
+    while state.decision == Decision::Measure {
+        let k = state.steps.len() as u64 + 1;
+        let qs: Vec<Vec<f64>> = state.next.iter().map(|p| p.q(model)).collect();
+        let mut batch = crate::sim::simulate(
+            model,
+            &truth,
+            &qs,
+            Some(&noise),
+            seed.wrapping_mul(1000).wrapping_add(k),
+        )?;
+        batch.config_ids = state.next.iter().map(|p| p.id.clone()).collect();
+        batch.source = format!("simulation (seed {seed}, batch {k})");
+        let r = step(cell, &state, &batch, observer)?;
+        state = r.state;
+        if let (Some(e), Some(last)) = (&r.estimate, state.steps.last_mut()) {
+            let params = e.params_for(model)?;
+            for (w, working) in last.working.iter_mut().zip(&cell.working) {
+                let err = tcp_position(model, &params, &working.q)
+                    - tcp_position(model, &truth, &working.q);
+                *w = w.clone().with_true_error(err);
+            }
+        }
+        estimate = r.estimate.or(estimate);
+    }
+    Ok(SimulatedCampaign {
+        truth: TruthRecord::new(&cell.name, model, &truth, seed),
+        state,
+        estimate,
+    })
+}
