@@ -268,6 +268,7 @@ fn every_convention_spec(seed: u64) -> ModelSpec {
         }),
     });
     ModelSpec {
+        compliance: None,
         name: "every".into(),
         instrument: None,
         links,

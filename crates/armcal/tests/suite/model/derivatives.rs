@@ -1,5 +1,6 @@
 //! Every analytic derivative against central finite differences, for every convention
-//! (revolute and prismatic), on random configurations. Relative error < 1e-6.
+//! (revolute and prismatic), rigid and with joint compliance (the lumped κ columns and the
+//! chain rule through the deflected joints), on random configurations. Relative error < 1e-6.
 
 use crate::common;
 use armcal::model::*;
@@ -11,7 +12,7 @@ const TOL: f64 = 1e-6;
 #[test]
 fn identification_jacobian_matches_finite_differences() {
     for seed in 0..4 {
-        let model = every_convention_model(seed);
+        for model in derivative_models(seed) {
         let mut r = rng(100 + seed);
         let params = model.nominal();
         let n = model.param_count();
@@ -44,13 +45,14 @@ fn identification_jacobian_matches_finite_differences() {
                 }
             }
         }
+        }
     }
 }
 
 #[test]
 fn joint_jacobian_matches_finite_differences() {
     for seed in 0..4 {
-        let model = every_convention_model(seed);
+        for model in derivative_models(seed) {
         let mut r = rng(200 + seed);
         let params = model.nominal();
         let q = random_q(&model, &mut r);
@@ -80,13 +82,14 @@ fn joint_jacobian_matches_finite_differences() {
                 }
             }
         }
+        }
     }
 }
 
 #[test]
 fn mixed_derivative_matches_finite_differences_of_jacobian() {
     for seed in 0..3 {
-        let model = every_convention_model(seed);
+        for model in derivative_models(seed) {
         let mut r = rng(300 + seed);
         let params = model.nominal();
         let n = model.param_count();
@@ -140,6 +143,7 @@ fn mixed_derivative_matches_finite_differences_of_jacobian() {
                 }
             }
         }
+        }
     }
 }
 
@@ -150,7 +154,7 @@ fn mixed_derivative_matches_finite_differences_of_jacobian() {
 fn mixed_derivative_matches_dual_numbers() {
     use num_dual::Dual64;
     for seed in 0..3 {
-        let model = every_convention_model(seed);
+        for model in derivative_models(seed) {
         let mut r = rng(500 + seed);
         let params = model.nominal();
         let n = model.param_count();
@@ -189,6 +193,7 @@ fn mixed_derivative_matches_dual_numbers() {
                     }
                 }
             }
+        }
         }
     }
 }
