@@ -21,6 +21,7 @@ pub fn random_geometry(c: Convention, kind: Option<JointKind>, r: &mut ChaCha8Rn
             Unit::Mm => r.random_range(-400.0..400.0),
             Unit::Rad => r.random_range(-3.0..3.0),
             Unit::Unitless => r.random_range(-1.5..1.5),
+            Unit::RadPerMm => r.random_range(0.0..1e-6),
         })
         .collect();
     let mut g = LinkGeometry::new(c, values);
@@ -118,7 +119,7 @@ pub fn compliant_model(seed: u64) -> Model {
         at: at.into(),
         value,
     };
-    let mut k = || r.random_range(0.2e-4..1.5e-4);
+    let mut k = || r.random_range(0.2e-5..1.5e-5);
     let terms = vec![
         term("q1", "q4", k()),
         term("q1", "q9", k()),
