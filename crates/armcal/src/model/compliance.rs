@@ -197,7 +197,13 @@ impl<T: RealField + Copy> ComplianceData<T> {
     /// Writes the compliance parameters' twists into `data` (after the deflected pass): a
     /// unit change of κ_t turns joint i by ℓ_t, so its twist is `ℓ_t ξ_i`, and it has no
     /// rate of its own.
-    pub(crate) fn set_twists(&self, c: &Compliance, data_twists: &mut [Twist<T>], joints: &[Twist<T>], rates: &mut [Twist<T>]) {
+    pub(crate) fn set_twists(
+        &self,
+        c: &Compliance,
+        data_twists: &mut [Twist<T>],
+        joints: &[Twist<T>],
+        rates: &mut [Twist<T>],
+    ) {
         for (t, term) in c.terms.iter().enumerate() {
             let j = joints[term.joint];
             data_twists[term.param] = Twist {
@@ -227,7 +233,10 @@ impl ComplianceSpec {
         let mut index = Vec::new();
         for name in joints {
             let i = names.iter().position(|n| n == name).ok_or_else(|| {
-                format!("unknown joint `{name}` (the robot's joints: {})", names.join(", "))
+                format!(
+                    "unknown joint `{name}` (the robot's joints: {})",
+                    names.join(", ")
+                )
             })?;
             if model.joints[i].kind == JointKind::Prismatic {
                 return Err(format!(
