@@ -498,13 +498,8 @@ fn compile_compliance(
     link_params: usize,
     registry: &mut Registry,
 ) -> Result<Compliance, Error> {
-    let g = Vector3::from(c.gravity);
-    if !(g.norm() > 1e-9) || !g.iter().all(|x| x.is_finite()) {
-        return Err(Error::Model(format!(
-            "compliance: gravity {:?} must be a non-zero direction",
-            c.gravity
-        )));
-    }
+    let g = crate::model::compliance::gravity_direction(c.gravity)
+        .map_err(|e| Error::Model(format!("compliance: {e}")))?;
     if c.levers.len() != link_params || !c.levers.iter().all(|x| x.is_finite()) {
         return Err(Error::Model(format!(
             "compliance: the lever geometry has {} values, the chain {link_params}",
@@ -529,7 +524,7 @@ fn compile_compliance(
                 t.at
             )));
         }
-        if !(t.value.abs() <= MAX_COMPLIANCE) {
+        if !Unit::RadPerMm.holds(t.value) {
             return Err(Error::Model(format!(
                 "compliance term `{}` = {:e} µrad/m is outside |x| ≤ {:e} µrad/m",
                 ComplianceSpec::parameter_name(t),
@@ -553,7 +548,7 @@ fn compile_compliance(
     let mut levers = c.levers.clone();
     levers.resize(registry.len(), 0.0);
     Ok(Compliance {
-        gravity: g.normalize(),
+        gravity: g,
         levers,
         terms,
     })

@@ -222,13 +222,7 @@ impl ComplianceSpec {
     /// compliance yet; its nominal parameters become the levers. The error names the joint
     /// and what to do (unknown, prismatic, no gravity torque, given twice).
     pub fn lumped(model: &Model, joints: &[String], gravity: [f64; 3]) -> Result<Self, String> {
-        let g = Vector3::from(gravity);
-        if !(g.norm() > 1e-9) || !g.iter().all(|x| x.is_finite()) {
-            return Err(format!(
-                "gravity {gravity:?} must be a non-zero direction in the base frame"
-            ));
-        }
-        let g = g.normalize();
+        let g = gravity_direction(gravity)?;
         let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
         let mut index = Vec::new();
         for name in joints {
@@ -310,6 +304,18 @@ impl ComplianceSpec {
     /// Name of term `t`'s parameter: `<joint>.compliance.<mass>`.
     pub fn parameter_name(term: &ComplianceTerm) -> String {
         format!("{}.compliance.{}", term.joint, term.mass)
+    }
+}
+
+/// The unit direction of `gravity` (any length), or an error for a zero or non-finite one.
+pub fn gravity_direction(gravity: [f64; 3]) -> Result<Vector3<f64>, String> {
+    let g = Vector3::from(gravity);
+    if g.iter().all(|x| x.is_finite()) && g.norm() > 1e-9 {
+        Ok(g.normalize())
+    } else {
+        Err(format!(
+            "gravity {gravity:?} must be a non-zero direction in the base frame"
+        ))
     }
 }
 
