@@ -159,6 +159,7 @@ pub fn print_summary(e: &Estimate) {
     if let Some(d) = &e.rank_deficit {
         println!("\nbelow the generic count: {d}");
     }
+    print_compliance(e);
     if !e.strong_correlations.is_empty() {
         println!("\nstrongly correlated pairs (|ρ| > 0.95):");
         for (a, b, r) in &e.strong_correlations {
@@ -274,6 +275,35 @@ fn print_stats_rows(rows: [(&str, &armcal::accuracy::ErrorStats); 3]) {
         println!(
             "  {n:<24} {:>8.4} {:>9.4} {:>9.4} {:>9.4}",
             s.mean, s.rms, s.max, s.p95
+        );
+    }
+}
+
+/// The compliance gate: per term κ ± σ, its largest correlation with the geometry, the
+/// share of its effect the geometry cannot absorb, and the verdict.
+fn print_compliance(e: &Estimate) {
+    if e.compliance.is_empty() {
+        return;
+    }
+    println!("\njoint compliance (κ = compliance × mass × g, µrad per m of lever):");
+    println!("  term                        κ ± σ (µrad/m)       max |ρ| with geometry   not absorbed   verdict");
+    for v in &e.compliance {
+        let rho = v
+            .most_correlated
+            .as_ref()
+            .map_or("-".to_string(), |(n, r)| format!("{r:+.3} ({n})"));
+        let verdict = match (v.separable, v.wrong_sign) {
+            (false, _) => "not separable from the geometry",
+            (true, true) => "WRONG SIGN: the arm rises against gravity",
+            (true, false) => "separable",
+        };
+        println!(
+            "  {:<26} {:>9.1} ± {:<8.1} {:<23} {:>8.1} %   {verdict}",
+            v.name,
+            v.estimate_urad_per_m,
+            v.sigma_urad_per_m,
+            rho,
+            100.0 * v.unabsorbed
         );
     }
 }

@@ -312,6 +312,7 @@ pub(crate) fn assemble_spec(
         links[last].geometry = t;
     }
     ModelSpec {
+        compliance: None,
         name: robot.spec.name.clone(),
         instrument: instrument.map(|g| LinkSpec {
             name: instrument_name.into(),

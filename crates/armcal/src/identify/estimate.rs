@@ -178,6 +178,10 @@ pub struct Estimate {
     pub model: ModelSpec,
     /// Every model parameter, free or fixed, in registry order (display units).
     pub parameters: Vec<ParameterEstimate>,
+    /// The identifiability gate of the free compliance terms
+    /// ([`crate::identify::compliance_gate`]); empty for a rigid model.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub compliance: Vec<crate::identify::compliance_gate::ComplianceVerdict>,
     /// Why each parameter not estimated was left out (identifiability analysis).
     pub fixed_reasons: Vec<(String, String)>,
     /// Why fewer parameters than the generic count were identified (at the fit, from these

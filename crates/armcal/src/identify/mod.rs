@@ -4,6 +4,7 @@
 //! axes by circle point analysis.
 
 pub mod circle_point;
+pub mod compliance_gate;
 pub mod estimate;
 pub mod fingerprint;
 pub mod gauss_newton;
@@ -389,6 +390,13 @@ fn estimate_of_fit(
         (cs, blocks)
     };
     let data_rows = sol.jacobian.nrows() - problem.priors.len();
+    let compliance = compliance_gate::compliance_gate(
+        model,
+        &problem.free,
+        &sol.jacobian.rows(0, data_rows).into_owned(),
+        &unc.covariance,
+        &sol.params,
+    );
     let observability = uncertainty::observability(sol.jacobian.rows(0, data_rows));
     let residuals = residuals::residual_report(&problem, &sol.params, &split.train_configs);
     let validation = phase(observer, "held-out validation", || {
@@ -420,6 +428,7 @@ fn estimate_of_fit(
         data: data.source.clone(),
         model: model.spec_at(&sol.params),
         parameters,
+        compliance,
         fixed_reasons: reasons.clone(),
         rank_deficit: rank_deficit.clone(),
         solver: SolverReport {

@@ -2,6 +2,7 @@
 //! one parameter registry. A [`Model`] is immutable once built and can be shared across
 //! threads; buffers for one evaluation live in [`crate::model::Data`].
 
+use crate::model::compliance::{CompiledTerm, Compliance, ComplianceSpec, MAX_COMPLIANCE};
 use crate::model::link::{Convention, Joint, JointKind, LinkGeometry, Motion};
 use crate::model::registry::{Registry, Segment, Status, Unit};
 use crate::Error;
@@ -74,6 +75,9 @@ pub struct ModelSpec {
     /// tooling balls, or a full end-effector frame.
     #[serde(default)]
     pub targets: Vec<LinkSpec>,
+    /// Joint compliance under gravity ([`crate::model::compliance`]); `None`: rigid joints.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compliance: Option<ComplianceSpec>,
 }
 
 /// A compiled link: its spec plus where its parameters live in the registry.
@@ -138,6 +142,8 @@ pub struct Model {
     pub links: Vec<Link>,
     /// Points or frames attached to the tool, measured by the instrument.
     pub targets: Vec<Link>,
+    /// Joint compliance, compiled; its κ are the registry's last parameters.
+    pub compliance: Option<Compliance>,
     pub(crate) instrument_steps: Vec<Step>,
     pub(crate) chain_steps: Vec<Step>,
     /// `chain_step_end[i]`: number of chain steps after which link `i` is complete.
@@ -330,6 +336,11 @@ impl Model {
             targets.push(l);
             target_steps.push(s);
         }
+        let link_params = registry.len();
+        let compliance = match &spec.compliance {
+            Some(c) => Some(compile_compliance(c, &joints, link_params, &mut registry)?),
+            None => None,
+        };
         Ok(Model {
             name: spec.name.clone(),
             registry,
@@ -337,6 +348,7 @@ impl Model {
             instrument,
             links,
             targets,
+            compliance,
             instrument_steps,
             chain_steps,
             chain_step_end,
@@ -355,6 +367,18 @@ impl Model {
             instrument: self.instrument.as_ref().map(re),
             links: self.links.iter().map(re).collect(),
             targets: self.targets.iter().map(re).collect(),
+            compliance: self.compliance.as_ref().map(|c| ComplianceSpec {
+                gravity: c.gravity.into(),
+                levers: c.levers[..c.link_params()].to_vec(),
+                terms: c
+                    .terms
+                    .iter()
+                    .map(|t| crate::model::compliance::ComplianceTerm {
+                        value: params[t.param],
+                        ..t.spec.clone()
+                    })
+                    .collect(),
+            }),
         }
     }
 
@@ -464,4 +488,68 @@ impl Model {
             self.joints.iter().map(|j| j.upper).collect(),
         )
     }
+}
+
+/// Checks a [`ComplianceSpec`] against the chain and adds its κ to the registry (unit
+/// µrad/m, segment chain, free).
+fn compile_compliance(
+    c: &ComplianceSpec,
+    joints: &[Joint],
+    link_params: usize,
+    registry: &mut Registry,
+) -> Result<Compliance, Error> {
+    let g = crate::model::compliance::gravity_direction(c.gravity)
+        .map_err(|e| Error::Model(format!("compliance: {e}")))?;
+    if c.levers.len() != link_params || !c.levers.iter().all(|x| x.is_finite()) {
+        return Err(Error::Model(format!(
+            "compliance: the lever geometry has {} values, the chain {link_params}",
+            c.levers.len()
+        )));
+    }
+    let joint = |name: &str| {
+        joints
+            .iter()
+            .position(|j| j.name == name)
+            .ok_or_else(|| Error::Model(format!("compliance: no joint `{name}`")))
+    };
+    let mut terms = Vec::new();
+    for t in &c.terms {
+        let (i, at) = (joint(&t.joint)?, joint(&t.at)?);
+        if joints[i].kind != JointKind::Revolute || at <= i {
+            return Err(Error::Model(format!(
+                "compliance term `{}`: joint `{}` must be revolute and the mass joint `{}` \
+                 beyond it",
+                ComplianceSpec::parameter_name(t),
+                t.joint,
+                t.at
+            )));
+        }
+        if !Unit::RadPerMm.holds(t.value) {
+            return Err(Error::Model(format!(
+                "compliance term `{}` = {:e} µrad/m is outside |x| ≤ {:e} µrad/m",
+                ComplianceSpec::parameter_name(t),
+                t.value * Unit::RadPerMm.display_factor(),
+                MAX_COMPLIANCE * Unit::RadPerMm.display_factor()
+            )));
+        }
+        let param = registry.add(
+            ComplianceSpec::parameter_name(t),
+            Unit::RadPerMm,
+            t.value,
+            Segment::Chain,
+        )?;
+        terms.push(CompiledTerm {
+            joint: i,
+            at,
+            param,
+            spec: t.clone(),
+        });
+    }
+    let mut levers = c.levers.clone();
+    levers.resize(registry.len(), 0.0);
+    Ok(Compliance {
+        gravity: g,
+        levers,
+        terms,
+    })
 }

@@ -118,6 +118,7 @@ pub fn dh_to_mdh(spec: &ModelSpec) -> Result<ModelSpec, Error> {
         return Err(leftover_error(from, a, alpha, None));
     }
     Ok(ModelSpec {
+        compliance: None,
         links,
         ..spec.clone()
     })
@@ -187,6 +188,7 @@ pub fn mdh_to_dh(spec: &ModelSpec) -> Result<ModelSpec, Error> {
         open = true;
     }
     Ok(ModelSpec {
+        compliance: None,
         links,
         ..spec.clone()
     })
@@ -280,6 +282,7 @@ pub fn to_zrp(model: &Model, params: &[f64]) -> ModelSpec {
     }
     links.push(fixed_link(&tool, frame6_geometry(&t0)));
     ModelSpec {
+        compliance: None,
         name: spec.name,
         instrument: spec.instrument,
         links,
@@ -420,6 +423,7 @@ pub(crate) fn link_pose(g: &LinkGeometry, kind: Option<JointKind>) -> Result<Pos
         upper: 0.0,
     });
     let spec = ModelSpec {
+        compliance: None,
         name: String::new(),
         instrument: None,
         links: vec![LinkSpec {
@@ -554,6 +558,7 @@ pub fn zrp_to_dh(spec: &ModelSpec, nominal: Option<&ModelSpec>) -> Result<ModelS
         frame6_geometry(&frame.inverse().compose(&tool_world)),
     ));
     Ok(ModelSpec {
+        compliance: None,
         name: spec.name.clone(),
         instrument: spec.instrument.clone(),
         links,

@@ -16,6 +16,7 @@ fn suffix(u: Unit) -> &'static str {
         Unit::Mm => "_mm",
         Unit::Rad => "_deg",
         Unit::Unitless => "",
+        Unit::RadPerMm => "_urad_per_m",
     }
 }
 

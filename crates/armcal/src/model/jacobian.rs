@@ -10,6 +10,7 @@
 //!   twists (Lie brackets of joint and parameter twists), for the pose-design gradients.
 
 use crate::model::chain::{Model, Step};
+use crate::model::compliance::commanded_columns;
 use crate::model::kinematics::{forward_kinematics, Data};
 use crate::model::pose::Pose;
 use crate::model::registry::Segment;
@@ -114,7 +115,8 @@ pub fn identification_jacobian<T: RealField + Copy>(
 }
 
 /// Geometric joint Jacobian of the observed frame in the world frame: rows 0–2 the
-/// velocity of its origin, rows 3–5 its angular velocity, one column per joint.
+/// velocity of its origin, rows 3–5 its angular velocity, one column per joint. With
+/// compliance, w.r.t. the commanded joints: `J̃ ∂(q + Δq)/∂q`.
 pub fn joint_jacobian<T: RealField + Copy>(data: &Data<T>, obs: Observed) -> DMatrix<T> {
     let p = observed_world(data, obs).trans;
     let n = data.joint_twists.len();
@@ -125,6 +127,9 @@ pub fn joint_jacobian<T: RealField + Copy>(data: &Data<T>, obs: Observed) -> DMa
             j[(r, c)] = v[r];
             j[(r + 3, c)] = tw.w[r];
         }
+    }
+    if let Some(c) = &data.compliance {
+        commanded_columns(c, &mut j);
     }
     j
 }
@@ -139,6 +144,8 @@ pub struct MixedWorkspace {
     /// Per joint, in the instrument frame: `R_Iᵀ ω_k` and the point's velocity `R_Iᵀ ṗ`.
     joint_w: Vec<Vector3<f64>>,
     joint_p_dot: Vec<Vector3<f64>>,
+    /// With compliance: per joint, its derivative matrix w.r.t. the deflected joint.
+    deflected: Vec<DMatrix<f64>>,
 }
 
 impl MixedWorkspace {
@@ -167,12 +174,17 @@ impl MixedWorkspace {
         for step in model.target_steps.iter().flatten() {
             mark(step, usize::MAX);
         }
+        // κ_t turns joint i: it acts where joint i acts, with no rate of its own
+        for t in model.compliance.iter().flat_map(|c| &c.terms) {
+            param_order[t.param] = joint_order[t.joint];
+        }
         MixedWorkspace {
             data: Data::new(model),
             param_order,
             joint_order,
             joint_w: vec![Vector3::zeros(); model.dof()],
             joint_p_dot: vec![Vector3::zeros(); model.dof()],
+            deflected: Vec::new(),
         }
     }
 }
@@ -193,7 +205,12 @@ impl MixedWorkspace {
 /// Rotations commute with cross products, so in the instrument frame each entry is one
 /// cross product: `∂J_j/∂q_k = (R_Iᵀω_k) × J_j` or `J^ω_j × (R_Iᵀ ṗ)` with
 /// `J^ω_j = s R_Iᵀ ω_j` (the orientation column). Orientation rows: `(R_Iᵀω_k) × J^ω_j`
-/// after joint k, the screw's `s R_Iᵀ ω̇_j`, zero before. Allocates nothing.
+/// after joint k, the screw's `s R_Iᵀ ω̇_j`, zero before.
+///
+/// With compliance ([`crate::model::compliance`]) the chain runs at `q̃ = q + Δq(q)`, so
+/// `∂J/∂q_k = Σ_l ∂J/∂q̃_l (δ_lk + Σ_{t: joint l} κ_t ∂ℓ_t/∂q_k)`, and the column of κ_t,
+/// `ℓ_t J̃_i` (joint i's column scaled by the lever), gains `(∂ℓ_t/∂q_k) J̃_i`. Allocates
+/// nothing after the first call with a given shape.
 #[allow(clippy::too_many_arguments)]
 pub fn identification_jacobian_dq(
     model: &Model,
@@ -243,6 +260,37 @@ pub fn identification_jacobian_dq(
                 out[(3, c)] = d_rot[0];
                 out[(4, c)] = d_rot[1];
                 out[(5, c)] = d_rot[2];
+            }
+        }
+    }
+    if let (Some(comp), Some(state)) = (&model.compliance, &data.compliance) {
+        let dof = model.dof();
+        ws.deflected.resize(dof, DMatrix::zeros(0, 0));
+        for (d, src) in ws.deflected.iter_mut().zip(dq.iter()) {
+            d.clone_from(src);
+        }
+        for (t, &(kappa, joint)) in state.kappa.iter().enumerate() {
+            for (k, out) in dq.iter_mut().enumerate().take(dof) {
+                let a = kappa * state.lever_rate[t * dof + k];
+                *out += &ws.deflected[joint] * a;
+            }
+        }
+        for (c, &j) in columns.iter().enumerate() {
+            let Some(t) = comp.terms.iter().position(|t| t.param == j) else {
+                continue;
+            };
+            let joint = comp.terms[t].joint;
+            let (w, p_dot) = (ws.joint_w[joint], ws.joint_p_dot[joint]);
+            for (k, out) in dq.iter_mut().enumerate().take(dof) {
+                let rate = state.lever_rate[t * dof + k];
+                for r in 0..3 {
+                    out[(r, c)] += p_dot[r] * rate;
+                }
+                if rows == Rows::Pose {
+                    for r in 0..3 {
+                        out[(3 + r, c)] += w[r] * rate;
+                    }
+                }
             }
         }
     }

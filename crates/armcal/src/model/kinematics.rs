@@ -4,6 +4,7 @@
 //! the pose of every frame and all the data the analytic Jacobians need.
 
 use crate::model::chain::{Model, Step};
+use crate::model::compliance::ComplianceData;
 use crate::model::link::Motion;
 use crate::model::pose::{rot_axis, Pose, Twist};
 use nalgebra::{convert, RealField, Vector3};
@@ -27,11 +28,29 @@ pub struct Data<T: RealField + Copy> {
     /// axis-direction and axis-point twists turn with φ, see `apply_screw`); every other
     /// parameter's twist is taken before its factor acts and its entry stays zero.
     pub param_twist_rates: Vec<Twist<T>>,
+    /// For every joint, the point where the chain reaches its axis (the frame origin before a
+    /// DH/MDH joint factor, a zero-reference screw's axis point), world frame (mm): where
+    /// [`crate::model::compliance`] puts its point masses.
+    pub joint_points: Vec<Vector3<T>>,
+    /// The lever pass and the deflected joints of a compliant model
+    /// ([`crate::model::compliance`]); `None` without compliance. `joint_twists` are then
+    /// the twists of the deflected joints `q + Δq`.
+    pub compliance: Option<Box<ComplianceData<T>>>,
 }
 
 impl<T: RealField + Copy> Data<T> {
     /// Buffers sized for `model`, every pose the identity and every twist zero.
     pub fn new(model: &Model) -> Self {
+        let mut data = Self::without_compliance(model);
+        data.compliance = model
+            .compliance
+            .as_ref()
+            .map(|c| Box::new(ComplianceData::new(model, c)));
+        data
+    }
+
+    /// Buffers for the chain alone, with no compliance state (the lever pass).
+    pub(crate) fn without_compliance(model: &Model) -> Self {
         Data {
             instrument: Pose::identity(),
             frames: vec![Pose::identity(); model.links.len()],
@@ -39,6 +58,8 @@ impl<T: RealField + Copy> Data<T> {
             param_twists: vec![Twist::zero(); model.param_count()],
             joint_twists: vec![Twist::zero(); model.dof()],
             param_twist_rates: vec![Twist::zero(); model.param_count()],
+            joint_points: vec![Vector3::zeros(); model.dof()],
+            compliance: None,
         }
     }
 
@@ -49,7 +70,9 @@ impl<T: RealField + Copy> Data<T> {
 }
 
 /// Evaluates the model at parameters `params` (internal units) and joints `q`, filling
-/// `data` with every frame pose and every parameter and joint twist. Allocates nothing.
+/// `data` with every frame pose and every parameter and joint twist. A compliant model
+/// ([`crate::model::compliance`]) first computes its levers at `q`, then evaluates the chain
+/// at the deflected joints `q + Δq`. Allocates nothing.
 pub fn forward_kinematics<T: RealField + Copy>(
     model: &Model,
     data: &mut Data<T>,
@@ -58,6 +81,27 @@ pub fn forward_kinematics<T: RealField + Copy>(
 ) {
     debug_assert_eq!(params.len(), model.param_count());
     debug_assert_eq!(q.len(), model.dof());
+    match (&model.compliance, data.compliance.take()) {
+        (Some(c), Some(mut state)) => {
+            state.evaluate(model, c, params, q);
+            chain_pass(model, data, params, &state.q);
+            state.set_twists(
+                c,
+                &mut data.param_twists,
+                &data.joint_twists,
+                &mut data.param_twist_rates,
+            );
+            data.compliance = Some(state);
+        }
+        (_, state) => {
+            data.compliance = state;
+            chain_pass(model, data, params, q);
+        }
+    }
+}
+
+/// One pass over instrument, chain and targets at joints `q` (no compliance).
+fn chain_pass<T: RealField + Copy>(model: &Model, data: &mut Data<T>, params: &[f64], q: &[T]) {
     let mut pose = Pose::identity();
     for step in &model.instrument_steps {
         apply_step(step, &mut pose, params, q, data);
@@ -141,6 +185,7 @@ fn apply_step<T: RealField + Copy>(
             data.param_twists[*param] = twist;
             if let Some(j) = joint {
                 data.joint_twists[*j] = twist;
+                data.joint_points[*j] = pose.trans;
             }
             match motion {
                 Motion::Rx => rotate_columns(pose, 1, 2, value),
@@ -213,6 +258,7 @@ fn apply_screw<T: RealField + Copy>(
         data.param_twists[first + 6] = offset;
         if let Some(j) = joint {
             data.joint_twists[j] = offset;
+            data.joint_points[j] = pose.transform_point(&p);
         }
         for k in 0..3 {
             let d = du(k);
@@ -238,6 +284,7 @@ fn apply_screw<T: RealField + Copy>(
     data.param_twists[first + 6] = offset;
     if let Some(j) = joint {
         data.joint_twists[j] = offset;
+        data.joint_points[j] = pose.transform_point(&p);
     }
     for k in 0..3 {
         let d = du(k);

@@ -4,6 +4,7 @@
 pub mod branch;
 pub mod chain;
 pub mod complete;
+pub mod compliance;
 pub mod convert;
 pub mod export;
 pub mod frames;

@@ -17,6 +17,10 @@ pub enum Unit {
     Rad,
     /// Dimensionless (components of a unit axis vector).
     Unitless,
+    /// Lumped joint compliance κ = c·m·g ([`crate::model::compliance`]), stored in rad per
+    /// mm of lever, shown in µrad/m.
+    #[serde(rename = "urad_per_m")]
+    RadPerMm,
 }
 
 impl Unit {
@@ -24,18 +28,20 @@ impl Unit {
     pub fn display_factor(self) -> f64 {
         match self {
             Unit::Rad => 180.0 / std::f64::consts::PI,
+            Unit::RadPerMm => 1e9,
             _ => 1.0,
         }
     }
 
     /// The largest magnitude a model value of this unit may have, in internal units: lengths
-    /// 10⁶ mm (1 km), angles 3600° (ten turns, 20π rad), dimensionless 10⁶. Beyond these the
+    /// 10⁶ mm (1 km), angles 3600° (ten turns, 20π rad), dimensionless 10⁶, compliance 10⁶ µrad/m. Beyond these the
     /// kinematics and the conversions between conventions lose every digit (and overflow), so
     /// a model refuses them ([`crate::model::LinkSpec::check_values`]).
     pub fn max_abs(self) -> f64 {
         match self {
             Unit::Mm | Unit::Unitless => 1e6,
             Unit::Rad => 20.0 * std::f64::consts::PI,
+            Unit::RadPerMm => crate::model::compliance::MAX_COMPLIANCE,
         }
     }
 
@@ -59,6 +65,7 @@ impl Unit {
             Unit::Mm => "mm",
             Unit::Rad => "deg",
             Unit::Unitless => "1",
+            Unit::RadPerMm => "µrad/m",
         }
     }
 }

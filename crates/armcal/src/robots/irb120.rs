@@ -73,6 +73,7 @@ pub fn irb120() -> Robot {
                  armcal's choice from the outline drawing."
             .into(),
         spec: ModelSpec {
+            compliance: None,
             name: "irb120".into(),
             instrument: None,
             links,

@@ -88,6 +88,7 @@ fn build(k: Kr) -> Robot {
         summary: k.summary.into(),
         source: format!("{} {COMMON}", k.source),
         spec: ModelSpec {
+            compliance: None,
             name: k.name.into(),
             instrument: None,
             links,

@@ -97,6 +97,7 @@ pub fn motoman(arm: Arm) -> Robot {
                  for the torso body."
             .into(),
         spec: ModelSpec {
+            compliance: None,
             name,
             instrument: None,
             links,

@@ -87,6 +87,7 @@ pub fn notional(lambda: f64, mu: f64) -> Robot {
                  armcal's choice: the paper does not publish its collision geometry."
             .into(),
         spec: ModelSpec {
+            compliance: None,
             name: format!("paper-{lambda}-{mu}"),
             instrument: None,
             links,

@@ -63,6 +63,7 @@ pub fn ur10() -> Robot {
                  (220.941 and 49.041 mm) are from UR's ROS description."
             .into(),
         spec: ModelSpec {
+            compliance: None,
             name: "ur10".into(),
             instrument: None,
             links,

@@ -21,6 +21,11 @@ pub struct Perturbation {
     pub angle: f64,
     /// Dimensionless parameters (zero-reference axis components).
     pub unitless: f64,
+    /// Lumped joint compliances κ ([`crate::model::compliance`], rad per mm of lever): the
+    /// truth draws `κ = nominal + σ |z|`, a sagging arm (κ ≥ 0 is the physical sign).
+    /// Default 2·10⁻⁷ rad/mm = 200 µrad/m (e.g. 10⁻⁶ rad/(N·m) with 20 kg beyond the joint).
+    #[serde(default = "default_compliance")]
+    pub compliance: f64,
     /// Perturb every parameter (`true`) or only the free ones (`false`, the default: the
     /// truth then lies in the identifiable set and identification can recover it exactly).
     pub all: bool,
@@ -32,9 +37,14 @@ impl Default for Perturbation {
             length: 0.5,
             angle: 0.1f64.to_radians(),
             unitless: 1e-3,
+            compliance: default_compliance(),
             all: false,
         }
     }
+}
+
+fn default_compliance() -> f64 {
+    2e-7
 }
 
 /// The true parameters: nominal + N(0, σ_kind²) per parameter (free ones unless `all`).
@@ -54,6 +64,7 @@ pub fn perturbed_truth(model: &Model, p: &Perturbation, seed: u64) -> Vec<f64> {
                 Unit::Mm => p.length,
                 Unit::Rad => p.angle,
                 Unit::Unitless => p.unitless,
+                Unit::RadPerMm => return par.nominal + p.compliance * z.abs(),
             };
             par.nominal + s * z
         })

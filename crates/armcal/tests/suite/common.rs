@@ -21,6 +21,7 @@ pub fn random_geometry(c: Convention, kind: Option<JointKind>, r: &mut ChaCha8Rn
             Unit::Mm => r.random_range(-400.0..400.0),
             Unit::Rad => r.random_range(-3.0..3.0),
             Unit::Unitless => r.random_range(-1.5..1.5),
+            Unit::RadPerMm => r.random_range(0.0..1e-6),
         })
         .collect();
     let mut g = LinkGeometry::new(c, values);
@@ -81,6 +82,7 @@ pub fn every_convention_model(seed: u64) -> Model {
         joint: None,
     });
     let spec = ModelSpec {
+        compliance: None,
         name: "every-convention".into(),
         instrument: Some(LinkSpec {
             name: "tracker".into(),
@@ -102,6 +104,44 @@ pub fn every_convention_model(seed: u64) -> Model {
         ],
     };
     Model::from_spec(&spec).expect("valid model")
+}
+
+/// [`every_convention_model`] with joint compliance: lumped terms on revolute joints of
+/// several conventions (DH, MDH, book type 3, ZRP), point masses at later joints' axis points
+/// (revolute and prismatic), a random gravity direction and κ large enough (10⁻⁴ rad/mm,
+/// deflections of a tenth of a radian) that the chain rule through `q + Δq` matters.
+pub fn compliant_model(seed: u64) -> Model {
+    let mut r = rng(1000 + seed);
+    let mut spec = every_convention_model(seed).spec();
+    let term = |joint: &str, at: &str, value: f64| armcal::model::compliance::ComplianceTerm {
+        joint: joint.into(),
+        mass: format!("at_{at}"),
+        at: at.into(),
+        value,
+    };
+    let mut k = || r.random_range(0.2e-5..1.5e-5);
+    let terms = vec![
+        term("q1", "q4", k()),
+        term("q1", "q9", k()),
+        term("q5", "q6", k()),
+        term("q9", "q13", k()),
+        term("q13", "q14", k()),
+    ];
+    let gravity = [r.random_range(-1.0..1.0), r.random_range(-1.0..1.0), -1.0];
+    let levers = every_convention_model(seed).nominal();
+    // levers slightly away from the evaluated geometry, as after an identification
+    let levers = levers.iter().map(|x| x * 1.01).collect();
+    spec.compliance = Some(armcal::model::compliance::ComplianceSpec {
+        gravity,
+        levers,
+        terms,
+    });
+    Model::from_spec(&spec).expect("valid compliant model")
+}
+
+/// Both test models of a seed: every convention, rigid and compliant.
+pub fn derivative_models(seed: u64) -> [Model; 2] {
+    [every_convention_model(seed), compliant_model(seed)]
 }
 
 pub fn random_q(model: &Model, r: &mut ChaCha8Rng) -> Vec<f64> {

@@ -13,6 +13,7 @@ mod model {
     mod robots;
 }
 mod identify {
+    mod compliance;
     mod estimate_branch;
     mod estimate_checks;
     mod frames_refit;

@@ -16,6 +16,7 @@ pub(super) fn find_with_unit<'t>(
         Unit::Mm => &[("_mm", 1.0), ("_m", 1000.0)],
         Unit::Rad => &[("_deg", std::f64::consts::PI / 180.0), ("_rad", 1.0)],
         Unit::Unitless => &[("", 1.0)],
+        Unit::RadPerMm => &[("_urad_per_m", 1e-9)],
     };
     let mut found = None;
     for (suffix, factor) in options {
@@ -119,6 +120,7 @@ pub(super) fn unit_spellings(field: &str, unit: Unit) -> String {
         Unit::Mm => format!("{field}_mm|{field}_m"),
         Unit::Rad => format!("{field}_deg|{field}_rad"),
         Unit::Unitless => field.to_string(),
+        Unit::RadPerMm => format!("{field}_urad_per_m"),
     }
 }
 

@@ -58,6 +58,8 @@ struct RawRobot {
     capsules: Vec<Spanned<toml::Table>>,
     /// `auto` (default), `as-given`, `dh`, `mdh` or `zrp` ([`LinkForm`]).
     convention: Option<String>,
+    /// Direction of gravity in the base frame (any length), default `[0, 0, -1]`.
+    gravity: Option<[f64; 3]>,
 }
 
 #[derive(Deserialize)]
@@ -83,6 +85,8 @@ struct RawParameters {
     #[serde(default)]
     priors: BTreeMap<String, toml::Table>,
     measurement: Option<String>,
+    /// Compliant joints, `["j2", "j3"]` ([`crate::model::compliance`]).
+    compliance: Option<Vec<String>>,
 }
 
 /// Error helper: file, line of a span, field path.
@@ -141,6 +145,7 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
     let shaped = shape_robot(&mut robot, &given, spec, form, &mut tool_capsules)
         .map_err(|e| ctx.err(rspan.clone(), "robot.convention", e))?;
     let mut model = Model::from_spec(&shaped.spec).map_err(model_error)?;
+    parameters::compliance(&ctx, raw.parameters.as_ref(), rr.gravity, &mut model)?;
 
     let (measurement, auto_free) =
         parameters::parameters(&ctx, raw.parameters.as_ref(), &mut model)?;

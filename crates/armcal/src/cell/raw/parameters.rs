@@ -1,8 +1,9 @@
-//! `[parameters]`: the free set (`auto`, `all` or patterns), `fixed`, `priors` and the
-//! measurement type.
+//! `[parameters]`: the free set (`auto`, `all` or patterns), `fixed`, `priors`, the
+//! measurement type and the compliant joints (with `[robot] gravity`).
 
 use super::fields::*;
 use super::*;
+use crate::model::compliance::ComplianceSpec;
 
 /// Applies `[parameters]` to `model`; returns the measurement type (pose if every target is
 /// a frame, else position, unless given) and whether the free set is `auto`.
@@ -90,10 +91,19 @@ pub(super) fn parameters(
             priors.push((name.clone(), s));
         }
         if !free.is_empty() {
-            // An explicit free list: everything else is fixed.
+            // An explicit free list: everything else is fixed, but the compliance terms the
+            // section asks for stay free (unless `fixed` names them).
             model
                 .set_status("*", Status::Fixed)
                 .expect("every model has parameters");
+            let terms: Vec<usize> = model
+                .compliance
+                .iter()
+                .flat_map(|c| c.terms.iter().map(|t| t.param))
+                .collect();
+            for i in terms {
+                model.registry.set_status(i, Status::Free);
+            }
         }
         apply_statuses(model, &p.fixed, &free, &priors)
             .map_err(|e| ctx.err(span.clone(), "parameters", e))?;
@@ -108,4 +118,28 @@ pub(super) fn parameters(
         }
     }
     Ok((measurement, auto_free))
+}
+
+/// `[parameters] compliance = ["j2", "j3"]`: rebuilds `model` with the lumped compliance
+/// terms of those joints ([`ComplianceSpec::lumped`], gravity from `[robot] gravity`, default
+/// `[0, 0, -1]`), free. The error names the joint and the line.
+pub(super) fn compliance(
+    ctx: &Ctx,
+    section: Option<&Spanned<RawParameters>>,
+    gravity: Option<[f64; 3]>,
+    model: &mut Model,
+) -> Result<(), Error> {
+    let Some(p) = section else {
+        return Ok(());
+    };
+    let Some(joints) = &p.get_ref().compliance else {
+        return Ok(());
+    };
+    let span = p.span();
+    let c = ComplianceSpec::lumped(model, joints, gravity.unwrap_or([0.0, 0.0, -1.0]))
+        .map_err(|e| ctx.err(span.clone(), "parameters.compliance", e))?;
+    let mut spec = model.spec();
+    spec.compliance = Some(c);
+    *model = Model::from_spec(&spec).map_err(|e| ctx.err(span, "parameters.compliance", e))?;
+    Ok(())
 }

@@ -70,6 +70,7 @@ pub(super) fn robot(
             summary: "inline robot from the cell file".into(),
             source: format!("cell file {file}"),
             spec: ModelSpec {
+                compliance: None,
                 name,
                 instrument: None,
                 links,
@@ -223,6 +224,7 @@ fn inline_link(t: &toml::Table, index: usize) -> Result<LinkSpec, String> {
                     Unit::Mm => "_mm",
                     Unit::Rad => "_deg",
                     Unit::Unitless => "",
+                    Unit::RadPerMm => "_urad_per_m",
                 };
                 return Err(format!(
                     "missing `{field}{hint}` for convention {convention}"

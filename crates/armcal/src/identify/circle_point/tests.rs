@@ -273,6 +273,7 @@ fn untrustworthy_axes_are_warned_about() {
 #[test]
 fn prismatic_axis_and_zero_reference_check() {
     let spec = ModelSpec {
+        compliance: None,
         name: "rp".into(),
         instrument: None,
         links: vec![

@@ -203,6 +203,7 @@ fn every_convention_spec(seed: u64) -> ModelSpec {
                 crate::model::Unit::Mm => r.random_range(-400.0..400.0),
                 crate::model::Unit::Rad => r.random_range(-3.0..3.0),
                 crate::model::Unit::Unitless => r.random_range(0.2..1.5),
+                crate::model::Unit::RadPerMm => unreachable!("no link field is a compliance"),
             })
             .collect();
         let mut g = LinkGeometry::new(c, values);
@@ -268,6 +269,7 @@ fn every_convention_spec(seed: u64) -> ModelSpec {
         }),
     });
     ModelSpec {
+        compliance: None,
         name: "every".into(),
         instrument: None,
         links,

@@ -95,6 +95,7 @@ fn random_chain(c: Convention, n: usize, seed: u64) -> ModelSpec {
         joint: None,
     });
     ModelSpec {
+        compliance: None,
         name: format!("random-{c}"),
         instrument: None,
         links,

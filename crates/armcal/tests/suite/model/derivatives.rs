@@ -1,5 +1,6 @@
 //! Every analytic derivative against central finite differences, for every convention
-//! (revolute and prismatic), on random configurations. Relative error < 1e-6.
+//! (revolute and prismatic), rigid and with joint compliance (the lumped κ columns and the
+//! chain rule through the deflected joints), on random configurations. Relative error < 1e-6.
 
 use crate::common;
 use armcal::model::*;
@@ -11,35 +12,36 @@ const TOL: f64 = 1e-6;
 #[test]
 fn identification_jacobian_matches_finite_differences() {
     for seed in 0..4 {
-        let model = every_convention_model(seed);
-        let mut r = rng(100 + seed);
-        let params = model.nominal();
-        let n = model.param_count();
-        let columns: Vec<usize> = (0..n).collect();
-        for _ in 0..3 {
-            let q = random_q(&model, &mut r);
-            let mut data = Data::new(&model);
-            forward_kinematics(&model, &mut data, &params, &q);
-            for obs in [Observed::Target(0), Observed::Target(1), Observed::Tool] {
-                let mut jac = DMatrix::zeros(6, n);
-                identification_jacobian(&model, &data, obs, Rows::Pose, &columns, &mut jac, 0);
-                for j in 0..n {
-                    let fd = fd_pose(
-                        |h| {
-                            let mut p = params.clone();
-                            p[j] += h;
-                            measure(&model, &p, &q, obs)
-                        },
-                        1e-6,
-                    );
-                    let name = &model.registry.get(j).name;
-                    for row in 0..6 {
-                        assert_close(
-                            jac[(row, j)],
-                            fd[row],
-                            TOL,
-                            &format!("seed {seed} {obs:?} d(row {row})/d{name}"),
+        for model in derivative_models(seed) {
+            let mut r = rng(100 + seed);
+            let params = model.nominal();
+            let n = model.param_count();
+            let columns: Vec<usize> = (0..n).collect();
+            for _ in 0..3 {
+                let q = random_q(&model, &mut r);
+                let mut data = Data::new(&model);
+                forward_kinematics(&model, &mut data, &params, &q);
+                for obs in [Observed::Target(0), Observed::Target(1), Observed::Tool] {
+                    let mut jac = DMatrix::zeros(6, n);
+                    identification_jacobian(&model, &data, obs, Rows::Pose, &columns, &mut jac, 0);
+                    for j in 0..n {
+                        let fd = fd_pose(
+                            |h| {
+                                let mut p = params.clone();
+                                p[j] += h;
+                                measure(&model, &p, &q, obs)
+                            },
+                            1e-6,
                         );
+                        let name = &model.registry.get(j).name;
+                        for row in 0..6 {
+                            assert_close(
+                                jac[(row, j)],
+                                fd[row],
+                                TOL,
+                                &format!("seed {seed} {obs:?} d(row {row})/d{name}"),
+                            );
+                        }
                     }
                 }
             }
@@ -50,33 +52,34 @@ fn identification_jacobian_matches_finite_differences() {
 #[test]
 fn joint_jacobian_matches_finite_differences() {
     for seed in 0..4 {
-        let model = every_convention_model(seed);
-        let mut r = rng(200 + seed);
-        let params = model.nominal();
-        let q = random_q(&model, &mut r);
-        let mut data = Data::new(&model);
-        forward_kinematics(&model, &mut data, &params, &q);
-        for obs in [Observed::Target(1), Observed::Tool] {
-            let jq = joint_jacobian(&data, obs);
-            for j in 0..model.dof() {
-                let fd = fd_pose(
-                    |h| {
-                        let mut qq = q.clone();
-                        qq[j] += h;
-                        let mut d = Data::new(&model);
-                        forward_kinematics(&model, &mut d, &params, &qq);
-                        // world frame: no instrument transform
-                        *armcal::model::jacobian::observed_world(&d, obs)
-                    },
-                    1e-6,
-                );
-                for row in 0..6 {
-                    assert_close(
-                        jq[(row, j)],
-                        fd[row],
-                        TOL,
-                        &format!("seed {seed} dq{j} row {row}"),
+        for model in derivative_models(seed) {
+            let mut r = rng(200 + seed);
+            let params = model.nominal();
+            let q = random_q(&model, &mut r);
+            let mut data = Data::new(&model);
+            forward_kinematics(&model, &mut data, &params, &q);
+            for obs in [Observed::Target(1), Observed::Tool] {
+                let jq = joint_jacobian(&data, obs);
+                for j in 0..model.dof() {
+                    let fd = fd_pose(
+                        |h| {
+                            let mut qq = q.clone();
+                            qq[j] += h;
+                            let mut d = Data::new(&model);
+                            forward_kinematics(&model, &mut d, &params, &qq);
+                            // world frame: no instrument transform
+                            *armcal::model::jacobian::observed_world(&d, obs)
+                        },
+                        1e-6,
                     );
+                    for row in 0..6 {
+                        assert_close(
+                            jq[(row, j)],
+                            fd[row],
+                            TOL,
+                            &format!("seed {seed} dq{j} row {row}"),
+                        );
+                    }
                 }
             }
         }
@@ -86,57 +89,72 @@ fn joint_jacobian_matches_finite_differences() {
 #[test]
 fn mixed_derivative_matches_finite_differences_of_jacobian() {
     for seed in 0..3 {
-        let model = every_convention_model(seed);
-        let mut r = rng(300 + seed);
-        let params = model.nominal();
-        let n = model.param_count();
-        let columns: Vec<usize> = (0..n).collect();
-        let q = random_q(&model, &mut r);
-        for rows in [Rows::Position, Rows::Pose] {
-            let m = rows.count();
-            let mut ws = MixedWorkspace::new(&model);
-            let mut value = DMatrix::zeros(m, n);
-            let mut dq = vec![DMatrix::zeros(m, n); model.dof()];
-            identification_jacobian_dq(
-                &model,
-                &mut ws,
-                &params,
-                &q,
-                Observed::Target(0),
-                rows,
-                &columns,
-                &mut value,
-                &mut dq,
-            );
-            let jac_at = |qq: &[f64]| {
-                let mut d = Data::new(&model);
-                forward_kinematics(&model, &mut d, &params, qq);
-                let mut jac = DMatrix::zeros(m, n);
-                identification_jacobian(
+        for model in derivative_models(seed) {
+            let mut r = rng(300 + seed);
+            let params = model.nominal();
+            let n = model.param_count();
+            let columns: Vec<usize> = (0..n).collect();
+            let q = random_q(&model, &mut r);
+            for rows in [Rows::Position, Rows::Pose] {
+                let m = rows.count();
+                let mut ws = MixedWorkspace::new(&model);
+                let mut value = DMatrix::zeros(m, n);
+                let mut dq = vec![DMatrix::zeros(m, n); model.dof()];
+                identification_jacobian_dq(
                     &model,
-                    &d,
+                    &mut ws,
+                    &params,
+                    &q,
                     Observed::Target(0),
                     rows,
                     &columns,
-                    &mut jac,
-                    0,
+                    &mut value,
+                    &mut dq,
                 );
-                jac
-            };
-            let j0 = jac_at(&q);
-            assert!(
-                (&value - &j0).abs().max() < 1e-12,
-                "the value equals the f64 Jacobian"
-            );
-            let h = 1e-6;
-            for k in 0..model.dof() {
-                let mut qp = q.clone();
-                qp[k] += h;
-                let mut qm = q.clone();
-                qm[k] -= h;
-                let fd = (jac_at(&qp) - jac_at(&qm)) / (2.0 * h);
-                for (idx, (a, b)) in dq[k].iter().zip(fd.iter()).enumerate() {
-                    assert_close(*a, *b, TOL, &format!("seed {seed} dJ/dq{k} entry {idx}"));
+                let jac_at = |qq: &[f64]| {
+                    let mut d = Data::new(&model);
+                    forward_kinematics(&model, &mut d, &params, qq);
+                    let mut jac = DMatrix::zeros(m, n);
+                    identification_jacobian(
+                        &model,
+                        &d,
+                        Observed::Target(0),
+                        rows,
+                        &columns,
+                        &mut jac,
+                        0,
+                    );
+                    jac
+                };
+                let j0 = jac_at(&q);
+                assert!(
+                    (&value - &j0).abs().max() < 1e-12,
+                    "the value equals the f64 Jacobian"
+                );
+                let h = 1e-6;
+                for k in 0..model.dof() {
+                    let mut qp = q.clone();
+                    qp[k] += h;
+                    let mut qm = q.clone();
+                    qm[k] -= h;
+                    let fd = (jac_at(&qp) - jac_at(&qm)) / (2.0 * h);
+                    for (idx, (a, b)) in dq[k].iter().zip(fd.iter()).enumerate() {
+                        // A κ column is a lever (~10³ mm) times a joint column: its finite
+                        // difference rounds at eps·|column|/h, so compare it on its column's
+                        // scale (the dual-number test below checks it exactly).
+                        let c = idx / m;
+                        let scale = if model.registry.get(c).unit == Unit::RadPerMm {
+                            j0.column(c).abs().max().max(1.0)
+                        } else {
+                            1.0
+                        };
+                        assert_close(
+                            *a / scale,
+                            *b / scale,
+                            TOL,
+                            &format!("seed {seed} dJ/dq{k} entry {idx}"),
+                        );
+                    }
                 }
             }
         }
@@ -150,41 +168,44 @@ fn mixed_derivative_matches_finite_differences_of_jacobian() {
 fn mixed_derivative_matches_dual_numbers() {
     use num_dual::Dual64;
     for seed in 0..3 {
-        let model = every_convention_model(seed);
-        let mut r = rng(500 + seed);
-        let params = model.nominal();
-        let n = model.param_count();
-        let columns: Vec<usize> = (0..n).filter(|c| c % 3 != 1).collect();
-        let q = random_q(&model, &mut r);
-        let mut ws = MixedWorkspace::new(&model);
-        let mut dual_data = Data::<Dual64>::new(&model);
-        for obs in [Observed::Target(0), Observed::Target(1), Observed::Tool] {
-            for rows in [Rows::Position, Rows::Pose] {
-                let m = rows.count();
-                let mut value = DMatrix::zeros(m, columns.len());
-                let mut dq = vec![DMatrix::zeros(m, columns.len()); model.dof()];
-                identification_jacobian_dq(
-                    &model, &mut ws, &params, &q, obs, rows, &columns, &mut value, &mut dq,
-                );
-                for (k, dqk) in dq.iter().enumerate() {
-                    let qd: Vec<Dual64> = q
-                        .iter()
-                        .enumerate()
-                        .map(|(i, &x)| Dual64::new(x, if i == k { 1.0 } else { 0.0 }))
-                        .collect();
-                    forward_kinematics(&model, &mut dual_data, &params, &qd);
-                    let mut jac = DMatrix::from_element(m, columns.len(), Dual64::from(0.0));
-                    identification_jacobian(&model, &dual_data, obs, rows, &columns, &mut jac, 0);
-                    let scale = jac.iter().fold(1.0f64, |a, x| a.max(x.eps.abs()));
-                    for (idx, (a, b)) in dqk.iter().zip(jac.iter()).enumerate() {
-                        assert!(
+        for model in derivative_models(seed) {
+            let mut r = rng(500 + seed);
+            let params = model.nominal();
+            let n = model.param_count();
+            let columns: Vec<usize> = (0..n).filter(|c| c % 3 != 1).collect();
+            let q = random_q(&model, &mut r);
+            let mut ws = MixedWorkspace::new(&model);
+            let mut dual_data = Data::<Dual64>::new(&model);
+            for obs in [Observed::Target(0), Observed::Target(1), Observed::Tool] {
+                for rows in [Rows::Position, Rows::Pose] {
+                    let m = rows.count();
+                    let mut value = DMatrix::zeros(m, columns.len());
+                    let mut dq = vec![DMatrix::zeros(m, columns.len()); model.dof()];
+                    identification_jacobian_dq(
+                        &model, &mut ws, &params, &q, obs, rows, &columns, &mut value, &mut dq,
+                    );
+                    for (k, dqk) in dq.iter().enumerate() {
+                        let qd: Vec<Dual64> = q
+                            .iter()
+                            .enumerate()
+                            .map(|(i, &x)| Dual64::new(x, if i == k { 1.0 } else { 0.0 }))
+                            .collect();
+                        forward_kinematics(&model, &mut dual_data, &params, &qd);
+                        let mut jac = DMatrix::from_element(m, columns.len(), Dual64::from(0.0));
+                        identification_jacobian(
+                            &model, &dual_data, obs, rows, &columns, &mut jac, 0,
+                        );
+                        let scale = jac.iter().fold(1.0f64, |a, x| a.max(x.eps.abs()));
+                        for (idx, (a, b)) in dqk.iter().zip(jac.iter()).enumerate() {
+                            assert!(
                             (a - b.eps).abs() <= 1e-10 * scale,
                             "seed {seed} {obs:?} {rows:?} dJ/dq{k} entry {idx}: analytic {a}, dual {}",
                             b.eps
                         );
-                        if k == 0 {
-                            let v = value[idx];
-                            assert!((v - b.re).abs() <= 1e-12 * scale.max(v.abs()));
+                            if k == 0 {
+                                let v = value[idx];
+                                assert!((v - b.re).abs() <= 1e-12 * scale.max(v.abs()));
+                            }
                         }
                     }
                 }

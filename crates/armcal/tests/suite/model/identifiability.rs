@@ -80,6 +80,7 @@ fn random_chain(kinds: &str, seed: u64) -> Model {
         joint: None,
     });
     Model::from_spec(&ModelSpec {
+        compliance: None,
         name: kinds.into(),
         instrument: None,
         links,

@@ -1,0 +1,370 @@
+//! Joint compliance under gravity (elastostatic deflection), identified with the geometry:
+//! the book's level-3 calibration (Mooring, Roth & Driels 1991, §1.3 and ch. 2's
+//! non-kinematic errors) and the outlook of Jost et al. 2017, §6 ("non-geometric errors like
+//! joint elasticities").
+//!
+//! # Model
+//! A compliant joint `i` deflects under the gravity torque of everything beyond it,
+//! `Δq_i = c_i τ_i(q)`, and forward kinematics runs at `q + Δq` (a joint-space correction:
+//! every other parameter, Jacobian and derivative is unchanged but evaluated there).
+//!
+//! # The identifiable combinations
+//! Let joint `i` have the unit world twist `ξ_i = (ω_i, v_i)` (axis direction and moment) and
+//! let a point mass `m` sit at `x` on a link beyond it. Gravity is `F = m g ĝ`, `ĝ` the unit
+//! direction of `[robot] gravity` (the chain's first frame, default `[0, 0, −1]`) and
+//! `g = 9.81 m/s²`. By virtual work the torque about joint `i` is the force times the
+//! velocity of `x` under a unit rotation of joint `i`:
+//!
+//! `τ_i = F · (ω_i × x + v_i) = m g ℓ_i(x, q)`, with the lever `ℓ_i = ĝ · ∂x/∂q_i` (mm).
+//!
+//! Link masses and stiffnesses are unknown, so `c_i` and `m` never appear alone: the data see
+//! only the products `κ_{i,m} = c_i m g`, and `Δq_i = Σ_m κ_{i,m} ℓ_i(x_m, q)`. Every lever is
+//! taken from the nominal kinematics (kept with the model as [`ComplianceSpec::levers`]), so
+//! `Δq` is a known function of `q` times the unknown `κ`: the model stays linear in `κ` and
+//! its derivatives stay exact. A general link mass (mass and first moment, four numbers per
+//! link) makes `τ_i` a combination of the levers of the link's origin and of its three axes;
+//! armcal starts from point masses at chosen frames instead (the form that worked on real
+//! tracker data, issue 14) and drops what cannot be told apart:
+//!
+//! * **no torque**: `ℓ_i ≡ 0` when `ω_i ∥ ĝ` (a vertical first joint: `ĝ · (ω_i × r) = 0`) or
+//!   when the mass lies on the axis of joint `i` (`r ∥ ω_i`) or before it in the chain;
+//! * **a constant torque**: `ℓ_i` constant over the joint range is the joint offset's
+//!   column (`Δq_i` constant), already identified;
+//! * **the same function twice**: a lever that is a linear combination of the joint's other
+//!   kept levers and the constant (a mass on the segment between two kept masses on one
+//!   link: `ℓ` is linear in `x`).
+//!
+//! The three tests run on the levers sampled over the joint limits
+//! ([`ComplianceSpec::lumped`]); a compliant joint with no term left is an error. What is
+//! left can still be indistinguishable from the geometry on a given data set (a small arm, a
+//! narrow joint range): the identification's gate reports for every term its σ, its largest
+//! correlation with the geometric parameters and the share of its effect the geometric
+//! columns cannot absorb (`crate::identify::compliance_gate`).
+//!
+//! # Default masses
+//! For compliant joints `i₁ < i₂ < …` two point masses: the **elbow**, the point where the
+//! chain reaches the axis of the joint after `i₁` (for a 6R arm with parallel shoulder and
+//! elbow: the elbow axis), and the **wrist**, the point of the second-to-last joint's axis
+//! (the wrist centre of a spherical wrist). A joint `i₁ = 2, i₂ = 3` arm gets
+//! `j2 × elbow`, `j2 × wrist`, `j3 × wrist` (`j3 × elbow` has no torque: the elbow lies on
+//! the axis of `j3`). The terms are named `<joint>.compliance.<mass>`.
+//!
+//! # Units
+//! `κ` is stored in rad per mm of lever and shown in **µrad/m** (`1 rad/mm = 10⁹ µrad/m`): a
+//! deflection of `κ` µrad for every metre of horizontal lever arm. For `c = 10⁻⁶ rad/(N·m)`
+//! and 20 kg beyond the joint, `κ ≈ 196 µrad/m`. A physical compliance is `κ ≥ 0` (the arm
+//! sags: the potential `−F·x` falls by `κ ℓ² ≥ 0`); a negative estimate is flagged.
+
+use crate::model::chain::Model;
+use crate::model::kinematics::{forward_kinematics, Data};
+use crate::model::link::JointKind;
+use crate::model::pose::Twist;
+use nalgebra::{convert, DMatrix, RealField, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// Largest |κ| a model holds (rad/mm; 10⁶ µrad/m).
+pub const MAX_COMPLIANCE: f64 = 1e-3;
+
+/// Configurations the lever tests of [`ComplianceSpec::lumped`] sample.
+const LEVER_SAMPLES: usize = 200;
+
+/// A lever whose part outside the span of the constant and the kept levers is below this
+/// share of its norm is dropped (it is the same function).
+const LEVER_DEPENDENCE: f64 = 1e-6;
+
+/// One lumped compliance term `κ_{i,m} = c_i m g` (see the module notes).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ComplianceTerm {
+    /// Name of the compliant joint `i`.
+    pub joint: String,
+    /// The mass's label in the parameter name (`elbow`, `wrist`).
+    pub mass: String,
+    /// The joint on whose axis the point mass sits (where the chain reaches that axis).
+    pub at: String,
+    /// κ in rad per mm of lever (shown in µrad/m).
+    pub value: f64,
+}
+
+/// Joint compliance of a model: gravity, the lever geometry and the lumped terms.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ComplianceSpec {
+    /// Unit gravity direction in the chain's first (base) frame.
+    pub gravity: [f64; 3],
+    /// The link parameter values (registry order, mm and rad) the levers are computed with:
+    /// the nominal geometry, kept so that a model rebuilt from an estimate deflects alike.
+    pub levers: Vec<f64>,
+    /// The lumped terms.
+    pub terms: Vec<ComplianceTerm>,
+}
+
+/// A term compiled against a model.
+#[derive(Clone, Debug)]
+pub struct CompiledTerm {
+    /// Index of the compliant joint in `q`.
+    pub joint: usize,
+    /// Index of the joint whose axis point carries the mass.
+    pub at: usize,
+    /// Index of κ in the registry.
+    pub param: usize,
+    /// The term as specified (its value is the nominal).
+    pub spec: ComplianceTerm,
+}
+
+/// [`ComplianceSpec`] compiled against a model ([`Model::compliance`]).
+#[derive(Clone, Debug)]
+pub struct Compliance {
+    /// Unit gravity in the base frame.
+    pub gravity: Vector3<f64>,
+    /// Lever parameter vector (a full parameter vector; compliance entries unused).
+    pub levers: Vec<f64>,
+    /// The terms, in registry order.
+    pub terms: Vec<CompiledTerm>,
+}
+
+impl Compliance {
+    /// Number of link parameters (the registry before the κ).
+    pub fn link_params(&self) -> usize {
+        self.levers.len() - self.terms.len()
+    }
+
+    /// Whether registry parameter `i` is a compliance term.
+    pub fn is_term(&self, i: usize) -> bool {
+        i >= self.link_params()
+    }
+}
+
+/// The per-evaluation state of the compliance ([`Data::compliance`]).
+#[derive(Clone, Debug)]
+pub struct ComplianceData<T: RealField + Copy> {
+    /// The lever pass: the model at the lever parameters and the commanded `q`.
+    pub levers: Data<T>,
+    /// The deflected joints `q + Δq` at which the chain is evaluated.
+    pub q: Vec<T>,
+    /// Per term, the lever `ℓ` (mm).
+    pub lever: Vec<T>,
+    /// Per term and joint (row-major, `term · dof + k`), `∂ℓ/∂q_k`.
+    pub lever_rate: Vec<T>,
+    /// Per term, κ (rad/mm), the compliant joint's index.
+    pub kappa: Vec<(T, usize)>,
+}
+
+impl<T: RealField + Copy> ComplianceData<T> {
+    /// Buffers for `model` (which has compliance).
+    pub(crate) fn new(model: &Model, c: &Compliance) -> Self {
+        let n = c.terms.len();
+        ComplianceData {
+            levers: Data::without_compliance(model),
+            q: vec![T::zero(); model.dof()],
+            lever: vec![T::zero(); n],
+            lever_rate: vec![T::zero(); n * model.dof()],
+            kappa: vec![(T::zero(), 0); n],
+        }
+    }
+
+    /// The levers and their q-derivatives at `q` and the deflected joints `q + Δq`.
+    ///
+    /// `∂ℓ_i/∂q_k` with `c = ω_i × x + v_i` (the velocity of the mass point under joint i):
+    /// for `k ≤ i` joint k turns axis i and the point rigidly, `ċ = ω_k × c`; for `k > i`
+    /// the axis stays and the point moves if joint k comes before it in the chain,
+    /// `ċ = ω_i × (ω_k × x + v_k)`, else nothing moves. `ℓ̇ = ĝ · ċ` (ĝ fixed in the world).
+    pub(crate) fn evaluate(&mut self, model: &Model, c: &Compliance, params: &[f64], q: &[T]) {
+        forward_kinematics(model, &mut self.levers, &c.levers, q);
+        let dof = model.dof();
+        let g: Vector3<T> = self.levers.frames[0].rot * c.gravity.map(convert::<f64, T>);
+        self.q.copy_from_slice(q);
+        for (t, term) in c.terms.iter().enumerate() {
+            let twists = &self.levers.joint_twists;
+            let x = self.levers.joint_points[term.at];
+            let axis = twists[term.joint];
+            let vel = axis.point_velocity(&x);
+            let kappa: T = convert(params[term.param]);
+            let lever = g.dot(&vel);
+            self.lever[t] = lever;
+            self.kappa[t] = (kappa, term.joint);
+            self.q[term.joint] += kappa * lever;
+            for (k, tw) in twists.iter().enumerate() {
+                self.lever_rate[t * dof + k] = if k <= term.joint {
+                    g.dot(&tw.w.cross(&vel))
+                } else if k < term.at {
+                    g.dot(&axis.w.cross(&tw.point_velocity(&x)))
+                } else {
+                    T::zero()
+                };
+            }
+        }
+    }
+
+    /// Writes the compliance parameters' twists into `data` (after the deflected pass): a
+    /// unit change of κ_t turns joint i by ℓ_t, so its twist is `ℓ_t ξ_i`, and it has no
+    /// rate of its own.
+    pub(crate) fn set_twists(
+        &self,
+        c: &Compliance,
+        data_twists: &mut [Twist<T>],
+        joints: &[Twist<T>],
+        rates: &mut [Twist<T>],
+    ) {
+        for (t, term) in c.terms.iter().enumerate() {
+            let j = joints[term.joint];
+            data_twists[term.param] = Twist {
+                w: j.w * self.lever[t],
+                v: j.v * self.lever[t],
+            };
+            rates[term.param] = Twist::zero();
+        }
+    }
+}
+
+impl ComplianceSpec {
+    /// The lumped terms for compliant `joints` with the default masses (elbow and wrist, see
+    /// the module notes), after dropping the terms with no torque, a constant torque or a
+    /// lever another term already has, sampled over the joint limits. `model` has no
+    /// compliance yet; its nominal parameters become the levers. The error names the joint
+    /// and what to do (unknown, prismatic, no gravity torque, given twice).
+    pub fn lumped(model: &Model, joints: &[String], gravity: [f64; 3]) -> Result<Self, String> {
+        let g = gravity_direction(gravity)?;
+        let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+        let mut index = Vec::new();
+        for name in joints {
+            let i = names.iter().position(|n| n == name).ok_or_else(|| {
+                format!(
+                    "unknown joint `{name}` (the robot's joints: {})",
+                    names.join(", ")
+                )
+            })?;
+            if model.joints[i].kind == JointKind::Prismatic {
+                return Err(format!(
+                    "joint `{name}` is prismatic; compliance is modelled for revolute joints only"
+                ));
+            }
+            if index.contains(&i) {
+                return Err(format!("joint `{name}` is listed twice"));
+            }
+            index.push(i);
+        }
+        index.sort_unstable();
+        let dof = model.dof();
+        let Some(&first) = index.first() else {
+            return Err("give at least one joint, e.g. [\"j2\", \"j3\"]".into());
+        };
+        let mut masses: Vec<(&str, usize)> = Vec::new();
+        if first + 1 < dof {
+            masses.push(("elbow", first + 1));
+        }
+        if dof >= 2 && masses.iter().all(|m| m.1 != dof - 2) {
+            masses.push(("wrist", dof - 2));
+        }
+        let levers = model.nominal();
+        let samples = lever_samples(model, &levers, g);
+        let mut terms = Vec::new();
+        for &i in &index {
+            // columns: the constant, then the kept levers of joint i
+            let mut basis: Vec<Vec<f64>> = vec![vec![1.0; samples.len()]];
+            orthonormalise(&mut basis[0]);
+            for &(label, at) in &masses {
+                if at <= i {
+                    continue;
+                }
+                let mut l: Vec<f64> = samples.iter().map(|s| s.lever(i, at)).collect();
+                let norm = l.iter().map(|x| x * x).sum::<f64>().sqrt();
+                for b in &basis {
+                    let d: f64 = b.iter().zip(&l).map(|(x, y)| x * y).sum();
+                    l.iter_mut().zip(b).for_each(|(y, x)| *y -= d * x);
+                }
+                let rest = l.iter().map(|x| x * x).sum::<f64>().sqrt();
+                // 1e-9 mm: no torque at all
+                if norm < 1e-9 * samples.len() as f64 || rest < LEVER_DEPENDENCE * norm {
+                    continue;
+                }
+                orthonormalise(&mut l);
+                basis.push(l);
+                terms.push(ComplianceTerm {
+                    joint: names[i].to_string(),
+                    mass: label.to_string(),
+                    at: names[at].to_string(),
+                    value: 0.0,
+                });
+            }
+            if basis.len() == 1 {
+                return Err(format!(
+                    "joint `{}` carries no gravity torque that a joint offset does not absorb \
+                     (its axis is along gravity, or the elbow and wrist lie on it or before \
+                     it); remove it from the list",
+                    names[i]
+                ));
+            }
+        }
+        Ok(ComplianceSpec {
+            gravity: [g.x, g.y, g.z],
+            levers,
+            terms,
+        })
+    }
+
+    /// Name of term `t`'s parameter: `<joint>.compliance.<mass>`.
+    pub fn parameter_name(term: &ComplianceTerm) -> String {
+        format!("{}.compliance.{}", term.joint, term.mass)
+    }
+}
+
+/// The unit direction of `gravity` (any length), or an error for a zero or non-finite one.
+pub fn gravity_direction(gravity: [f64; 3]) -> Result<Vector3<f64>, String> {
+    let g = Vector3::from(gravity);
+    if g.iter().all(|x| x.is_finite()) && g.norm() > 1e-9 {
+        Ok(g.normalize())
+    } else {
+        Err(format!(
+            "gravity {gravity:?} must be a non-zero direction in the base frame"
+        ))
+    }
+}
+
+/// One sampled configuration of the lever tests: joint twists and joint points at the
+/// lever parameters, and world gravity.
+struct LeverSample {
+    twists: Vec<Twist<f64>>,
+    points: Vec<Vector3<f64>>,
+    gravity: Vector3<f64>,
+}
+
+impl LeverSample {
+    fn lever(&self, i: usize, at: usize) -> f64 {
+        self.gravity
+            .dot(&self.twists[i].point_velocity(&self.points[at]))
+    }
+}
+
+fn lever_samples(model: &Model, levers: &[f64], g: Vector3<f64>) -> Vec<LeverSample> {
+    let qs = crate::model::random_configurations(model, LEVER_SAMPLES, 14);
+    let mut data = Data::without_compliance(model);
+    qs.iter()
+        .map(|q| {
+            forward_kinematics(model, &mut data, levers, q);
+            LeverSample {
+                twists: data.joint_twists.clone(),
+                points: data.joint_points.clone(),
+                gravity: data.frames[0].rot * g,
+            }
+        })
+        .collect()
+}
+
+fn orthonormalise(v: &mut [f64]) {
+    let n = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    v.iter_mut().for_each(|x| *x /= n);
+}
+
+/// `J_q = J̃ (I + K ∂ℓ/∂q)`: the derivative w.r.t. the commanded joints of columns `jac`
+/// given w.r.t. the deflected joints (one column per joint), in place.
+pub(crate) fn commanded_columns<T: RealField + Copy>(c: &ComplianceData<T>, jac: &mut DMatrix<T>) {
+    let dof = jac.ncols();
+    let deflected = jac.clone_owned();
+    for (t, &(kappa, joint)) in c.kappa.iter().enumerate() {
+        for k in 0..dof {
+            let a = kappa * c.lever_rate[t * dof + k];
+            for r in 0..jac.nrows() {
+                jac[(r, k)] += deflected[(r, joint)] * a;
+            }
+        }
+    }
+}
