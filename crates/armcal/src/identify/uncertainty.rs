@@ -23,12 +23,15 @@ pub struct ParameterUncertainty {
     /// Pairs of free-parameter columns with |ρ| > 0.95, and ρ.
     pub strong_correlations: Vec<(usize, usize, f64)>,
     /// A-posteriori variance factor σ̂₀² = rᵀr / (m − n); ≈ 1 if σ and the model are right.
+    /// NaN (`null` in the file) without degrees of freedom.
+    #[serde(deserialize_with = "crate::json::nan_from_null")]
     pub variance_factor: f64,
     /// Degrees of freedom m − n.
     pub dof: usize,
     /// rᵀr, χ²(m − n)-distributed under the model.
     pub chi2: f64,
-    /// P(χ² ≥ rᵀr).
+    /// P(χ² ≥ rᵀr); NaN (`null` in the file) without degrees of freedom.
+    #[serde(deserialize_with = "crate::json::nan_from_null")]
     pub p_value: f64,
     /// Two-sided test at 5 %: "consistent", "residuals too large", "residuals too small".
     pub verdict: String,

@@ -535,3 +535,23 @@ fn study_section_has_tables_6_to_8_and_figure_8() {
     // 90 points per curve and a legend dot each, in each of the two charts.
     assert_eq!(html.matches("<circle").count(), 2 * (2 * 90 + 2));
 }
+
+/// An estimate without degrees of freedom has no variance factor and no p-value (NaN,
+/// written `null`); armcal reads that file back (it refused it before: "invalid type: null,
+/// expected f64").
+#[test]
+fn an_estimate_without_degrees_of_freedom_reads_back() {
+    let (_, _, est) = fixtures();
+    let mut e = est.clone();
+    e.uncertainty.variance_factor = f64::NAN;
+    e.uncertainty.p_value = f64::NAN;
+    let text = serde_json::to_string_pretty(&e).unwrap();
+    assert!(text.contains("\"variance_factor\": null"));
+    match Document::from_json(&text, "estimate.json").expect("reads back") {
+        Document::Estimate(again) => {
+            assert!(again.uncertainty.variance_factor.is_nan());
+            assert!(again.uncertainty.p_value.is_nan());
+        }
+        _ => panic!("not an estimate"),
+    }
+}
