@@ -217,7 +217,7 @@ pub fn records(text: &str) {
                 let _ = evaluate_design(cell, &design, true);
             }
         }
-        Document::Study(_) | Document::Demo(_) | Document::Truth(_) => {}
+        Document::Study(_) | Document::Demo(_) | Document::Truth(_) | Document::Campaign(_) => {}
     }
     let inputs = [Input {
         label: "fuzz".into(),
