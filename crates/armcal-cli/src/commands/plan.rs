@@ -4,7 +4,7 @@
 use super::output::{load_cell, Outputs};
 use super::progress::Progress;
 use anyhow::bail;
-use armcal::design::assess::evaluate_design;
+use armcal::design::assess::{evaluate_design, PathPrecision};
 use armcal::design::plan::PlanSettings;
 use armcal::design::record::KindMargin;
 use armcal::design::user_pool::{PoolReport, PoolSettings};
@@ -21,8 +21,9 @@ pub struct PlanArgs {
     /// Number of measurement poses.
     #[arg(long, default_value_t = 60)]
     pub poses: usize,
-    /// Criterion: kpi (TCP variance at the working poses, paper eq. 24), a, d, e, o1…o5.
-    #[arg(long, default_value = "kpi", value_parser = ["kpi", "a", "d", "e", "o1", "o2", "o3", "o4", "o5"])]
+    /// Criterion: kpi (mean TCP variance at the working poses and paths, paper eq. 24), kpi-max
+    /// (the largest one), a, d, e, o1…o5.
+    #[arg(long, default_value = "kpi", value_parser = ["kpi", "kpi-max", "a", "d", "e", "o1", "o2", "o3", "o4", "o5"])]
     pub criterion: String,
     /// Collision and line-of-sight constraints.
     #[arg(long, default_value = "on", value_parser = ["on", "off"])]
@@ -189,6 +190,7 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
     if let Some(t) = record.assessment.tcp.first() {
         println!("(1/3) tr C_s at `{}`: {:.5} mm²", t.name, t.kpi);
     }
+    print_paths(&record.assessment.paths, "");
     println!(
         "design → {}, report → {}",
         a.out.display(),
@@ -205,6 +207,20 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         bail!("the design violates constraints; see the report");
     }
     Ok(())
+}
+
+/// Each working path's mean and largest (1/3) tr C_s, indented by `indent`.
+fn print_paths(paths: &[PathPrecision], indent: &str) {
+    for p in paths {
+        println!(
+            "{indent}(1/3) tr C_s along `{}` ({} configurations): mean {:.5} mm², largest {:.5} mm² at configuration {}",
+            p.name,
+            p.kpi.len(),
+            p.mean_kpi,
+            p.max_kpi,
+            p.worst
+        );
+    }
 }
 
 /// The pool's rows on stderr: how many are infeasible (the first ten of them), which were
@@ -269,6 +285,7 @@ pub fn run_evaluate(a: &EvaluateArgs) -> anyhow::Result<()> {
     for t in &ev.assessment.tcp {
         println!("  (1/3) tr C_s at `{}` = {:.5} mm²", t.name, t.kpi);
     }
+    print_paths(&ev.assessment.paths, "  ");
     let infeasible = &ev.infeasible_poses;
     match (&ev.min_margin, infeasible.is_empty()) {
         (_, true) => println!("every pose feasible"),

@@ -56,17 +56,29 @@ pub fn to_cell_toml(cell: &Cell, identified: &Model, spec: &ModelSpec) -> Result
         }
     }
     s.parameters = Some(parameters(cell, &exported));
+    let display = |q: &[f64]| -> Vec<f64> {
+        q.iter()
+            .zip(&cell.model.joints)
+            .map(|(v, j)| v * j.kind.unit().display_factor())
+            .collect()
+    };
     for w in &cell.working {
-        let q: Vec<f64> =
-            w.q.iter()
-                .zip(&cell.model.joints)
-                .map(|(v, j)| v * j.kind.unit().display_factor())
-                .collect();
         let _ = writeln!(
             s.tail,
-            "\n[[working]]\nname = {}\njoints_deg = {q:?}\nweight = {:?}",
+            "\n[[working]]\nname = {}\njoints_deg = {:?}\nweight = {:?}",
             toml_text::string(&w.name),
+            display(&w.q),
             w.weight
+        );
+    }
+    // A path read from a file is written inline, so that the exported cell stands alone.
+    for p in &cell.working_paths {
+        let q: Vec<Vec<f64>> = p.q.iter().map(|q| display(q)).collect();
+        let _ = writeln!(
+            s.tail,
+            "\n[[working_path]]\nname = {}\nweight = {:?}\njoints_deg = {q:?}",
+            toml_text::string(&p.name),
+            p.weight
         );
     }
     for o in &cell.obstacles {

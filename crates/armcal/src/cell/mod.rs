@@ -41,6 +41,20 @@ pub struct WorkingPose {
     pub weight: f64,
 }
 
+/// A path the robot works along (`[[working_path]]`: a welding seam, a measuring path); the
+/// pose-design KPIs take the TCP at each of its configurations (paper §6, "working path
+/// trajectories").
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct WorkingPath {
+    /// Name from `[[working_path]] name`, used in reports.
+    pub name: String,
+    /// Its configurations in order, internal units (rad, mm).
+    pub q: Vec<Vec<f64>>,
+    /// Relative weight (> 0) of the whole path in the mean KPI, shared equally by its
+    /// configurations (a working pose of the same weight counts as much as the path).
+    pub weight: f64,
+}
+
 /// An obstacle in the world frame (mm).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
@@ -142,6 +156,8 @@ pub struct Cell {
     pub instrument: Option<Instrument>,
     /// `[[working]]` configurations, in file order.
     pub working: Vec<WorkingPose>,
+    /// `[[working_path]]` paths, in file order.
+    pub working_paths: Vec<WorkingPath>,
     /// `[[obstacles]]` the pose design keeps clear of, in the world frame.
     pub obstacles: Vec<Obstacle>,
     /// Capsules of the robot and of the tool (in chain frames).
@@ -186,6 +202,18 @@ impl Cell {
             .unwrap_or_default()
     }
 
+    /// Every configuration the pose-design KPIs take the TCP at, with its weight in the mean
+    /// KPI: the working poses (their weight), then each working path's configurations (the
+    /// path's weight shared equally among them).
+    pub fn kpi_configurations(&self) -> Vec<(&[f64], f64)> {
+        let poses = self.working.iter().map(|w| (w.q.as_slice(), w.weight));
+        let paths = self.working_paths.iter().flat_map(|p| {
+            let share = p.weight / p.q.len() as f64;
+            p.q.iter().map(move |q| (q.as_slice(), share))
+        });
+        poses.chain(paths).collect()
+    }
+
     /// Reads a cell file.
     pub fn from_file(path: &Path) -> Result<Cell, Error> {
         let text =
@@ -220,6 +248,7 @@ impl Cell {
             model,
             instrument: None,
             working: Vec::new(),
+            working_paths: Vec::new(),
             obstacles: Vec::new(),
             design: DesignClearance::default(),
             measurement: Measurement::Pose,

@@ -25,10 +25,61 @@ pub struct DesignAssessment {
     pub phi_a_cp: f64,
     /// C_s at each working configuration.
     pub tcp: Vec<TcpCovariance>,
+    /// The predicted TCP precision along each working path (none in files of an older armcal).
+    #[serde(default)]
+    pub paths: Vec<PathPrecision>,
     /// The observability indices O1…O5 of the design's Jacobian.
     pub observability: Observability,
     /// Every criterion's value (see [`Criterion`]).
     pub criteria: Vec<(Criterion, f64)>,
+}
+
+/// The predicted TCP position precision along a working path: the KPI value
+/// `v = (1/3) tr C_s` (mm², paper eq. 24) at each of its configurations, summarised.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct PathPrecision {
+    /// The path's name (`[[working_path]] name`).
+    pub name: String,
+    /// `v` at each configuration in path order (mm²).
+    pub kpi: Vec<f64>,
+    /// Mean of `v` along the path (mm²): the path's term in the mean KPI.
+    pub mean_kpi: f64,
+    /// Largest `v` along the path (mm²).
+    pub max_kpi: f64,
+    /// Where it is largest (1-based configuration of the path).
+    pub worst: usize,
+}
+
+/// The [`PathPrecision`] of each of `cell`'s working paths under the parameter covariance
+/// `cp`, from the KPI rows of `d` (the paths' configurations follow the working poses there).
+pub fn path_precision(cell: &Cell, d: &DesignModel, cp: &DMatrix<f64>) -> Vec<PathPrecision> {
+    let mut block = cell.working.len();
+    cell.working_paths
+        .iter()
+        .map(|p| {
+            let kpi: Vec<f64> = (block..block + p.q.len())
+                .map(|k| {
+                    let g = d.kpi_rows.rows(3 * k, 3);
+                    (g * cp).component_mul(&g).sum() / 3.0
+                })
+                .collect();
+            block += p.q.len();
+            let (worst, max_kpi) =
+                kpi.iter()
+                    .enumerate()
+                    .fold(
+                        (0, f64::NEG_INFINITY),
+                        |b, (i, &v)| if v > b.1 { (i, v) } else { b },
+                    );
+            PathPrecision {
+                name: p.name.clone(),
+                mean_kpi: kpi.iter().sum::<f64>() / kpi.len() as f64,
+                max_kpi,
+                worst: worst + 1,
+                kpi,
+            }
+        })
+        .collect()
 }
 
 /// The predicted precision of `design` (internal units) for `cell`, before anything is measured.
@@ -58,7 +109,7 @@ pub fn assess(cell: &Cell, design: &[Vec<f64>]) -> Result<DesignAssessment, Erro
     );
     let mut criteria = Vec::new();
     for c in Criterion::ALL {
-        if c == Criterion::Kpi && cell.working.is_empty() {
+        if matches!(c, Criterion::Kpi | Criterion::KpiMax) && d.kpi_weights.is_empty() {
             continue;
         }
         let obj = DesignObjective::new(&d, c, &[]);
@@ -66,6 +117,7 @@ pub fn assess(cell: &Cell, design: &[Vec<f64>]) -> Result<DesignAssessment, Erro
         criteria.push((c, obj.value_and_gradient(&mut ows, &design.concat(), None)?));
     }
     Ok(DesignAssessment {
+        paths: path_precision(cell, &d, &unc.covariance),
         phi_a_cp: unc.covariance.trace() / names.len() as f64,
         parameters: names,
         sigma: unc.sigma,

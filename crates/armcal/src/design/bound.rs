@@ -40,16 +40,24 @@ pub struct OptimalityBound {
 pub fn has_bound(c: Criterion) -> bool {
     matches!(
         c,
-        Criterion::A | Criterion::D | Criterion::E | Criterion::Kpi | Criterion::O1 | Criterion::O3
+        Criterion::A
+            | Criterion::D
+            | Criterion::E
+            | Criterion::Kpi
+            | Criterion::KpiMax
+            | Criterion::O1
+            | Criterion::O3
     )
 }
 
 /// A design's efficiency against the lower bound `lower` of its criterion `c`: `lower / value`
-/// for the criteria of positive values (A, E, KPI; `None` when `lower ≤ 0`, a bound that says
+/// for the criteria of positive values (A, E, KPI, KPI-max; `None` when `lower ≤ 0`, a bound that says
 /// nothing), `exp(lower − value)` for the log-scale ones (D, O1, O3).
 pub fn efficiency(c: Criterion, lower: f64, value: f64) -> Option<f64> {
     match c {
-        Criterion::A | Criterion::E | Criterion::Kpi => (lower > 0.0).then(|| lower / value),
+        Criterion::A | Criterion::E | Criterion::Kpi | Criterion::KpiMax => {
+            (lower > 0.0).then(|| lower / value)
+        }
         _ => Some((lower - value).exp()),
     }
 }

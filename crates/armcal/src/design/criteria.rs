@@ -10,7 +10,14 @@
 //! * `E`: `λ_max(C) = 1/λ_min(M)`; `Φ = −v vᵀ/λ_min²`;
 //! * `Kpi`: `Σ_w ω_w (1/3) tr(G_w C G_wᵀ) / Σ_w ω_w`, the TCP position variance at the
 //!   working configurations (paper eq. 24, φ_A(C_s)); `Φ = −C HᵀH C` with `H` the stacked
-//!   `√(ω_w/(3Σω)) G_w`;
+//!   `√(ω_w/(3Σω)) G_w`; the working configurations are the `[[working]]` poses and every
+//!   configuration of every `[[working_path]]` (a path's weight shared equally by its points);
+//! * `KpiMax`: the largest TCP position variance over the same configurations (paper §6,
+//!   "working path trajectories"), through the smooth maximum
+//!   `φ = (Σ_k v_k^p)^{1/p}`, `v_k = (1/3) tr(G_k C G_kᵀ)`, p = [`SMOOTH_MAX_P`]
+//!   (`max_k v_k ≤ φ ≤ K^{1/p} max_k v_k`; convex in M, since each v_k is and the p-norm of
+//!   non-negative convex functions is); `Φ = −Σ_k (v_k/φ)^{p−1} C G_kᵀ G_k C / 3`. The
+//!   weights ω do not enter a maximum;
 //! * `O1`…`O5`: `−log O_k` of the observability indices (see
 //!   [`crate::identify::Observability`]) written through the eigenvalues λ_i = σ_i² of M:
 //!   O1 ∝ (Π λ_i)^{1/2n}, O2 = (λ_min/λ_max)^{1/2}, O3 = λ_min^{1/2},
@@ -35,6 +42,10 @@ pub enum Criterion {
     /// Weighted mean TCP position variance at the working configurations (mm², paper eq. 24,
     /// φ_A(C_s)).
     Kpi,
+    /// Largest TCP position variance over the working configurations and paths (mm², smooth
+    /// maximum; paper §6).
+    #[serde(rename = "kpi-max")]
+    KpiMax,
     /// `−log O1`, O1 ∝ (Π σ_i)^{1/n} (Borm & Menq; book §4.5.3), σ_i = √λ_i(M).
     O1,
     /// `−log O2`, O2 = σ_min/σ_max, the inverse condition number (book §4.5.3).
@@ -55,6 +66,7 @@ impl Criterion {
             "d" => Criterion::D,
             "e" => Criterion::E,
             "kpi" => Criterion::Kpi,
+            "kpi-max" => Criterion::KpiMax,
             "o1" => Criterion::O1,
             "o2" => Criterion::O2,
             "o3" => Criterion::O3,
@@ -71,6 +83,7 @@ impl Criterion {
             Criterion::D => "D",
             Criterion::E => "E",
             Criterion::Kpi => "KPI",
+            Criterion::KpiMax => "KPI-max",
             Criterion::O1 => "O1",
             Criterion::O2 => "O2",
             Criterion::O3 => "O3",
@@ -80,13 +93,14 @@ impl Criterion {
     }
 
     /// The name [`Criterion::from_name`] reads (and the files carry): `a`, `d`, `e`, `kpi`,
-    /// `o1` … `o5`.
+    /// `kpi-max`, `o1` … `o5`.
     pub fn name(self) -> &'static str {
         match self {
             Criterion::A => "a",
             Criterion::D => "d",
             Criterion::E => "e",
             Criterion::Kpi => "kpi",
+            Criterion::KpiMax => "kpi-max",
             Criterion::O1 => "o1",
             Criterion::O2 => "o2",
             Criterion::O3 => "o3",
@@ -96,11 +110,12 @@ impl Criterion {
     }
 
     /// Every criterion, in declaration order.
-    pub const ALL: [Criterion; 9] = [
+    pub const ALL: [Criterion; 10] = [
         Criterion::A,
         Criterion::D,
         Criterion::E,
         Criterion::Kpi,
+        Criterion::KpiMax,
         Criterion::O1,
         Criterion::O2,
         Criterion::O3,
@@ -137,7 +152,7 @@ pub fn evaluate(
         return Err(singular());
     }
     match criterion {
-        Criterion::A | Criterion::D | Criterion::Kpi => {
+        Criterion::A | Criterion::D | Criterion::Kpi | Criterion::KpiMax => {
             // C = R⁻¹ R⁻ᵀ.
             let rinv = r
                 .clone()
@@ -156,6 +171,7 @@ pub fn evaluate(
                         gradient: -c / nf,
                     }
                 }
+                Criterion::KpiMax => kpi_max(&c, d)?,
                 _ => {
                     let h = kpi_matrix(d)?;
                     let ch = &c * h.transpose();
@@ -232,13 +248,57 @@ pub fn evaluate(
     }
 }
 
-/// `H`: the KPI rows `√(ω_w / (3 Σω)) G_w` stacked.
-pub(crate) fn kpi_matrix(d: &DesignModel) -> Result<DMatrix<f64>, Error> {
+/// The exponent of [`Criterion::KpiMax`]'s smooth maximum: with K configurations the value
+/// lies between the largest variance and `K^{1/p}` times it (1.15 for 100 points).
+pub const SMOOTH_MAX_P: f64 = 32.0;
+
+/// [`Criterion::KpiMax`] at `C`: the smooth maximum of the TCP variances `v_k` and its
+/// matrix gradient (see the module notes). The variances are scaled by their largest before
+/// the powers are taken, so that nothing underflows.
+fn kpi_max(c: &DMatrix<f64>, d: &DesignModel) -> Result<CriterionValue, Error> {
+    require_working(d)?;
+    let g = &d.kpi_rows;
+    let cg = c * g.transpose();
+    let k = d.kpi_weights.len();
+    let v: Vec<f64> = (0..k)
+        .map(|w| {
+            (0..3)
+                .map(|r| g.row(3 * w + r).dot(&cg.column(3 * w + r).transpose()))
+                .sum::<f64>()
+                / 3.0
+        })
+        .collect();
+    let vmax = v.iter().fold(0.0f64, |a, &x| a.max(x));
+    let p = SMOOTH_MAX_P;
+    let value = vmax
+        * v.iter()
+            .map(|x| (x / vmax).powf(p))
+            .sum::<f64>()
+            .powf(1.0 / p);
+    let mut weighted = cg.clone();
+    for (w, vw) in v.iter().enumerate() {
+        let s = ((vw / value).powf(p - 1.0) / 3.0).sqrt();
+        weighted.columns_mut(3 * w, 3).scale_mut(s);
+    }
+    Ok(CriterionValue {
+        value,
+        gradient: -(&weighted * weighted.transpose()),
+    })
+}
+
+/// The KPI criteria need a working configuration.
+fn require_working(d: &DesignModel) -> Result<(), Error> {
     if d.kpi_weights.is_empty() {
         return Err(Error::Input(
-            "the KPI criterion needs at least one [[working]] configuration in the cell".into(),
+            "the KPI criteria need at least one [[working]] configuration or [[working_path]] in the cell".into(),
         ));
     }
+    Ok(())
+}
+
+/// `H`: the KPI rows `√(ω_w / (3 Σω)) G_w` stacked.
+pub(crate) fn kpi_matrix(d: &DesignModel) -> Result<DMatrix<f64>, Error> {
+    require_working(d)?;
     let total: f64 = d.kpi_weights.iter().sum();
     let mut h = d.kpi_rows.clone();
     for (w, weight) in d.kpi_weights.iter().enumerate() {

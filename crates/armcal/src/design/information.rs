@@ -28,9 +28,10 @@ pub struct DesignModel {
     /// from the instrument to the TCP at the first working configuration and then held
     /// constant, so that the weights do not depend on q.
     pub sigma: [f64; 3],
-    /// `G`: 3 rows per working configuration, TCP position w.r.t. the free parameters.
+    /// `G`: 3 rows per KPI configuration ([`Cell::kpi_configurations`]: the working poses,
+    /// then the working paths' configurations), TCP position w.r.t. the free parameters.
     pub kpi_rows: DMatrix<f64>,
-    /// Weight of each working configuration.
+    /// Weight of each KPI configuration in the mean KPI.
     pub kpi_weights: Vec<f64>,
 }
 
@@ -51,7 +52,8 @@ impl DesignModel {
         } else {
             (0..model.targets.len()).map(Observed::Target).collect()
         };
-        let working: Vec<Vec<f64>> = cell.working.iter().map(|w| w.q.clone()).collect();
+        let kpi = cell.kpi_configurations();
+        let working: Vec<Vec<f64>> = kpi.iter().map(|(q, _)| q.to_vec()).collect();
         let kpi_rows = crate::identify::uncertainty::tcp_jacobian(&model, &params, &free, &working);
         let noise = cell.noise();
         let sigma = match noise {
@@ -80,7 +82,7 @@ impl DesignModel {
             observed,
             sigma,
             kpi_rows,
-            kpi_weights: cell.working.iter().map(|w| w.weight).collect(),
+            kpi_weights: kpi.iter().map(|(_, w)| *w).collect(),
         })
     }
 

@@ -18,6 +18,9 @@ pub fn criterion_description(c: Criterion) -> &'static str {
         Criterion::D => "D: log det(C_p)/n_p",
         Criterion::E => "E: largest eigenvalue of C_p",
         Criterion::Kpi => "KPI: (1/3) tr(C_s) at the working pose, the paper's φ_A(C_s) (eq. 24)",
+        Criterion::KpiMax => {
+            "KPI-max: the largest (1/3) tr(C_s) over the working poses and paths (smooth maximum)"
+        }
         Criterion::O1 => "O1: −log of observability index O1",
         Criterion::O2 => "O2: −log of observability index O2",
         Criterion::O3 => "O3: −log of observability index O3",
@@ -133,6 +136,20 @@ pub fn design_section(id: &str, label: &str, d: &DesignRecord) -> Result<Section
                 number(c[(0, 0)].sqrt()),
                 number(c[(1, 1)].sqrt()),
                 number(c[(2, 2)].sqrt())
+            ),
+        ));
+    }
+    for p in &a.paths {
+        rows.push((
+            "predicted C_s",
+            format!(
+                "along <em>{}</em> ({} configurations): (1/3) tr C_s mean {} mm², largest {} mm² (TCP σ {} mm) at configuration {}",
+                escape(&p.name),
+                p.kpi.len(),
+                number(p.mean_kpi),
+                number(p.max_kpi),
+                number(p.max_kpi.sqrt()),
+                p.worst
             ),
         ));
     }

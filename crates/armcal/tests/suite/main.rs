@@ -38,6 +38,7 @@ mod design {
     mod design_refine;
     mod measurable;
     mod paper_cell_geometry;
+    mod working_paths;
 }
 mod compensate {
     mod compensation;

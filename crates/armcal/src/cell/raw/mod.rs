@@ -36,6 +36,8 @@ struct RawCell {
     #[serde(default)]
     working: Vec<Spanned<toml::Table>>,
     #[serde(default)]
+    working_path: Vec<Spanned<toml::Table>>,
+    #[serde(default)]
     obstacles: Vec<Spanned<toml::Table>>,
     #[serde(default)]
     tool_capsules: Vec<Spanned<toml::Table>>,
@@ -149,7 +151,10 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
 
     let (measurement, auto_free) =
         parameters::parameters(&ctx, raw.parameters.as_ref(), &mut model)?;
-    let (working, warnings) = working::working(&ctx, &raw.working, &model)?;
+    let (working, mut warnings) = working::working(&ctx, &raw.working, &model)?;
+    let (working_paths, path_warnings) =
+        working::working_paths(&ctx, &raw.working_path, &model, dir)?;
+    warnings.extend(path_warnings);
     let obstacles = obstacles::obstacles(&ctx, &raw.obstacles)?;
     let design = design::design(&ctx, raw.design.as_ref())?;
     design::check_joint_margin(&ctx, raw.design.as_ref(), &design, &model)?;
@@ -174,6 +179,7 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
         model,
         instrument,
         working,
+        working_paths,
         obstacles,
         capsules,
         design,
