@@ -41,6 +41,9 @@ enum Command {
     /// target TCP precision or plan the next batch.
     #[command(subcommand_required = true)]
     Campaign(commands::campaign::Args),
+    /// Drift check: check poses measured after the calibration against its prediction (χ²),
+    /// and which parameter groups most likely moved (score tests).
+    Check(commands::check::Args),
     /// Filter a joint program or Cartesian targets through the calibrated model.
     Compensate(commands::compensate::Args),
     /// ISO 9283 accuracy and repeatability, and a model's errors, from a data file.
@@ -83,6 +86,7 @@ fn main() {
         Command::Report(a) => commands::report::run(&a),
         Command::Export(a) => commands::export::run(&a),
         Command::Campaign(a) => commands::campaign::run(&a),
+        Command::Check(a) => commands::check::run(&a),
         Command::Compensate(a) => commands::compensate::run(&a),
         Command::Accuracy(a) => commands::accuracy::run(&a),
         Command::Axes(a) => commands::axes::run(&a),

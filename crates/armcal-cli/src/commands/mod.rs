@@ -3,6 +3,7 @@
 pub mod accuracy;
 pub mod axes;
 pub mod campaign;
+pub mod check;
 pub mod compensate;
 pub mod demo;
 pub mod export;

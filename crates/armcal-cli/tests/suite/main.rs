@@ -5,6 +5,7 @@ mod common;
 mod accuracy_cli;
 mod browser;
 mod campaign_cli;
+mod check_cli;
 mod cli;
 mod compensate_cli;
 mod error_causes;

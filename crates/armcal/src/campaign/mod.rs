@@ -10,6 +10,7 @@
 //! [`simulate`] runs the whole loop against a virtual robot and instrument; [`study`]
 //! compares it with one-shot and random designs over seeded runs.
 
+pub mod drift;
 pub mod precision;
 pub mod simulate;
 pub mod state;

@@ -26,6 +26,7 @@ mod identify {
 }
 mod campaign {
     mod adaptive;
+    mod drift;
 }
 mod design {
     mod clearance;
