@@ -99,6 +99,19 @@ pub fn start(
     })
 }
 
+/// `cell` with its model's nominal parameters replaced by `params` (every parameter,
+/// internal units), or `cell` itself without them.
+fn cell_at<'a>(cell: &'a Cell, params: Option<&[f64]>) -> std::borrow::Cow<'a, Cell> {
+    match params {
+        Some(p) => {
+            let mut at = cell.clone();
+            at.model.registry.set_nominal(p);
+            std::borrow::Cow::Owned(at)
+        }
+        None => std::borrow::Cow::Borrowed(cell),
+    }
+}
+
 /// The poses `qs` named `offset + 1`, `offset + 2`, ….
 fn numbered(cell: &Cell, qs: &[Vec<f64>], offset: usize) -> Vec<CampaignPose> {
     qs.iter()
@@ -341,11 +354,20 @@ pub fn step(
         let n = state.settings.budget.map_or(state.settings.batch, |b| {
             state.settings.batch.min(b - measured)
         });
-        let qs = plan_batch(cell, &state.settings, &data.configurations, n, k, observer)?;
+        // Planned at the latest converged estimate (this step's, else an earlier one, else
+        // the nominal): the design criterion and the cell's constraints (the tracker's
+        // estimated pose among them) are evaluated where the robot is believed to be.
+        let latest = fit
+            .as_ref()
+            .filter(|f| f.status.is_converged())
+            .map(|f| f.params.as_slice())
+            .or(state.warm_start());
+        let at = cell_at(cell, latest);
+        let qs = plan_batch(&at, &state.settings, &data.configurations, n, k, observer)?;
         let mut all = data.configurations.clone();
         all.extend(qs.iter().cloned());
         let s = fit.as_ref().map_or(1.0, |f| f.covariance_scale);
-        let predicted = predicted_sigmas(cell, &all, s)?;
+        let predicted = predicted_sigmas(&at, &all, s)?;
         let largest = predicted.iter().copied().fold(0.0, f64::max);
         let total = poses_needed(all.len(), largest, target);
         (numbered(cell, &qs, measured), predicted, Some(total))

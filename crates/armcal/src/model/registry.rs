@@ -251,6 +251,16 @@ impl Registry {
         self.params[i].status = status;
     }
 
+    /// Sets every nominal value (internal units) to `values`, one per parameter: e.g. an
+    /// estimate's, so that a design is planned at the current estimate (a locally optimal
+    /// design is optimal where it is linearised).
+    pub fn set_nominal(&mut self, values: &[f64]) {
+        assert_eq!(values.len(), self.params.len(), "one value per parameter");
+        for (p, &v) in self.params.iter_mut().zip(values) {
+            p.nominal = v;
+        }
+    }
+
     /// Nominal parameter vector.
     pub fn nominal(&self) -> Vec<f64> {
         self.params.iter().map(|p| p.nominal).collect()

@@ -225,3 +225,54 @@ pub fn unplaced_tracker_paper_cell(frames_only: bool, seed: u64) -> (Cell, Vec<f
     }
     (cell, truth)
 }
+
+/// Monte Carlo of the TCP covariance: `runs` calibrations (seeds `seed..seed + runs`) of
+/// `truth` measured at `design` with the cell's instrument noise, each identified from the
+/// nominal; returns the empirical covariance of the identified model's tool position
+/// (mm²) at each of `configs`.
+pub fn monte_carlo_tcp_covariances(
+    cell: &Cell,
+    truth: &[f64],
+    design: &[Vec<f64>],
+    configs: &[Vec<f64>],
+    runs: u64,
+    seed: u64,
+) -> Vec<nalgebra::Matrix3<f64>> {
+    use armcal::identify::{solve, IdentifySettings, Problem};
+    use armcal::progress::Silent;
+    use nalgebra::{Matrix3, Vector3};
+    use rayon::prelude::*;
+    let model = &cell.model;
+    let noise = cell.instrument.as_ref().unwrap().noise.clone();
+    let tcps: Vec<Vec<Vector3<f64>>> = (seed..seed + runs)
+        .into_par_iter()
+        .map(|s| {
+            let data = armcal::sim::simulate(model, truth, design, Some(&noise), s).unwrap();
+            let mut p = Problem::new(model, &data, &noise).unwrap();
+            let (sol, _, _) = solve(
+                &mut p,
+                &model.nominal(),
+                &IdentifySettings::default(),
+                &mut Silent,
+            )
+            .unwrap();
+            let mut data = Data::new(model);
+            configs
+                .iter()
+                .map(|q| {
+                    forward_kinematics(model, &mut data, &sol.params, q);
+                    observed_position(&data, Observed::Tool)
+                })
+                .collect()
+        })
+        .collect();
+    let n = runs as f64;
+    (0..configs.len())
+        .map(|k| {
+            let mean = tcps.iter().fold(Vector3::zeros(), |a, t| a + t[k]) / n;
+            tcps.iter().fold(Matrix3::zeros(), |a, t| {
+                a + (t[k] - mean) * (t[k] - mean).transpose()
+            }) / (n - 1.0)
+        })
+        .collect()
+}

@@ -108,3 +108,53 @@ fn a_simulated_campaign_stops_at_the_target_and_resumes() {
         .to_string();
     assert!(e.contains("stopped"), "{e}");
 }
+
+#[test]
+fn the_next_batch_is_planned_at_the_estimate_not_the_nominal() {
+    // The paper cell, whose true tracker stands 300 mm (x and y) from where the cell puts
+    // it: the first batch is planned at the nominal; after its fit, the next batch is
+    // planned where the fit puts the robot and the tracker — feasible there (incidence, line
+    // of sight, collisions, joint limits) — and not where the nominal puts the tracker.
+    let cell = paper_cell();
+    let model = &cell.model;
+    let mut truth = armcal::sim::perturbed_truth(model, &Perturbation::default(), 5);
+    for name in ["tracker.x", "tracker.y"] {
+        truth[model.registry.require(name).unwrap()] += 300.0;
+    }
+    let settings = CampaignSettings {
+        target_sigma_mm: 0.01,
+        batch: 5,
+        ..CampaignSettings::default()
+    };
+    let state = campaign::start(&cell, "unplaced", &settings, &mut Silent).unwrap();
+    let qs: Vec<Vec<f64>> = state.next.iter().map(|p| p.q(model)).collect();
+    // Many more poses than the fewest, so that the first fit converges from afar.
+    let mut qs2 = qs.clone();
+    qs2.extend(armcal::model::random_configurations(model, 31, 60));
+    let mut state = state;
+    state.next = qs2
+        .iter()
+        .enumerate()
+        .map(|(i, q)| campaign::CampaignPose::of(model, (i + 1).to_string(), q))
+        .collect();
+    let noise = cell.noise();
+    let mut batch = armcal::sim::simulate(model, &truth, &qs2, Some(&noise), 7).unwrap();
+    batch.config_ids = state.next.iter().map(|p| p.id.clone()).collect();
+    let r = campaign::step(&cell, &state, &batch, &mut Silent).unwrap();
+    let step = r.state.steps.last().unwrap();
+    let fit = step.fit.as_ref().unwrap();
+    assert!(fit.status.is_converged(), "{:?}", fit.status);
+    assert_eq!(r.state.decision, Decision::Measure);
+    let set = armcal::design::plan::constraint_set(&cell, true).unwrap();
+    let nominal = model.nominal();
+    let at_fit = armcal::design::plan::CellConstraints::new(&set, &fit.params);
+    let at_nominal = armcal::design::plan::CellConstraints::new(&set, &nominal);
+    let next: Vec<Vec<f64>> = r.state.next.iter().map(|p| p.q(model)).collect();
+    assert_eq!(next.len(), 5);
+    assert!(next.iter().all(|q| at_fit.feasible(q)));
+    let infeasible_at_nominal = next.iter().filter(|q| !at_nominal.feasible(q)).count();
+    assert!(
+        infeasible_at_nominal > 0,
+        "every pose of the next batch is also feasible at the nominal"
+    );
+}

@@ -2,16 +2,13 @@
 //! and at the heuristic design; the empirical ratio of TCP error variances at the working
 //! pose matches the predicted ratio within ±15 %.
 
+use crate::common::monte_carlo_tcp_covariances;
 use armcal::cell::Cell;
 use armcal::design::baselines::random_feasible;
 use armcal::design::plan::{constraint_set, plan, CellConstraints, PlanSettings};
 use armcal::design::{Criterion, DesignModel, DesignObjective};
-use armcal::identify::{solve, IdentifySettings, Problem};
-use armcal::model::{forward_kinematics, observed_position, Data, Observed};
 use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, simulate, Perturbation};
-use nalgebra::{Matrix3, Vector3};
-use rayon::prelude::*;
+use armcal::sim::{perturbed_truth, Perturbation};
 use std::path::Path;
 
 #[test]
@@ -46,36 +43,10 @@ fn kpi_design_variance_gain_holds_in_monte_carlo() {
     let pred_k = obj
         .value_and_gradient(&mut ws, &kpi.design.concat(), None)
         .unwrap();
-    let noise = cell.instrument.as_ref().unwrap().noise.clone();
     let truth = perturbed_truth(model, &Perturbation::default(), 8);
-    let work = cell.working[0].q.clone();
-    let tcp = |p: &[f64]| {
-        let mut data = Data::new(model);
-        forward_kinematics(model, &mut data, p, &work);
-        observed_position(&data, Observed::Tool)
-    };
-    let empirical = |design: &[Vec<f64>], offset: u64| -> f64 {
-        let est: Vec<Vector3<f64>> = (0..200u64)
-            .into_par_iter()
-            .map(|s| {
-                let data = simulate(model, &truth, design, Some(&noise), offset + s).unwrap();
-                let mut p = Problem::new(model, &data, &noise).unwrap();
-                let (sol, _, _) = solve(
-                    &mut p,
-                    &model.nominal(),
-                    &IdentifySettings::default(),
-                    &mut Silent,
-                )
-                .unwrap();
-                tcp(&sol.params)
-            })
-            .collect();
-        let n = est.len() as f64;
-        let mean = est.iter().fold(Vector3::zeros(), |a, b| a + b) / n;
-        let c = est.iter().fold(Matrix3::zeros(), |a, e| {
-            a + (e - mean) * (e - mean).transpose()
-        }) / (n - 1.0);
-        c.trace() / 3.0
+    let work = [cell.working[0].q.clone()];
+    let empirical = |design: &[Vec<f64>], seed: u64| -> f64 {
+        monte_carlo_tcp_covariances(&cell, &truth, design, &work, 200, seed)[0].trace() / 3.0
     };
     let emp_h = empirical(&heuristic, 10_000);
     let emp_k = empirical(&kpi.design, 20_000);

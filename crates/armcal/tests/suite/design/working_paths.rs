@@ -250,3 +250,65 @@ fn an_exported_cell_keeps_its_paths_inline() {
         }
     }
 }
+
+#[test]
+fn a_path_design_lowers_the_largest_sigma_along_a_50_pose_path_in_monte_carlo() {
+    // Issue 16's evidence: a design for a 50-configuration path (`kpi-max` over the path and
+    // the cell's working pose) against the single-pose KPI design (the cell without the
+    // path), both judged by the largest (1/3) tr C_s along the path — predicted, and in 200
+    // simulated calibrations of one virtual robot per design.
+    let path = sweep(50);
+    let single = cell_with("mc-single", "", &[]).unwrap();
+    let with_path = cell_with("mc-path", &inline_path("seam", 1.0, &path), &[]).unwrap();
+    let settings = PlanSettings {
+        poses: 60,
+        collisions: false,
+        starts: 1,
+        ..PlanSettings::default()
+    };
+    let single_design = plan(&single, &settings, &[], &mut Silent).unwrap().design;
+    let path_design = plan(
+        &with_path,
+        &PlanSettings {
+            criterion: Criterion::KpiMax,
+            ..settings.clone()
+        },
+        &[],
+        &mut Silent,
+    )
+    .unwrap()
+    .design;
+    let predicted = |design: &[Vec<f64>]| assess(&with_path, design).unwrap().paths[0].max_kpi;
+    let (pred_single, pred_path) = (predicted(&single_design), predicted(&path_design));
+    let configs: Vec<Vec<f64>> = path
+        .iter()
+        .map(|q| q.iter().map(|v| v.to_radians()).collect())
+        .collect();
+    let truth =
+        armcal::sim::perturbed_truth(&with_path.model, &armcal::sim::Perturbation::default(), 8);
+    let largest = |design: &[Vec<f64>], seed: u64| {
+        crate::common::monte_carlo_tcp_covariances(&with_path, &truth, design, &configs, 200, seed)
+            .iter()
+            .map(|c| c.trace() / 3.0)
+            .fold(0.0, f64::max)
+    };
+    let (mc_single, mc_path) = (
+        largest(&single_design, 30_000),
+        largest(&path_design, 40_000),
+    );
+    eprintln!(
+        "largest (1/3) tr C_s along the 50-configuration path: single-pose KPI design {pred_single:.4} \
+         predicted, {mc_single:.4} Monte Carlo; path design {pred_path:.4} predicted, {mc_path:.4} Monte Carlo"
+    );
+    assert!(
+        pred_path < 0.9 * pred_single,
+        "{pred_path} vs {pred_single}"
+    );
+    assert!(mc_path < mc_single, "{mc_path} vs {mc_single}");
+    for (mc, pred) in [(mc_single, pred_single), (mc_path, pred_path)] {
+        assert!(
+            (mc / pred - 1.0).abs() <= 0.15,
+            "Monte Carlo {mc} vs predicted {pred}"
+        );
+    }
+}
