@@ -26,6 +26,7 @@ use crate::design::plan::{constraint_set, plan, CellConstraints, PlanSettings};
 use crate::design::DesignModel;
 use crate::identify::{identify, Estimate, IdentifySettings, ModelFingerprint};
 use crate::measure::Dataset;
+use crate::model::Segment;
 use crate::progress::Observer;
 use crate::Error;
 use precision::{poses_needed, predicted_sigmas, working_sigmas, WorkingSigma};
@@ -99,17 +100,25 @@ pub fn start(
     })
 }
 
-/// `cell` with its model's nominal parameters replaced by `params` (every parameter,
-/// internal units), or `cell` itself without them.
+/// `cell` with the instrument and target frames of its model at `params` (every parameter
+/// of the model, internal units), or `cell` itself without them. The links stay nominal:
+/// the cell's capsules are drawn on the nominal links, and the estimate of a minimal set
+/// may move a frame whose effect another parameter absorbs (a link offset traded against
+/// the next link's), which would put the capsules where no link is.
 fn cell_at<'a>(cell: &'a Cell, params: Option<&[f64]>) -> std::borrow::Cow<'a, Cell> {
-    match params {
-        Some(p) => {
-            let mut at = cell.clone();
-            at.model.registry.set_nominal(p);
-            std::borrow::Cow::Owned(at)
+    let Some(params) = params else {
+        return std::borrow::Cow::Borrowed(cell);
+    };
+    let mut at = cell.clone();
+    for (i, &v) in params.iter().enumerate() {
+        if matches!(
+            at.model.registry.get(i).segment,
+            Segment::Instrument | Segment::Target(_)
+        ) {
+            at.model.registry.set_nominal(i, v);
         }
-        None => std::borrow::Cow::Borrowed(cell),
     }
+    std::borrow::Cow::Owned(at)
 }
 
 /// The poses `qs` named `offset + 1`, `offset + 2`, ….
@@ -354,9 +363,9 @@ pub fn step(
         let n = state.settings.budget.map_or(state.settings.batch, |b| {
             state.settings.batch.min(b - measured)
         });
-        // Planned at the latest converged estimate (this step's, else an earlier one, else
-        // the nominal): the design criterion and the cell's constraints (the tracker's
-        // estimated pose among them) are evaluated where the robot is believed to be.
+        // Planned with the instrument and targets where the latest converged fit (this
+        // step's, else an earlier one's; the nominal before any) puts them: the tracker's
+        // incidence, line of sight and the TCP variance in its frame are evaluated there.
         let latest = fit
             .as_ref()
             .filter(|f| f.status.is_converged())

@@ -151,8 +151,9 @@ pub struct CampaignStep {
     pub reason: String,
     /// Predicted σ at every working pose once `next` is measured too (mm, scaled as the fit's
     /// C_s; [`crate::campaign::precision::predicted_sigmas`]); empty when stopped. `next`
-    /// was planned, and this predicted, at the latest converged fit's parameters (this
-    /// step's `fit.params`, else an earlier step's; the nominal before any).
+    /// was planned, and this predicted, with the instrument and target frames at the latest
+    /// converged fit (this step's `fit.params`, else an earlier step's; the nominal before
+    /// any) and the links nominal.
     pub predicted_next_sigma_mm: Vec<f64>,
     /// Predicted poses in all the target needs (C_s ∝ 1/N beyond the next batch), when
     /// continuing.

@@ -251,14 +251,10 @@ impl Registry {
         self.params[i].status = status;
     }
 
-    /// Sets every nominal value (internal units) to `values`, one per parameter: e.g. an
-    /// estimate's, so that a design is planned at the current estimate (a locally optimal
-    /// design is optimal where it is linearised).
-    pub fn set_nominal(&mut self, values: &[f64]) {
-        assert_eq!(values.len(), self.params.len(), "one value per parameter");
-        for (p, &v) in self.params.iter_mut().zip(values) {
-            p.nominal = v;
-        }
+    /// Sets the nominal value of parameter `i` (internal units): e.g. to an estimate's, so
+    /// that a design is planned where the frame is now believed to be.
+    pub fn set_nominal(&mut self, i: usize, value: f64) {
+        self.params[i].nominal = value;
     }
 
     /// Nominal parameter vector.

@@ -113,8 +113,8 @@ fn a_simulated_campaign_stops_at_the_target_and_resumes() {
 fn the_next_batch_is_planned_at_the_estimate_not_the_nominal() {
     // The paper cell, whose true tracker stands 300 mm (x and y) from where the cell puts
     // it: the first batch is planned at the nominal; after its fit, the next batch is
-    // planned where the fit puts the robot and the tracker — feasible there (incidence, line
-    // of sight, collisions, joint limits) — and not where the nominal puts the tracker.
+    // planned with the tracker (and reflector) where the fit puts them — feasible there
+    // (incidence, line of sight, collisions, joint limits) — not where the cell puts them.
     let cell = paper_cell();
     let model = &cell.model;
     let mut truth = armcal::sim::perturbed_truth(model, &Perturbation::default(), 5);
@@ -147,7 +147,14 @@ fn the_next_batch_is_planned_at_the_estimate_not_the_nominal() {
     assert_eq!(r.state.decision, Decision::Measure);
     let set = armcal::design::plan::constraint_set(&cell, true).unwrap();
     let nominal = model.nominal();
-    let at_fit = armcal::design::plan::CellConstraints::new(&set, &fit.params);
+    // The fit's frames on the nominal links.
+    let mut frames_at_fit = nominal.clone();
+    for i in 0..model.param_count() {
+        if !matches!(model.registry.get(i).segment, armcal::model::Segment::Chain) {
+            frames_at_fit[i] = fit.params[i];
+        }
+    }
+    let at_fit = armcal::design::plan::CellConstraints::new(&set, &frames_at_fit);
     let at_nominal = armcal::design::plan::CellConstraints::new(&set, &nominal);
     let next: Vec<Vec<f64>> = r.state.next.iter().map(|p| p.q(model)).collect();
     assert_eq!(next.len(), 5);
