@@ -117,6 +117,10 @@ pub struct Validation {
     /// on the pose measurements; `None` without pose measurements.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub orientation: Option<HeldOutOrientation>,
+    /// The calibrated model's error at every validation measurement, with its station and
+    /// temperature ([`super::held_out`]: grouped per station and per temperature bin).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub errors: Vec<super::held_out::HeldOutError>,
 }
 
 /// Held-out orientation error (degrees) before and after calibration

@@ -23,6 +23,7 @@ mod identify {
     mod identification_validation;
     mod mixed_measurements;
     mod priors_and_noise;
+    mod stations;
 }
 mod campaign {
     mod adaptive;
