@@ -111,6 +111,30 @@ fn browser(exe: &Path, profile: &Path, extra: &[String], url: &str) -> Command {
     cmd
 }
 
+/// `armcal report record` into `work/r`, and the page's DOM after headless Chromium ran its
+/// scripts.
+fn report_dom(exe: &Path, work: &Path, record: &Path) -> String {
+    let mut report = Command::new(env!("CARGO_BIN_EXE_armcal"));
+    report
+        .arg("report")
+        .arg(record)
+        .args(["--quiet", "--out"])
+        .arg(work.join("r"));
+    run(report, work, "report");
+    let url = format!(
+        "file://{}",
+        work.join("r/report.html")
+            .canonicalize()
+            .expect("report path")
+            .display()
+    );
+    run(
+        browser(exe, &work.join("profile-dom"), &["--dump-dom".into()], &url),
+        work,
+        "chromium-dump-dom",
+    )
+}
+
 /// The value of attribute `name` in the start tag `tag` (`<canvas …>`).
 fn attribute<'a>(tag: &'a str, name: &str) -> Option<&'a str> {
     let key = format!(" {name}=\"");
@@ -311,30 +335,7 @@ fn campaign_report_draws_in_headless_chromium() {
     run(sim, &work, "campaign-simulate");
     let state = std::fs::read_to_string(work.join("c/campaign.json")).expect("campaign.json");
     let steps = state.matches("\"decision\": ").count() - 1;
-    let mut report = Command::new(env!("CARGO_BIN_EXE_armcal"));
-    report
-        .arg("report")
-        .arg(work.join("c/campaign.json"))
-        .args(["--quiet", "--out"])
-        .arg(work.join("r"));
-    run(report, &work, "report");
-    let url = format!(
-        "file://{}",
-        work.join("r/report.html")
-            .canonicalize()
-            .expect("report path")
-            .display()
-    );
-    let dom = run(
-        browser(
-            &exe,
-            &work.join("profile-dom"),
-            &["--dump-dom".into()],
-            &url,
-        ),
-        &work,
-        "chromium-dump-dom",
-    );
+    let dom = report_dom(&exe, &work, &work.join("c/campaign.json"));
     let tag = "<svg data-figure=\"campaign-sigma\"";
     let at = dom.find(tag).expect("the campaign's σ-vs-poses figure");
     let svg = &dom[at..at + dom[at..].find("</svg>").expect("svg closes")];
@@ -369,30 +370,7 @@ fn ur10_calibration_report_draws_in_headless_chromium() {
         .args(["--holdout", "0.3", "--seed", "1", "--quiet", "--out"])
         .arg(work.join("b.json"));
     run(fit, &work, "identify");
-    let mut report = Command::new(env!("CARGO_BIN_EXE_armcal"));
-    report
-        .arg("report")
-        .arg(work.join("b.json"))
-        .args(["--quiet", "--out"])
-        .arg(work.join("r"));
-    run(report, &work, "report");
-    let url = format!(
-        "file://{}",
-        work.join("r/report.html")
-            .canonicalize()
-            .expect("report path")
-            .display()
-    );
-    let dom = run(
-        browser(
-            &exe,
-            &work.join("profile-dom"),
-            &["--dump-dom".into()],
-            &url,
-        ),
-        &work,
-        "chromium-dump-dom",
-    );
+    let dom = report_dom(&exe, &work, &work.join("b.json"));
     let first = dom.find("<section id=\"").expect("sections");
     assert!(
         dom[first..].starts_with("<section id=\"verdict\""),
