@@ -152,17 +152,7 @@ fn two_stations_noise_free_recover_the_truth() {
         "both stations' poses estimated: {stations:?}"
     );
     assert!(e.parameters.iter().all(|p| !p.name.starts_with("tracker.")));
-    for p in &e.parameters {
-        let i = model.registry.require(&p.name).unwrap();
-        let f = model.registry.get(i).unit.display_factor();
-        assert!(
-            (p.estimate - truth[i] * f).abs() < 1e-6,
-            "{} = {} vs truth {}",
-            p.name,
-            p.estimate,
-            truth[i] * f
-        );
-    }
+    common::assert_estimate_is(&model, &e, &truth);
     // the generic count grows by one instrument pose: 30 + 6
     let v = e.verdicts.as_ref().unwrap();
     assert!(
@@ -246,4 +236,56 @@ fn a_bad_station_value_is_an_error_with_file_line_and_field() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("line 2") && e.contains("no [instrument]"), "{e}");
+}
+
+#[test]
+fn a_frames_refit_fits_every_stations_pose_with_the_robot_held() {
+    let (cell, model, truth) = stationed_truth([250.0, 10.0]);
+    let first = identify(
+        &cell,
+        &station_data(&model, &truth, 30, 0.0, 1),
+        &IdentifySettings::default(),
+        &mut Silent,
+    )
+    .unwrap();
+    // Both trackers set up again elsewhere: the robot is the same.
+    let mut moved = truth.clone();
+    for (station, shift) in STATIONS.iter().zip([150.0, -300.0]) {
+        for field in ["x", "y"] {
+            moved[model
+                .registry
+                .require(&format!("tracker@{station}.{field}"))
+                .unwrap()] += shift;
+        }
+        moved[model
+            .registry
+            .require(&format!("tracker@{station}.rz"))
+            .unwrap()] += 0.2;
+    }
+    let refit = FramesRefit {
+        estimate: first.clone(),
+        origin: "two-stations.json".into(),
+        acceptance: Acceptance {
+            accepted: false,
+            accept: "--accept-unconverged",
+            raise_iterations: "--max-iterations",
+        },
+    };
+    let opts = IdentifySettings {
+        refit: Some(refit),
+        ..Default::default()
+    };
+    let e = identify(
+        &cell,
+        &station_data(&model, &moved, 30, 0.0, 5),
+        &opts,
+        &mut Silent,
+    )
+    .unwrap();
+    assert!(e.solver.status.is_converged(), "{:?}", e.solver.status);
+    common::assert_estimate_is(&model, &e, &moved);
+    // the estimate of two stations gives a model without stations its first station's pose
+    let one = first.params_for(&cell.model).unwrap();
+    let x = cell.model.registry.require("tracker.x").unwrap();
+    assert!((one[x] - truth[model.registry.require("tracker@S1.x").unwrap()]).abs() < 1e-6);
 }
