@@ -1,10 +1,14 @@
 //! `armcal identify`: calibrate the cell's free parameters from a data file.
 
-use super::output::{load_cell, load_data, load_estimate, AcceptUnconverged, Outputs};
+use super::output::{
+    load_cell, load_data, load_estimate, load_station_data, station_files, AcceptUnconverged,
+    Outputs,
+};
 use super::progress::Progress;
 use anyhow::bail;
 use armcal::identify::{
-    identify, Estimate, FramesRefit, IdentifySettings, LmSettings, Loss, Method, ToleranceSettings,
+    held_out, identify, Estimate, FramesRefit, IdentifySettings, LmSettings, Loss, Method,
+    ToleranceSettings,
 };
 use std::path::{Path, PathBuf};
 
@@ -13,9 +17,12 @@ pub struct Args {
     /// Cell file or built-in robot.
     #[arg(long)]
     pub cell: String,
-    /// Data file (CSV).
-    #[arg(long)]
-    pub data: PathBuf,
+    /// Data file (CSV). Repeat it, each as `STATION=FILE`, for one fit over the data of
+    /// several instrument stations (every row of FILE measured from STATION; a `station`
+    /// column names the station row by row instead): each station gets its own instrument
+    /// pose, `<instrument>@<STATION>.x` …, the robot is shared.
+    #[arg(long, required = true)]
+    pub data: Vec<String>,
     /// Fraction of configurations held out at random for validation, in [0, 1).
     #[arg(long, default_value_t = 0.0, value_parser = holdout_fraction, allow_negative_numbers = true)]
     pub holdout: f64,
@@ -58,12 +65,14 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
-    let mut inputs = vec![Path::new(&a.cell), a.data.as_path()];
+    let files = station_files(&a.data);
+    let mut inputs = vec![Path::new(&a.cell)];
+    inputs.extend(files.iter().map(|(_, f)| f.as_path()));
     inputs.extend(a.test.as_deref());
     inputs.extend(a.estimate.as_deref());
     let outputs = Outputs::plan(a.force, &inputs, &[&a.out])?;
     let cell = load_cell(&a.cell)?;
-    let data = load_data(&cell, &a.data)?;
+    let data = load_station_data(&cell, &files)?;
     let test = a.test.as_deref().map(|t| load_data(&cell, t)).transpose()?;
     let refit = match &a.estimate {
         Some(path) => Some(FramesRefit {
@@ -265,6 +274,29 @@ pub fn print_summary(e: &Estimate) {
                 ("nominal + frames fitted", &o.frames_only),
                 (calibrated, &o.calibrated),
             ]);
+        }
+        let groups = [
+            ("station", held_out::by_station(&v.errors)),
+            ("temperature", held_out::by_temperature(&v.errors, 0.5)),
+        ];
+        for (what, rows) in groups.iter().filter(|(_, g)| !g.is_empty()) {
+            println!("  {calibrated}, per {what}: n, position mean / RMS / max / p95 (mm), orientation (deg), mean °C");
+            for g in rows {
+                let o = g.orientation.as_ref().map_or(String::new(), |o| {
+                    format!(
+                        "  {:.4} / {:.4} / {:.4} / {:.4}",
+                        o.mean, o.rms, o.max, o.p95
+                    )
+                });
+                let t = g
+                    .temperature_c
+                    .map_or(String::new(), |t| format!("  {t:.2} °C"));
+                let p = &g.position;
+                println!(
+                    "    {:<16} {:>5}  {:.4} / {:.4} / {:.4} / {:.4}{o}{t}",
+                    g.group, p.count, p.mean, p.rms, p.max, p.p95
+                );
+            }
         }
     }
 }

@@ -180,6 +180,46 @@ pub fn load_data(
     Ok(data)
 }
 
+/// The files of `--data` arguments, each `FILE` or `STATION=FILE` (a `=` in an existing
+/// file's name is part of the name), with the station each names.
+pub fn station_files(args: &[String]) -> Vec<(Option<String>, PathBuf)> {
+    args.iter()
+        .map(|a| match a.split_once('=') {
+            Some((station, file)) if !Path::new(a).exists() => {
+                (Some(station.to_string()), PathBuf::from(file))
+            }
+            _ => (None, PathBuf::from(a)),
+        })
+        .collect()
+}
+
+/// The data of several files ([`station_files`]) read for a cell ([`load_data`]), each at
+/// its station if it names one, appended in order into one data set.
+pub fn load_station_data(
+    cell: &armcal::cell::Cell,
+    files: &[(Option<String>, PathBuf)],
+) -> anyhow::Result<armcal::measure::Dataset> {
+    let mut all = armcal::measure::Dataset::default();
+    let mut sources = Vec::new();
+    for (station, file) in files {
+        let data = load_data(cell, file)?;
+        let data = match station {
+            Some(s) => data.at_station(s)?,
+            None => data,
+        };
+        if files.len() > 1 && data.stations.is_empty() {
+            bail!(
+                "{}: with several data files, give each its station (`--data STATION=FILE`) or a `station` column",
+                file.display()
+            );
+        }
+        sources.push(data.source.clone());
+        all.append(&data);
+    }
+    all.source = sources.join(" + ");
+    Ok(all)
+}
+
 /// The reader's remarks on stderr: ignored columns, then rows read with a warning (the first
 /// few, and how many more).
 pub fn print_read_report(report: &armcal::measure::csv::ReadReport) {

@@ -33,6 +33,22 @@ fn chromium() -> Option<PathBuf> {
         .find(|p| p.is_file())
 }
 
+/// [`chromium`], or `None` with a message that the test is skipped; a panic instead when
+/// `ARMCAL_REQUIRE_BROWSER=1`.
+fn chromium_or_skip() -> Option<PathBuf> {
+    let exe = chromium();
+    if exe.is_none() {
+        if std::env::var("ARMCAL_REQUIRE_BROWSER").as_deref() == Ok("1") {
+            panic!(
+                "Chromium not found (ARMCAL_REQUIRE_BROWSER=1): install Debian package \
+                 `chromium` or set ARMCAL_CHROMIUM"
+            );
+        }
+        eprintln!("skipped: Chromium not found (install Debian package `chromium`)");
+    }
+    exe
+}
+
 /// Runs `cmd` with stdout and stderr sent to files in `dir` (a browser's DOM dump is larger
 /// than a pipe holds); kills its process group and fails if it is not done by [`DEADLINE`].
 /// Returns stdout.
@@ -95,6 +111,30 @@ fn browser(exe: &Path, profile: &Path, extra: &[String], url: &str) -> Command {
     cmd
 }
 
+/// `armcal report record` into `work/r`, and the page's DOM after headless Chromium ran its
+/// scripts.
+fn report_dom(exe: &Path, work: &Path, record: &Path) -> String {
+    let mut report = Command::new(env!("CARGO_BIN_EXE_armcal"));
+    report
+        .arg("report")
+        .arg(record)
+        .args(["--quiet", "--out"])
+        .arg(work.join("r"));
+    run(report, work, "report");
+    let url = format!(
+        "file://{}",
+        work.join("r/report.html")
+            .canonicalize()
+            .expect("report path")
+            .display()
+    );
+    run(
+        browser(exe, &work.join("profile-dom"), &["--dump-dom".into()], &url),
+        work,
+        "chromium-dump-dom",
+    )
+}
+
 /// The value of attribute `name` in the start tag `tag` (`<canvas …>`).
 fn attribute<'a>(tag: &'a str, name: &str) -> Option<&'a str> {
     let key = format!(" {name}=\"");
@@ -149,14 +189,7 @@ fn off_dominant_share(pixels: &[[u8; 3]]) -> f64 {
 
 #[test]
 fn demo_report_draws_in_headless_chromium() {
-    let Some(exe) = chromium() else {
-        if std::env::var("ARMCAL_REQUIRE_BROWSER").as_deref() == Ok("1") {
-            panic!(
-                "Chromium not found (ARMCAL_REQUIRE_BROWSER=1): install Debian package \
-                 `chromium` or set ARMCAL_CHROMIUM"
-            );
-        }
-        eprintln!("skipped: Chromium not found (install Debian package `chromium`)");
+    let Some(exe) = chromium_or_skip() else {
         return;
     };
     let work = Path::new(env!("CARGO_TARGET_TMPDIR")).join("browser");
@@ -280,11 +313,7 @@ fn demo_report_draws_in_headless_chromium() {
 /// that has a fit, and the dashed target and decision lines — in the browser.
 #[test]
 fn campaign_report_draws_in_headless_chromium() {
-    let Some(exe) = chromium() else {
-        if std::env::var("ARMCAL_REQUIRE_BROWSER").as_deref() == Ok("1") {
-            panic!("Chromium not found (ARMCAL_REQUIRE_BROWSER=1)");
-        }
-        eprintln!("skipped: Chromium not found (install Debian package `chromium`)");
+    let Some(exe) = chromium_or_skip() else {
         return;
     };
     let work = Path::new(env!("CARGO_TARGET_TMPDIR")).join("browser-campaign");
@@ -306,30 +335,7 @@ fn campaign_report_draws_in_headless_chromium() {
     run(sim, &work, "campaign-simulate");
     let state = std::fs::read_to_string(work.join("c/campaign.json")).expect("campaign.json");
     let steps = state.matches("\"decision\": ").count() - 1;
-    let mut report = Command::new(env!("CARGO_BIN_EXE_armcal"));
-    report
-        .arg("report")
-        .arg(work.join("c/campaign.json"))
-        .args(["--quiet", "--out"])
-        .arg(work.join("r"));
-    run(report, &work, "report");
-    let url = format!(
-        "file://{}",
-        work.join("r/report.html")
-            .canonicalize()
-            .expect("report path")
-            .display()
-    );
-    let dom = run(
-        browser(
-            &exe,
-            &work.join("profile-dom"),
-            &["--dump-dom".into()],
-            &url,
-        ),
-        &work,
-        "chromium-dump-dom",
-    );
+    let dom = report_dom(&exe, &work, &work.join("c/campaign.json"));
     let tag = "<svg data-figure=\"campaign-sigma\"";
     let at = dom.find(tag).expect("the campaign's σ-vs-poses figure");
     let svg = &dom[at..at + dom[at..].find("</svg>").expect("svg closes")];
@@ -338,4 +344,62 @@ fn campaign_report_draws_in_headless_chromium() {
     assert!(svg.contains("target 0.700 mm"), "no target line");
     assert!(svg.contains("stop: target reached"), "no stopping decision");
     eprintln!("campaign figure: {points} points for {steps} steps");
+}
+
+/// Issue 13: the report of the UR10 calibration on real data (Series B, 30 % held out) — its
+/// verdict, the held-out position and orientation errors, and the held-out error against
+/// the recorded temperature — in the browser.
+#[test]
+fn ur10_calibration_report_draws_in_headless_chromium() {
+    let Some(exe) = chromium_or_skip() else {
+        return;
+    };
+    let work = Path::new(env!("CARGO_TARGET_TMPDIR")).join("browser-ur10");
+    let _ = std::fs::remove_dir_all(&work);
+    std::fs::create_dir_all(&work).expect("work dir");
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
+    let mut fit = Command::new(env!("CARGO_BIN_EXE_armcal"));
+    fit.current_dir(root)
+        .args([
+            "identify",
+            "--cell",
+            "examples/ur10-leica-cell.toml",
+            "--data",
+        ])
+        .arg("data/ipa-ur10-leica/Series_B/measurements_joint_configurations.csv")
+        .args(["--holdout", "0.3", "--seed", "1", "--quiet", "--out"])
+        .arg(work.join("b.json"));
+    run(fit, &work, "identify");
+    let dom = report_dom(&exe, &work, &work.join("b.json"));
+    let first = dom.find("<section id=\"").expect("sections");
+    assert!(
+        dom[first..].starts_with("<section id=\"verdict\""),
+        "the report must open with its verdict"
+    );
+    assert_eq!(
+        dom.matches("data-kind=\"Estimate\"").count(),
+        1,
+        "verdict panel"
+    );
+    // position and orientation errors: fit residuals and held out, before and after
+    assert!(dom.contains("Orientation error of the held-out pose measurements"));
+    assert!(dom.matches("orientation").count() >= 3);
+    // the held-out error per axis, and against temperature: Series B spans 21.6–22.2 °C,
+    // three bins of 0.25 °C, a point each
+    for (kind, mark, fewest) in [
+        ("held-out-axes", "<rect", 9),
+        ("held-out-temperature-position", "<circle", 3),
+        ("held-out-temperature-orientation", "<circle", 3),
+    ] {
+        let tag = format!("<svg data-figure=\"{kind}\"");
+        let at = dom.find(&tag).unwrap_or_else(|| panic!("no {kind} figure"));
+        let svg = &dom[at..at + dom[at..].find("</svg>").expect("svg closes")];
+        let marks = svg.matches(mark).count();
+        assert!(marks >= fewest, "{kind}: {marks} {mark} elements");
+        eprintln!("{kind}: {marks} {mark} elements");
+    }
+    assert!(
+        dom.contains("21.50–21.75 °C"),
+        "the temperature table's bins"
+    );
 }

@@ -313,6 +313,27 @@ impl Cell {
         declared
     }
 
+    /// This cell with its instrument repeated at each of `stations`
+    /// ([`Model::with_stations`]; its model and declared free set follow); empty: the cell
+    /// as it is.
+    pub fn with_stations(&self, stations: &[String]) -> Result<Cell, Error> {
+        if stations.is_empty() {
+            return Ok(self.clone());
+        }
+        let model = self.model.with_stations(stations)?;
+        let declared_free = (0..model.param_count())
+            .filter(|&i| {
+                self.declared_free
+                    .contains(&self.model.station_source(&model, i))
+            })
+            .collect();
+        Ok(Cell {
+            model,
+            declared_free,
+            ..self.clone()
+        })
+    }
+
     /// Default analysis options for this cell (its measurement type).
     pub fn identifiability_settings(&self) -> IdentifiabilitySettings {
         IdentifiabilitySettings {

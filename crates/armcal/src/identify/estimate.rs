@@ -117,6 +117,10 @@ pub struct Validation {
     /// on the pose measurements; `None` without pose measurements.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub orientation: Option<HeldOutOrientation>,
+    /// The calibrated model's error at every validation measurement, with its station and
+    /// temperature ([`super::held_out`]: grouped per station and per temperature bin).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub errors: Vec<super::held_out::HeldOutError>,
 }
 
 /// Held-out orientation error (degrees) before and after calibration
@@ -344,14 +348,11 @@ impl Estimate {
     }
 
     /// The full parameter vector of `model` from this estimate (by parameter name), after
-    /// [`Estimate::check_model`].
+    /// [`Estimate::check_model`]. An estimate over several instrument stations gives a model
+    /// without stations its first station's instrument pose ([`Estimate::by_model_name`]).
     pub fn params_for(&self, model: &Model) -> Result<Vec<f64>, Error> {
         self.check_model(model)?;
-        let by_name: std::collections::HashMap<&str, &ParameterEstimate> = self
-            .parameters
-            .iter()
-            .map(|p| (p.name.as_str(), p))
-            .collect();
+        let by_name = self.by_model_name(model);
         Ok(model
             .registry
             .iter()
@@ -359,14 +360,39 @@ impl Estimate {
             .collect())
     }
 
+    /// This estimate's parameters under the names `model` gives them
+    /// ([`Estimate::model_name`]); the first of several with one name.
+    fn by_model_name(
+        &self,
+        model: &Model,
+    ) -> std::collections::HashMap<String, &ParameterEstimate> {
+        let mut out = std::collections::HashMap::new();
+        for p in &self.parameters {
+            out.entry(Self::model_name(model, &p.name)).or_insert(p);
+        }
+        out
+    }
+
+    /// The name `model` gives this estimate's parameter `name`: the name itself, except that
+    /// for a model without stations a station's instrument parameter `I@S.f`
+    /// ([`crate::model::station`]) is `I.f` (the robot is the same at every station; each
+    /// station's pose stays in [`Estimate::parameters`]).
+    fn model_name(model: &Model, name: &str) -> String {
+        let field = match (&model.instrument, model.stations.is_empty()) {
+            (Some(l), true) => name
+                .strip_prefix(l.spec.name.as_str())
+                .and_then(|rest| rest.strip_prefix(crate::model::station::SEPARATOR))
+                .and_then(|rest| rest.split_once('.'))
+                .map(|(_, f)| format!("{}.{f}", l.spec.name)),
+            _ => None,
+        };
+        field.unwrap_or_else(|| name.to_string())
+    }
+
     /// An estimate of a different robot or cell (other parameter names) is an error that
     /// names the mismatch.
     fn check_names(&self, model: &Model) -> Result<(), Error> {
-        let by_name: std::collections::HashMap<&str, &ParameterEstimate> = self
-            .parameters
-            .iter()
-            .map(|p| (p.name.as_str(), p))
-            .collect();
+        let by_name = self.by_model_name(model);
         let missing: Vec<&str> = model
             .registry
             .iter()
@@ -376,7 +402,12 @@ impl Estimate {
         let extra: Vec<&str> = self
             .parameters
             .iter()
-            .filter(|p| model.registry.index_of(&p.name).is_none())
+            .filter(|p| {
+                model
+                    .registry
+                    .index_of(&Self::model_name(model, &p.name))
+                    .is_none()
+            })
             .map(|p| p.name.as_str())
             .collect();
         if !missing.is_empty() || !extra.is_empty() {

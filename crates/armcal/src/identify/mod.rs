@@ -8,6 +8,7 @@ pub mod compliance_gate;
 pub mod estimate;
 pub mod fingerprint;
 pub mod gauss_newton;
+pub mod held_out;
 pub mod kalman;
 pub mod lm;
 pub mod problem;
@@ -167,7 +168,10 @@ fn identifiable_model_given(
         &declared,
         at,
         &data.configurations,
-        &cell.identifiability_settings(),
+        &IdentifiabilitySettings {
+            stations: data.config_stations.clone(),
+            ..cell.identifiability_settings()
+        },
     )?;
     report.apply(&mut declared)?;
     let generic_excluded: std::collections::HashSet<&str> =
@@ -234,6 +238,7 @@ fn frames_model(
         &data.configurations,
         &IdentifiabilitySettings {
             measurement: data_measurement(data),
+            stations: data.config_stations.clone(),
             ..Default::default()
         },
     )?;
@@ -323,14 +328,19 @@ pub fn identify(
     let noise = cell.noise();
     let split = Split::of(data, opts)?;
     let train: &Dataset = &split.train;
+    let stationed = cell.with_stations(&data.stations)?;
     let fit = match &opts.refit {
-        Some(refit) => refit::fit_frames(cell, train, &noise, opts, refit, observer)?,
-        None => fit_free_set(cell, train, &noise, opts, observer)?,
+        Some(refit) => refit::fit_frames(&stationed, cell, train, &noise, opts, refit, observer)?,
+        None => fit_free_set(&stationed, train, &noise, opts, observer)?,
     };
     observer.start("uncertainty, observability and residuals", None);
-    let estimate = estimate_of_fit(cell, data, opts, &split, fit, &noise, observer);
+    let estimate = estimate_of_fit(&stationed, data, opts, &split, fit, &noise, observer);
     observer.finish();
-    estimate
+    // an estimate belongs to the cell as its file describes it, whatever stations its data name
+    estimate.map(|e| Estimate {
+        fingerprint: Some(ModelFingerprint::of(&cell.model)),
+        ..e
+    })
 }
 
 /// The estimate of a fit: covariance, TCP covariance at the working configurations,
@@ -450,7 +460,7 @@ fn estimate_of_fit(
                 rank_deficit.as_ref(),
             ),
         }),
-        fingerprint: Some(ModelFingerprint::of(&cell.model)),
+        fingerprint: None,
         free: names,
         strong_correlations: strong,
         uncertainty: unc,

@@ -67,6 +67,19 @@ impl<'a> Problem<'a> {
     /// row from the noise model. Checks the data against the model.
     pub fn new(model: &'a Model, data: &'a Dataset, noise: &NoiseModel) -> Result<Self, Error> {
         let free = model.registry.free();
+        let stations: Vec<&str> = (0..model.stations.len())
+            .filter_map(|s| model.station_name(s))
+            .collect();
+        if data.stations != stations {
+            return Err(Error::Input(format!(
+                "{}: the data's instrument stations ({}) are not those of model `{}` ({}); \
+                 a model with the data's stations: `Model::with_stations`",
+                data.source,
+                data.stations.join(", "),
+                model.name,
+                stations.join(", ")
+            )));
+        }
         for (c, q) in data.configurations.iter().enumerate() {
             model.check_measured_joints(q).map_err(|e| {
                 Error::Input(format!("configuration `{}`: {e}", data.config_ids[c]))
@@ -263,6 +276,7 @@ impl<'a> Problem<'a> {
             if measurements.is_empty() {
                 continue;
             }
+            data.station = self.data.station_of(c);
             forward_kinematics(self.model, data, params, q);
             for (s, p) in current.iter_mut().enumerate() {
                 self.predict_slot(data, s, p, with_jacobian);
@@ -272,6 +286,7 @@ impl<'a> Problem<'a> {
                 let b = match &self.data.measurements[i].kind {
                     MeasurementKind::Distance { other: o, .. } => {
                         let q = &self.data.configurations[*o];
+                        other_data.station = self.data.station_of(*o);
                         forward_kinematics(self.model, other_data, params, q);
                         self.predict_slot(other_data, slot, other, with_jacobian);
                         Some(&*other)

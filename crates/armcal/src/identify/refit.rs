@@ -42,9 +42,11 @@ pub struct RefitRecord {
 /// The fit of a frames refit: the estimate checked (converged, or accepted; the same cell
 /// model, [`Estimate::params_for`]), the robot parameters held at its values, the frames
 /// these data identify fitted by Levenberg–Marquardt from the cell's nominal frames, then
-/// refined by the chosen method.
+/// refined by the chosen method. `cell` is `source` (the cell the estimate is of) with the
+/// data's stations ([`Cell::with_stations`]).
 pub(super) fn fit_frames(
     cell: &Cell,
+    source: &Cell,
     train: &Dataset,
     noise: &NoiseModel,
     opts: &IdentifySettings,
@@ -58,7 +60,7 @@ pub(super) fn fit_frames(
         .map_err(of_estimate)?;
     let robot = refit
         .estimate
-        .params_for(&cell.model)
+        .params_for(&source.model)
         .map_err(of_estimate)?;
     let declared = if cell.auto_free {
         cell.declared_model()
@@ -68,7 +70,7 @@ pub(super) fn fit_frames(
     let mut start = declared.nominal();
     for (i, value) in start.iter_mut().enumerate() {
         if !is_frame_parameter(&declared, i) {
-            *value = robot[i];
+            *value = robot[source.model.station_source(&declared, i)];
         }
     }
     let (model, excluded) = frames_model(&frames_only(&declared), train, &start)?;

@@ -1,6 +1,7 @@
 //! The split of a data set into the configurations a fit uses and those it is validated
 //! on (a seeded random holdout, or the user's own test file).
 
+use super::held_out::held_out_errors;
 use super::{
     frames_first_start, holdout_split, residuals, AxisErrors, HeldOutAxes, HeldOutOrientation,
     IdentifySettings, Problem, Validation,
@@ -23,6 +24,24 @@ pub(super) struct Split<'d> {
     pub(super) test: Option<(std::borrow::Cow<'d, Dataset>, String)>,
 }
 
+/// [`holdout_split`] of each station's configurations (in file order) with the same seed:
+/// every station holds out what a fit of its data alone would (the whole data set without
+/// stations).
+fn holdout_split_by_station(data: &Dataset, fraction: f64, seed: u64) -> (Vec<usize>, Vec<usize>) {
+    let (mut train, mut test) = (Vec::new(), Vec::new());
+    for s in 0..data.stations.len().max(1) {
+        let configs: Vec<usize> = (0..data.configurations.len())
+            .filter(|&c| data.station_of(c) == s)
+            .collect();
+        let (tr, te) = holdout_split(configs.len(), fraction, seed);
+        train.extend(tr.into_iter().map(|i| configs[i]));
+        test.extend(te.into_iter().map(|i| configs[i]));
+    }
+    train.sort_unstable();
+    test.sort_unstable();
+    (train, test)
+}
+
 impl<'d> Split<'d> {
     pub(super) fn of(data: &'d Dataset, opts: &'d IdentifySettings) -> Result<Split<'d>, Error> {
         let h = opts.holdout;
@@ -42,7 +61,7 @@ impl<'d> Split<'d> {
                 test: Some((std::borrow::Cow::Borrowed(test), test.source.clone())),
             }),
             (None, true) => {
-                let (train, test) = holdout_split(all.len(), h, opts.seed);
+                let (train, test) = holdout_split_by_station(data, h, opts.seed);
                 if test.is_empty() {
                     return Err(Error::Input(format!(
                         "the holdout fraction {h} of {} configurations holds out none; hold out a larger fraction",
@@ -113,7 +132,14 @@ impl<'d> Split<'d> {
             frames_only: axes(&frames),
             calibrated: axes(calibrated),
         };
+        let position = eval.errors(&mut ws, calibrated);
+        let errors = held_out_errors(
+            test,
+            &position,
+            &eval.orientation_errors(&mut ws, calibrated),
+        );
         Ok(Some(Validation {
+            errors,
             per_axis: Some(per_axis),
             orientation,
             test_data: source.clone(),
@@ -123,7 +149,7 @@ impl<'d> Split<'d> {
             test_ids: test.config_ids.clone(),
             nominal: ErrorStats::of(&eval.errors(&mut ws, &model.nominal())),
             frames_only: ErrorStats::of(&eval.errors(&mut ws, &frames)),
-            calibrated: ErrorStats::of(&eval.errors(&mut ws, calibrated)),
+            calibrated: ErrorStats::of(&position),
         }))
     }
 }

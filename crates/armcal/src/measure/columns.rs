@@ -33,6 +33,8 @@ pub(crate) struct Layout {
     pub temperature: Option<Column>,
     pub pose_id: Option<usize>,
     pub target: Option<usize>,
+    /// The `station` column ([`crate::model::station`]).
+    pub station: Option<usize>,
     /// Header names no column of the layout uses.
     pub ignored: Vec<String>,
 }
@@ -135,7 +137,8 @@ impl DataFormat {
         let find = |name: &str| header.iter().position(|h| h == name);
         let pose_id = find("pose_id");
         let target = find("target");
-        for c in [pose_id, target].into_iter().flatten() {
+        let station = find("station");
+        for c in [pose_id, target, station].into_iter().flatten() {
             used[c] = true;
         }
         let ignored = header
@@ -153,6 +156,7 @@ impl DataFormat {
             temperature,
             pose_id,
             target,
+            station,
             ignored,
         })
     }

@@ -12,7 +12,9 @@
 //! * `roll`, `pitch`, `yaw` — orientation (pose measurements) [`_deg`; also `_rad`];
 //! * `sigma_x` … `sigma_z` or `u_x` … `u_z` — stated σ per axis [`_mm`; also `_m`, `_in`],
 //!   and `sigma_roll` … for pose rows (σ of the residual's rotation rows);
-//! * `temperature_c` — air temperature at the measurement, °C (a covariate).
+//! * `temperature_c` — air temperature at the measurement, °C (a covariate);
+//! * `station` — the instrument station the row was measured from
+//!   ([`crate::model::station`]); with it, a configuration is a (station, `pose_id`) pair.
 //!
 //! That is [`DataFormat::armcal`]; a cell's `[data]` section maps any other layout
 //! ([`crate::measure::format`]: delimiter, decimal comma, column names, units, orientation
@@ -191,6 +193,25 @@ impl Row<'_> {
                  robot reaches there"
             ),
         ))
+    }
+
+    /// The row's station name: checked ([`crate::model::station::check_name`]), and only
+    /// for a model with an instrument whose pose a station sets.
+    fn station(&self, c: usize, model: &Model) -> Result<&str, Error> {
+        let s = self.text(c);
+        let fail = |why: String| {
+            err(
+                self.file,
+                format!("line {}: `station` = `{s}`: {why}", self.line),
+            )
+        };
+        crate::model::station::check_name(s).map_err(fail)?;
+        if model.instrument.is_none() {
+            return Err(fail(
+                "the cell has no [instrument] whose pose a station could set".into(),
+            ));
+        }
+        Ok(s)
     }
 
     /// The joint values (internal units).
@@ -387,7 +408,7 @@ fn read_rows(
         source: file.to_string(),
         ..Default::default()
     };
-    let mut config_of: HashMap<String, usize> = HashMap::new();
+    let mut config_of: HashMap<(usize, String), usize> = HashMap::new();
     let mut warnings = Vec::new();
     let targets: Vec<&str> = model.targets.iter().map(|t| t.spec.name.as_str()).collect();
     for (r, record) in rdr.records().enumerate() {
@@ -408,7 +429,12 @@ fn read_rows(
             .pose_id
             .map(|c| row.text(c).to_string())
             .unwrap_or_else(|| format!("{}", r + 1));
-        let config = match config_of.get(&id) {
+        let station = match layout.station {
+            Some(c) => Some(row.station(c, model)?),
+            None => None,
+        };
+        let key = (station.map_or(0, |s| data.station_index(s)), id.clone());
+        let config = match config_of.get(&key) {
             Some(&c) => {
                 if data.configurations[c]
                     .iter()
@@ -423,8 +449,11 @@ fn read_rows(
                 c
             }
             None => {
-                let c = data.push_configuration(id.clone(), q);
-                config_of.insert(id, c);
+                let c = data.push_configuration(id, q);
+                if let Some(s) = data.config_stations.last_mut() {
+                    *s = key.0;
+                }
+                config_of.insert(key, c);
                 c
             }
         };
@@ -544,7 +573,8 @@ pub fn import(path: &Path, model: &Model, format: &DataFormat) -> Result<Import,
     Ok(Import { data, report, csv })
 }
 
-/// Writes a dataset in armcal's format: `pose_id`, `q<i>_deg` (or `_mm`), `target`, `x_mm`,
+/// Writes a dataset in armcal's format: `pose_id`, `station` if the data name stations,
+/// `q<i>_deg` (or `_mm`), `target`, `x_mm`,
 /// `y_mm`, `z_mm`, then `roll_deg`, `pitch_deg`, `yaw_deg` for pose rows and σ columns if
 /// any measurement has them, and `temperature_c` if any measurement recorded one. Only
 /// position and pose measurements have a CSV form.
@@ -563,6 +593,10 @@ pub fn write_string(data: &Dataset, model: &Model) -> Result<String, Error> {
         .iter()
         .any(|m| m.covariates.temperature_c.is_some());
     let mut header = vec!["pose_id".to_string()];
+    let stations = !data.stations.is_empty();
+    if stations {
+        header.push("station".into());
+    }
     header.extend(model.joints.iter().map(joint_column));
     header.extend(["target", "x_mm", "y_mm", "z_mm"].map(String::from));
     if any_pose {
@@ -581,6 +615,9 @@ pub fn write_string(data: &Dataset, model: &Model) -> Result<String, Error> {
     let f = |x: f64| format!("{x:.9}");
     for m in &data.measurements {
         let mut row = vec![data.config_ids[m.config].clone()];
+        if stations {
+            row.push(data.stations[data.station_of(m.config)].clone());
+        }
         for (v, j) in data.configurations[m.config].iter().zip(&model.joints) {
             row.push(f(joint_display(j, *v)));
         }

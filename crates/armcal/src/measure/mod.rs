@@ -137,6 +137,15 @@ pub struct Dataset {
     pub measurements: Vec<Measurement>,
     /// Where the data came from.
     pub source: String,
+    /// The instrument stations the data name (a `station` column, or
+    /// [`Dataset::at_station`]), in order of first appearance; empty: one station, the
+    /// cell's instrument pose ([`crate::model::station`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub stations: Vec<String>,
+    /// The station of each configuration, an index into `stations`; empty when `stations`
+    /// is.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub config_stations: Vec<usize>,
 }
 
 impl Dataset {
@@ -145,17 +154,71 @@ impl Dataset {
         self.measurements.iter().map(|m| m.kind.rows()).sum()
     }
 
-    /// Adds a configuration and returns its index.
+    /// Adds a configuration (at the first station, if the data name stations) and returns
+    /// its index.
     pub fn push_configuration(&mut self, id: String, q: Vec<f64>) -> usize {
         self.configurations.push(q);
         self.config_ids.push(id);
+        if !self.stations.is_empty() {
+            self.config_stations.push(0);
+        }
         self.configurations.len() - 1
     }
 
-    /// Appends `other`'s configurations (with their ids) and measurements, which then refer
-    /// to the appended configurations.
+    /// The station of configuration `c` (an index into [`Dataset::stations`]; 0 without
+    /// stations).
+    pub fn station_of(&self, c: usize) -> usize {
+        self.config_stations.get(c).copied().unwrap_or(0)
+    }
+
+    /// The index of station `name`, added to [`Dataset::stations`] if new. A data set
+    /// without stations so far gets `name` for every configuration it has.
+    pub fn station_index(&mut self, name: &str) -> usize {
+        if let Some(s) = self.stations.iter().position(|s| s == name) {
+            return s;
+        }
+        if self.stations.is_empty() {
+            self.config_stations = vec![0; self.configurations.len()];
+        }
+        self.stations.push(name.to_string());
+        self.stations.len() - 1
+    }
+
+    /// Every configuration of this data set at station `name` (the data of one set-up,
+    /// before they are appended to another's, [`Dataset::append`]). The name is checked
+    /// ([`crate::model::station::check_name`]); data that name their own stations already
+    /// are an error.
+    pub fn at_station(mut self, name: &str) -> Result<Dataset, crate::Error> {
+        crate::model::station::check_name(name)
+            .map_err(|e| crate::Error::Input(format!("station `{name}`: {e}")))?;
+        if !self.stations.is_empty() {
+            return Err(crate::Error::Input(format!(
+                "{}: the data name their own stations ({}); give the file without a station",
+                self.source,
+                self.stations.join(", ")
+            )));
+        }
+        self.stations = vec![name.to_string()];
+        self.config_stations = vec![0; self.configurations.len()];
+        Ok(self)
+    }
+
+    /// Appends `other`'s configurations (with their ids and stations, merged by name) and
+    /// measurements, which then refer to the appended configurations.
     pub fn append(&mut self, other: &Dataset) {
         let offset = self.configurations.len();
+        if !other.stations.is_empty() {
+            let stations: Vec<usize> = other
+                .stations
+                .iter()
+                .map(|s| self.station_index(s))
+                .collect();
+            self.config_stations
+                .extend((0..other.configurations.len()).map(|c| stations[other.station_of(c)]));
+        } else if !self.stations.is_empty() {
+            self.config_stations
+                .extend(std::iter::repeat_n(0, other.configurations.len()));
+        }
         self.configurations
             .extend(other.configurations.iter().cloned());
         self.config_ids.extend(other.config_ids.iter().cloned());
@@ -175,11 +238,15 @@ impl Dataset {
         let mut map = vec![usize::MAX; self.configurations.len()];
         let mut out = Dataset {
             source: self.source.clone(),
+            stations: self.stations.clone(),
             ..Default::default()
         };
         for &c in configs {
             map[c] =
                 out.push_configuration(self.config_ids[c].clone(), self.configurations[c].clone());
+            if let Some(s) = out.config_stations.last_mut() {
+                *s = self.station_of(c);
+            }
         }
         for m in &self.measurements {
             if map[m.config] == usize::MAX {

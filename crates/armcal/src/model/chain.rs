@@ -137,7 +137,12 @@ pub struct Model {
     /// Joints in chain order; `q[i]` drives `joints[i]` (rad or mm).
     pub joints: Vec<Joint>,
     /// Instrument frame in the world (paper eq. 3); `None`: measurements in the world frame.
+    /// With stations, its spec is the cell's instrument and its parameters the first
+    /// station's.
     pub instrument: Option<Link>,
+    /// The instrument's frame at each station the data name, in station order (frames
+    /// `<instrument>@<station>`, [`crate::model::station`]); empty: one instrument pose.
+    pub stations: Vec<Link>,
     /// Base frame, links, tool frame, in chain order.
     pub links: Vec<Link>,
     /// Points or frames attached to the tool, measured by the instrument.
@@ -145,6 +150,8 @@ pub struct Model {
     /// Joint compliance, compiled; its κ are the registry's last parameters.
     pub compliance: Option<Compliance>,
     pub(crate) instrument_steps: Vec<Step>,
+    /// The instrument steps of each station (empty without stations).
+    pub(crate) station_steps: Vec<Vec<Step>>,
     pub(crate) chain_steps: Vec<Step>,
     /// `chain_step_end[i]`: number of chain steps after which link `i` is complete.
     pub(crate) chain_step_end: Vec<usize>,
@@ -182,6 +189,12 @@ impl Model {
     /// Builds a model from its spec. Checks field counts, unique names, conventions that
     /// need or forbid a joint, non-zero ZRP axes and joint limits.
     pub fn from_spec(spec: &ModelSpec) -> Result<Model, Error> {
+        Model::compile(spec, &[])
+    }
+
+    /// As [`Model::from_spec`], with the instrument's frame repeated once per station
+    /// (`stations` non-empty: [`crate::model::station`]).
+    pub(crate) fn compile(spec: &ModelSpec, stations: &[String]) -> Result<Model, Error> {
         let mut registry = Registry::new();
         let mut joints = Vec::new();
         let mut names = std::collections::HashSet::new();
@@ -299,6 +312,8 @@ impl Model {
             ))
         };
 
+        let mut station_links = Vec::new();
+        let mut station_steps = Vec::new();
         let (instrument, instrument_steps) = match &spec.instrument {
             Some(ls) => {
                 if ls.joint.is_some() {
@@ -306,8 +321,34 @@ impl Model {
                         "the instrument frame cannot have a joint".into(),
                     ));
                 }
-                let (l, s) = compile(ls, Segment::Instrument, &mut registry, &mut joints)?;
-                (Some(l), s)
+                for station in stations {
+                    let at = LinkSpec {
+                        name: crate::model::station::frame_name(&ls.name, station),
+                        ..ls.clone()
+                    };
+                    let (l, s) = compile(&at, Segment::Instrument, &mut registry, &mut joints)?;
+                    station_links.push(l);
+                    station_steps.push(s);
+                }
+                match (station_links.first(), station_steps.first()) {
+                    (Some(first), Some(steps)) => {
+                        let template = Link {
+                            spec: ls.clone(),
+                            ..first.clone()
+                        };
+                        (Some(template), steps.clone())
+                    }
+                    _ => {
+                        let (l, s) = compile(ls, Segment::Instrument, &mut registry, &mut joints)?;
+                        (Some(l), s)
+                    }
+                }
+            }
+            None if !stations.is_empty() => {
+                return Err(Error::Model(format!(
+                    "model `{}` has no instrument whose pose stations could set",
+                    spec.name
+                )))
             }
             None => (None, Vec::new()),
         };
@@ -346,10 +387,12 @@ impl Model {
             registry,
             joints,
             instrument,
+            stations: station_links,
             links,
             targets,
             compliance,
             instrument_steps,
+            station_steps,
             chain_steps,
             chain_step_end,
             target_steps,

@@ -72,6 +72,10 @@ pub struct IdentifiabilitySettings {
     /// A scaled column whose component orthogonal to the kept columns is below this is
     /// dependent; also the relative singular-value threshold of the rank.
     pub tolerance: f64,
+    /// The instrument station of each configuration of [`analyze_at`] (an index into
+    /// [`Model::stations`]); empty: the configurations are spread over the model's stations
+    /// in turn (as [`analyze`]'s random ones always are).
+    pub stations: Vec<usize>,
 }
 
 impl Default for IdentifiabilitySettings {
@@ -81,6 +85,7 @@ impl Default for IdentifiabilitySettings {
             poses: 60,
             seed: 1,
             tolerance: 1e-8,
+            stations: Vec::new(),
         }
     }
 }
@@ -143,14 +148,16 @@ pub struct Identifiability {
 /// where the book gives a count: `4R + 2P + 6` for a full pose; `4R + 2P + 3` for the
 /// position of one point (the tool orientation is not measured, book §4.7, Prop. 4.7.3);
 /// `4R + 2P − 3` for distances of one point (the placement of the robot, 6, is lost).
-/// `None` for several points, whose count depends on their layout.
+/// `None` for several points, whose count depends on their layout. Each instrument station
+/// after the first adds 6 to a pose or position count ([`crate::model::station`]).
 pub fn expected_count(model: &Model, m: Measurement) -> Option<usize> {
     let (r, p) = joint_counts(model);
+    let stations = 6 * model.stations.len().saturating_sub(1);
     let base = 4 * r + 2 * p;
     let single_point = model.targets.len() <= 1;
     match m {
-        Measurement::Pose => Some(base + 6),
-        Measurement::Position if single_point => Some(base + 3),
+        Measurement::Pose => Some(base + 6 + stations),
+        Measurement::Position if single_point => Some(base + 3 + stations),
         Measurement::Distance if single_point => (base + 3).checked_sub(6),
         _ => None,
     }
@@ -229,11 +236,24 @@ pub fn stacked_jacobian(
     m: Measurement,
     columns: &[usize],
 ) -> DMatrix<f64> {
+    stacked_jacobian_at(model, params, qs, &|_| 0, m, columns)
+}
+
+/// As [`stacked_jacobian`], configuration `i` measured from station `station(i)`.
+fn stacked_jacobian_at(
+    model: &Model,
+    params: &[f64],
+    qs: &[Vec<f64>],
+    station: &dyn Fn(usize) -> usize,
+    m: Measurement,
+    columns: &[usize],
+) -> DMatrix<f64> {
     let obs = observations(model, m);
     let per_pose: usize = obs.iter().map(|(_, r)| r.count()).sum();
     let mut data = Data::new(model);
     let mut full = DMatrix::zeros(per_pose * qs.len(), columns.len());
     for (i, q) in qs.iter().enumerate() {
+        data.station = station(i);
         forward_kinematics(model, &mut data, params, q);
         let mut row = i * per_pose;
         for &(o, r) in &obs {
@@ -246,7 +266,8 @@ pub fn stacked_jacobian(
     }
     // Distance between the point at pose i and at pose i+1: row = d̂ᵀ (J_i − J_{i+1}).
     let mut positions = Vec::with_capacity(qs.len());
-    for q in qs {
+    for (i, q) in qs.iter().enumerate() {
+        data.station = station(i);
         forward_kinematics(model, &mut data, params, q);
         positions.push(
             obs.iter()
@@ -288,15 +309,21 @@ fn stacked_factor(
     model: &Model,
     params: &[f64],
     qs: &[Vec<f64>],
-    m: Measurement,
+    opts: &IdentifiabilitySettings,
     columns: &[usize],
 ) -> (DMatrix<f64>, usize) {
+    let m = opts.measurement;
     let overlap = usize::from(m == Measurement::Distance);
     let mut factor = RowCompressor::new(columns.len());
     let mut start = 0;
+    let stations = model.stations.len().max(1);
     while start + overlap < qs.len() {
         let end = (start + FACTOR_BLOCK + overlap).min(qs.len());
-        let block = stacked_jacobian(model, params, &qs[start..end], m, columns);
+        let station = |i: usize| {
+            let i = start + i;
+            opts.stations.get(i).copied().unwrap_or(i % stations)
+        };
+        let block = stacked_jacobian_at(model, params, &qs[start..end], &station, m, columns);
         factor.add_rows(block.as_view());
         start = end - overlap;
     }
@@ -334,7 +361,7 @@ pub fn analyze_at(
     // Everything below depends on the stacked Jacobian only through inner products of its
     // columns, so it runs on its n × n triangular factor (`linalg`), built a block of
     // configurations at a time: memory and time stay flat in the number of configurations.
-    let (factor, m) = stacked_factor(model, params, qs, opts.measurement, &candidates);
+    let (factor, m) = stacked_factor(model, params, qs, opts, &candidates);
     let name = |i: usize| model.registry.get(i).name.clone();
 
     // Column scaling to unit norm; zero columns stay zero.

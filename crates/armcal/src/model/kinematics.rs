@@ -13,7 +13,10 @@ use nalgebra::{convert, RealField, Vector3};
 /// the scalar so dual numbers can flow through the same code.
 #[derive(Clone, Debug)]
 pub struct Data<T: RealField + Copy> {
-    /// Pose of the instrument frame in the world.
+    /// The station whose instrument pose [`forward_kinematics`] takes (an index into
+    /// [`Model::stations`]; 0 by default, and the only one without stations).
+    pub station: usize,
+    /// Pose of the instrument frame in the world (at `station`).
     pub instrument: Pose<T>,
     /// World pose at the end of each chain link (base, links, tool).
     pub frames: Vec<Pose<T>>,
@@ -52,6 +55,7 @@ impl<T: RealField + Copy> Data<T> {
     /// Buffers for the chain alone, with no compliance state (the lever pass).
     pub(crate) fn without_compliance(model: &Model) -> Self {
         Data {
+            station: 0,
             instrument: Pose::identity(),
             frames: vec![Pose::identity(); model.links.len()],
             targets: vec![Pose::identity(); model.targets.len()],
@@ -103,7 +107,18 @@ pub fn forward_kinematics<T: RealField + Copy>(
 /// One pass over instrument, chain and targets at joints `q` (no compliance).
 fn chain_pass<T: RealField + Copy>(model: &Model, data: &mut Data<T>, params: &[f64], q: &[T]) {
     let mut pose = Pose::identity();
-    for step in &model.instrument_steps {
+    let steps = match model.station_steps.get(data.station) {
+        Some(steps) => {
+            // only this station's instrument parameters move what it measures
+            for l in &model.stations {
+                let first = l.first_param;
+                data.param_twists[first..first + l.param_count()].fill(Twist::zero());
+            }
+            steps
+        }
+        None => &model.instrument_steps,
+    };
+    for step in steps {
         apply_step(step, &mut pose, params, q, data);
     }
     data.instrument = pose;

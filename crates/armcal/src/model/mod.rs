@@ -16,6 +16,7 @@ pub mod pose;
 pub mod rank_deficit;
 pub mod registry;
 pub mod sampling;
+pub mod station;
 pub mod urdf;
 
 pub use chain::{LimitTolerance, Link, LinkSpec, Model, ModelSpec, MEASURED_LIMIT_TOLERANCE};

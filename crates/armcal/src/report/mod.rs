@@ -26,6 +26,7 @@ pub mod parameter_charts;
 pub mod parameter_view;
 pub mod study;
 pub mod tcp;
+pub mod temperature;
 pub mod verdict;
 
 pub use documents::Document;
@@ -266,6 +267,7 @@ pub fn page(c: &ReportContent) -> Result<Page, Error> {
                     .map_err(of(i))?;
             let fill = colours.of(&i.label);
             held_out::held_out_axes_block(&mut section, &i.label, e, fill).map_err(of(i))?;
+            temperature::temperature_block(&mut section, &i.label, e).map_err(of(i))?;
             let truth = truths.iter().copied().find(|t| t.cell == e.cell);
             parameter_view::parameter_blocks(&mut section, &i.label, e, truth, fill)
                 .map_err(of(i))?;

@@ -276,3 +276,19 @@ pub fn monte_carlo_tcp_covariances(
         })
         .collect()
 }
+
+/// Every parameter of the estimate `e` of `model` within 1e-6 (display units) of `truth`
+/// (internal units, registry order).
+pub fn assert_estimate_is(model: &Model, e: &armcal::identify::Estimate, truth: &[f64]) {
+    for p in &e.parameters {
+        let i = model.registry.require(&p.name).unwrap();
+        let f = model.registry.get(i).unit.display_factor();
+        assert!(
+            (p.estimate - truth[i] * f).abs() < 1e-6,
+            "{} = {} vs truth {}",
+            p.name,
+            p.estimate,
+            truth[i] * f
+        );
+    }
+}

@@ -23,6 +23,7 @@ mod identify {
     mod identification_validation;
     mod mixed_measurements;
     mod priors_and_noise;
+    mod stations;
 }
 mod campaign {
     mod adaptive;
@@ -62,6 +63,7 @@ mod real_data {
     mod motoman_nominal;
     mod ur10_cubes;
     mod ur10_import;
+    mod ur10_stations;
 }
 mod hostile {
     mod cell_export_strings;

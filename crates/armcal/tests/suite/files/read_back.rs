@@ -75,6 +75,7 @@ fn data_files_read_back_in_the_data_reader() {
             config_ids: Vec::new(),
             measurements: Vec::new(),
             source: "random".into(),
+            ..Default::default()
         };
         for i in 0..r.random_range(1..6) {
             let q = random_q(&model, r);

@@ -105,17 +105,7 @@ fn a_frames_refit_recovers_a_moved_tracker_with_the_robot_held() {
         "{:?}",
         first.solver.status
     );
-    for p in &first.parameters {
-        let i = cell.model.registry.require(&p.name).unwrap();
-        let f = cell.model.registry.get(i).unit.display_factor();
-        assert!(
-            (p.estimate - truth[i] * f).abs() < 1e-6,
-            "{} = {} vs truth {}",
-            p.name,
-            p.estimate,
-            truth[i] * f
-        );
-    }
+    common::assert_estimate_is(&cell.model, &first, &truth);
     // The tracker re-installed elsewhere and the probe re-mounted: new data.
     let mut moved = truth.clone();
     set(
