@@ -159,7 +159,7 @@ pub fn print_summary(e: &Estimate) {
     if let Some(d) = &e.rank_deficit {
         println!("\nbelow the generic count: {d}");
     }
-    print_compliance(e);
+    print_nongeometric(e);
     if !e.strong_correlations.is_empty() {
         println!("\nstrongly correlated pairs (|ρ| > 0.95):");
         for (a, b, r) in &e.strong_correlations {
@@ -279,29 +279,32 @@ fn print_stats_rows(rows: [(&str, &armcal::accuracy::ErrorStats); 3]) {
     }
 }
 
-/// The compliance gate: per term κ ± σ, its largest correlation with the geometry, the
-/// share of its effect the geometry cannot absorb, and the verdict.
-fn print_compliance(e: &Estimate) {
-    if e.compliance.is_empty() {
+/// The gate of the non-geometric terms: per term estimate ± σ, its largest correlation with
+/// another parameter, the share of its effect the others cannot absorb, and the verdict.
+fn print_nongeometric(e: &Estimate) {
+    if e.nongeometric.is_empty() {
         return;
     }
-    println!("\njoint compliance (κ = compliance × mass × g, µrad per m of lever):");
-    println!("  term                        κ ± σ (µrad/m)       max |ρ| with geometry   not absorbed   verdict");
-    for v in &e.compliance {
+    println!(
+        "
+non-geometric terms (compliance κ in µrad per m of lever, periodic amplitudes in arcsec):"
+    );
+    println!("  term                        estimate ± σ          max |ρ| with another    not absorbed   verdict");
+    for v in &e.nongeometric {
         let rho = v
             .most_correlated
             .as_ref()
             .map_or("-".to_string(), |(n, r)| format!("{r:+.3} ({n})"));
         let verdict = match (v.separable, v.wrong_sign) {
-            (false, _) => "not separable from the geometry",
+            (false, _) => "not separable",
             (true, true) => "WRONG SIGN: the arm rises against gravity",
             (true, false) => "separable",
         };
         println!(
             "  {:<26} {:>9.1} ± {:<8.1} {:<23} {:>8.1} %   {verdict}",
             v.name,
-            v.estimate_urad_per_m,
-            v.sigma_urad_per_m,
+            v.estimate,
+            v.sigma,
             rho,
             100.0 * v.unabsorbed
         );

@@ -178,10 +178,10 @@ pub struct Estimate {
     pub model: ModelSpec,
     /// Every model parameter, free or fixed, in registry order (display units).
     pub parameters: Vec<ParameterEstimate>,
-    /// The identifiability gate of the free compliance terms
-    /// ([`crate::identify::compliance_gate`]); empty for a rigid model.
+    /// The identifiability gate of the free non-geometric terms (compliance, periodic
+    /// errors; [`crate::identify::nongeometric_gate`]); empty for a kinematic model.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub compliance: Vec<crate::identify::compliance_gate::ComplianceVerdict>,
+    pub nongeometric: Vec<crate::identify::nongeometric_gate::TermVerdict>,
     /// Why each parameter not estimated was left out (identifiability analysis).
     pub fixed_reasons: Vec<(String, String)>,
     /// Why fewer parameters than the generic count were identified (at the fit, from these
