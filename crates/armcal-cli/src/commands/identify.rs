@@ -4,7 +4,8 @@ use super::output::{load_cell, load_data, load_estimate, AcceptUnconverged, Outp
 use super::progress::Progress;
 use anyhow::bail;
 use armcal::identify::{
-    identify, Estimate, FramesRefit, IdentifySettings, LmSettings, Loss, Method, ToleranceSettings,
+    identify, Candidate, Estimate, FramesRefit, IdentifySettings, LmSettings, Loss, Method,
+    NonGeometric, ToleranceSettings,
 };
 use std::path::{Path, PathBuf};
 
@@ -53,6 +54,16 @@ pub struct Args {
     /// The estimate (estimate.json of the same cell) whose robot parameters --refit keeps.
     #[arg(long, requires = "refit")]
     pub estimate: Option<PathBuf>,
+    /// The cell's non-geometric terms ([parameters] compliance / periodic) the fit keeps:
+    /// `as-cell` (all), `none` (the kinematic model), `compliance`, `periodic`, `both`, or
+    /// `auto`: the candidate chosen by k-fold cross-validation on the training data (the
+    /// fewest terms within one standard error of the best held-out RMS), every candidate's
+    /// table printed and kept in the estimate.
+    #[arg(long, default_value = "as-cell", value_parser = ["as-cell", "none", "compliance", "periodic", "both", "auto"])]
+    pub nongeometric: String,
+    /// Folds of the cross-validation of `--nongeometric auto` (seeded by --seed).
+    #[arg(long, default_value_t = 5)]
+    pub folds: usize,
     #[command(flatten)]
     pub accept: AcceptUnconverged,
 }
@@ -88,6 +99,11 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         },
         refit,
         start: None,
+        nongeometric: match a.nongeometric.as_str() {
+            "as-cell" => NonGeometric::AsCell,
+            "auto" => NonGeometric::Auto { folds: a.folds },
+            other => NonGeometric::Only(Candidate::from_name(other).expect("clap checked")),
+        },
     };
     let est = identify(&cell, &data, &opts, &mut Progress::new(a.quiet))?;
     outputs.commit(&[(&a.out, &serde_json::to_string_pretty(&est)?)])?;
@@ -160,6 +176,7 @@ pub fn print_summary(e: &Estimate) {
         println!("\nbelow the generic count: {d}");
     }
     print_nongeometric(e);
+    print_choice(e);
     if !e.strong_correlations.is_empty() {
         println!("\nstrongly correlated pairs (|ρ| > 0.95):");
         for (a, b, r) in &e.strong_correlations {
@@ -277,6 +294,39 @@ fn print_stats_rows(rows: [(&str, &armcal::accuracy::ErrorStats); 3]) {
             s.mean, s.rms, s.max, s.p95
         );
     }
+}
+
+/// `--nongeometric auto`: every candidate's cross-validated held-out errors and the choice.
+fn print_choice(e: &Estimate) {
+    let Some(c) = &e.nongeometric_choice else {
+        return;
+    };
+    println!(
+        "
+non-geometric terms chosen by {}-fold cross-validation on the {} training configurations:",
+        c.folds, c.configurations
+    );
+    println!(
+        "  {:<26} {:>5} {:>9} {:>9} {:>9} {:>9}",
+        "candidate", "terms", "mean", "RMS", "± s.e.", "max (mm)"
+    );
+    for s in &c.candidates {
+        let mark = if s.candidate == c.chosen {
+            "  ← chosen"
+        } else {
+            ""
+        };
+        println!(
+            "  {:<26} {:>5} {:>9.4} {:>9.4} {:>9.4} {:>9.4}{mark}",
+            s.candidate.words(),
+            s.terms,
+            s.held_out.mean,
+            s.held_out.rms,
+            s.standard_error,
+            s.held_out.max
+        );
+    }
+    println!("  rule: {}", c.rule);
 }
 
 /// The gate of the non-geometric terms: per term estimate ± σ, its largest correlation with

@@ -29,7 +29,12 @@ fn truth_of(file: &Path, unit: &str) -> Vec<(String, f64)> {
         .unwrap()
         .iter()
         .filter(|p| p["unit"] == unit)
-        .map(|p| (p["name"].as_str().unwrap().into(), p["truth"].as_f64().unwrap()))
+        .map(|p| {
+            (
+                p["name"].as_str().unwrap().into(),
+                p["truth"].as_f64().unwrap(),
+            )
+        })
         .collect()
 }
 
@@ -38,7 +43,10 @@ fn simulate_draws_compliance_and_periodic_errors_at_the_given_magnitudes() {
     let dir = scratch("nongeometric-simulate");
     let cell = nongeometric_cell(&dir);
     let run = |tag: &str, kappa: &str, arcsec: &str| {
-        let (out, truth) = (dir.join(format!("{tag}.csv")), dir.join(format!("{tag}.json")));
+        let (out, truth) = (
+            dir.join(format!("{tag}.csv")),
+            dir.join(format!("{tag}.json")),
+        );
         let (ok, stdout, stderr) = armcal(&[
             "simulate",
             "--cell",
@@ -71,7 +79,10 @@ fn simulate_draws_compliance_and_periodic_errors_at_the_given_magnitudes() {
     assert!(p1.iter().all(|x| x.1.abs() < 5.0 * 30.0), "{p1:?}");
     // same seed, twice the σ: every drawn value doubles (nominal 0)
     for (a, b) in k1.iter().zip(&k2).chain(p1.iter().zip(&p2)) {
-        assert!((2.0 * a.1 - b.1).abs() <= 1e-9 * b.1.abs().max(1.0), "{a:?} {b:?}");
+        assert!(
+            (2.0 * a.1 - b.1).abs() <= 1e-9 * b.1.abs().max(1.0),
+            "{a:?} {b:?}"
+        );
     }
     let (ok, _, stderr) = armcal(&[
         "simulate",
@@ -84,4 +95,71 @@ fn simulate_draws_compliance_and_periodic_errors_at_the_given_magnitudes() {
         dir.join("bad.csv").to_str().unwrap(),
     ]);
     assert!(!ok && stderr.contains("--perturb-arcsec"), "{stderr}");
+}
+
+/// On a strongly compliant truth (2000 µrad/m, no periodic error, noise-free: the cell's
+/// σ = 1 mm would hide the sag) `--nongeometric auto`
+/// keeps the compliance, prints every candidate's cross-validated table and records it;
+/// `--nongeometric none` leaves every term out with its reason.
+#[test]
+fn identify_chooses_the_nongeometric_terms_by_cross_validation() {
+    let dir = scratch("nongeometric-identify");
+    let cell = nongeometric_cell(&dir);
+    let data = dir.join("data.csv");
+    let (ok, stdout, stderr) = armcal(&[
+        "simulate",
+        "--cell",
+        &cell,
+        "--poses",
+        "examples/paper-pool-500.csv",
+        "--seed",
+        "3",
+        "--perturb-urad-per-m",
+        "2000",
+        "--perturb-arcsec",
+        "0",
+        "--noise-free",
+        "--allow-unmeasurable",
+        "--out",
+        data.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stdout}{stderr}");
+    let identify = |options: &[&str], out: &Path| {
+        let mut args = vec![
+            "identify",
+            "--cell",
+            &cell,
+            "--data",
+            data.to_str().unwrap(),
+        ];
+        args.extend_from_slice(options);
+        args.extend(["--quiet", "--out", out.to_str().unwrap()]);
+        let (ok, stdout, stderr) = armcal(&args);
+        assert!(ok, "{stdout}{stderr}");
+        stdout
+    };
+    let out = dir.join("auto.json");
+    let stdout = identify(
+        &["--holdout", "0.3", "--nongeometric", "auto", "--folds", "4"],
+        &out,
+    );
+    assert!(
+        stdout.contains("4-fold cross-validation") && stdout.contains("+ compliance + periodic"),
+        "{stdout}"
+    );
+    let chosen = stdout
+        .lines()
+        .find(|l| l.contains("← chosen"))
+        .unwrap_or_else(|| panic!("{stdout}"));
+    assert!(chosen.contains("+ compliance"), "{chosen}");
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let c = &v["nongeometric_choice"];
+    assert_eq!(c["candidates"].as_array().unwrap().len(), 4, "{c}");
+    let rms = |k: usize| c["candidates"][k]["held_out"]["rms"].as_f64().unwrap();
+    assert!(rms(1) < 0.5 * rms(0), "compliance pays: {c}");
+    let stdout = identify(&["--nongeometric", "none"], &dir.join("none.json"));
+    assert!(
+        stdout.contains("`q2.compliance.elbow` left out: the non-geometric model is `kinematic`"),
+        "{stdout}"
+    );
 }

@@ -23,11 +23,14 @@ pub(super) struct FreeSetFit {
 /// `free = "auto"`, a non-geometric term the gate finds not separable
 /// ([`nongeometric_gate`]) is then dropped like every parameter the data cannot identify —
 /// the least separable first, named with its reason — and the fit repeated without it.
+/// `left_out` are terms left out from the start (a non-geometric candidate,
+/// [`super::nongeometric_choice`]), with their reasons.
 pub(super) fn fit_free_set(
     cell: &Cell,
     train: &Dataset,
     noise: &crate::measure::NoiseModel,
     opts: &IdentifySettings,
+    left_out: &[(usize, String)],
     observer: &mut dyn Observer,
 ) -> Result<FreeSetFit, Error> {
     let declared = if cell.auto_free {
@@ -40,10 +43,20 @@ pub(super) fn fit_free_set(
     } else {
         None
     };
-    let mut dropped: Vec<(usize, String)> = Vec::new();
+    let mut dropped: Vec<(usize, String)> = left_out.to_vec();
     let decide = |at: &[f64], dropped: &[(usize, String)]| match &generic {
         Some(g) => identifiable_model_given(cell, train, at, g, dropped),
-        None => Ok((cell.model.clone(), Vec::new())),
+        None => {
+            let mut model = cell.model.clone();
+            let reasons = dropped
+                .iter()
+                .map(|(i, why)| {
+                    model.registry.set_status(*i, ParamStatus::Fixed);
+                    (model.registry.get(*i).name.clone(), why.clone())
+                })
+                .collect();
+            Ok((model, reasons))
+        }
     };
     let mut at = match &opts.start {
         Some(start) if start.len() == declared.param_count() => start.clone(),
@@ -59,6 +72,9 @@ pub(super) fn fit_free_set(
             frames_first_start(&declared, train, noise, opts)
         })?,
     };
+    for &(i, _) in left_out {
+        at[i] = declared.registry.get(i).nominal;
+    }
     let mut decided = phase(observer, "choosing the identifiable parameters", || {
         decide(&at, &dropped)
     })?;

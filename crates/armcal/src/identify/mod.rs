@@ -10,6 +10,7 @@ mod free_set;
 pub mod gauss_newton;
 pub mod kalman;
 pub mod lm;
+pub mod nongeometric_choice;
 pub mod nongeometric_gate;
 pub mod problem;
 pub mod refit;
@@ -42,6 +43,7 @@ use crate::model::{Model, Segment, Status as ParamStatus};
 use crate::progress::{Observer, Silent};
 use crate::Error;
 use free_set::{fit_free_set, FreeSetFit};
+pub use nongeometric_choice::{Candidate, NonGeometric, NonGeometricChoice};
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -108,6 +110,9 @@ pub struct IdentifySettings {
     /// starts there instead of at the frames-first start ([`frames_first_start`]), and the
     /// free set is decided there. `None`: the frames-first start.
     pub start: Option<Vec<f64>>,
+    /// Which of the cell's non-geometric terms (compliance, periodic errors) the fit keeps,
+    /// or a choice by cross-validation ([`nongeometric_choice`]).
+    pub nongeometric: NonGeometric,
 }
 
 impl Default for IdentifySettings {
@@ -121,6 +126,7 @@ impl Default for IdentifySettings {
             lm: LmSettings::default(),
             refit: None,
             start: None,
+            nongeometric: NonGeometric::AsCell,
         }
     }
 }
@@ -335,14 +341,25 @@ pub fn identify(
     let noise = cell.noise();
     let split = Split::of(data, opts)?;
     let train: &Dataset = &split.train;
+    let (left_out, choice) = match opts.nongeometric {
+        NonGeometric::AsCell => (Vec::new(), None),
+        NonGeometric::Only(c) => (c.left_out(&cell.model)?, None),
+        NonGeometric::Auto { folds } => {
+            let choice = nongeometric_choice::choose(cell, train, &noise, opts, folds, observer)?;
+            (choice.chosen.left_out(&cell.model)?, Some(choice))
+        }
+    };
     let fit = match &opts.refit {
         Some(refit) => refit::fit_frames(cell, train, &noise, opts, refit, observer)?,
-        None => fit_free_set(cell, train, &noise, opts, observer)?,
+        None => fit_free_set(cell, train, &noise, opts, &left_out, observer)?,
     };
     observer.start("uncertainty, observability and residuals", None);
     let estimate = estimate_of_fit(cell, data, opts, &split, fit, &noise, observer);
     observer.finish();
-    estimate
+    estimate.map(|e| Estimate {
+        nongeometric_choice: choice,
+        ..e
+    })
 }
 
 /// The estimate of a fit: covariance, TCP covariance at the working configurations,
@@ -441,6 +458,7 @@ fn estimate_of_fit(
         model: model.spec_at(&sol.params),
         parameters,
         nongeometric,
+        nongeometric_choice: None,
         fixed_reasons: reasons.clone(),
         rank_deficit: rank_deficit.clone(),
         solver: SolverReport {

@@ -56,8 +56,9 @@ impl TermVerdict {
             .as_ref()
             .map_or(String::new(), |(n, rho)| format!(", ρ = {rho:.3} with {n}"));
         format!(
-            "not separable from the other parameters on these data: {:.1} % of its effect is \
-             not absorbed by them (separable: ≥ {:.0} %, |ρ| < {MAX_CORRELATION}){with}",
+            "`{}` is not separable from the other parameters on these data: {:.1} % of its \
+             effect is not absorbed by them (separable: ≥ {:.0} %, |ρ| < {MAX_CORRELATION}){with}",
+            self.name,
             100.0 * self.unabsorbed,
             100.0 * MIN_UNABSORBED
         )

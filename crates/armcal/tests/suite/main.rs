@@ -61,6 +61,7 @@ mod accuracy {
 mod real_data {
     mod motoman_calibration;
     mod motoman_nominal;
+    mod motoman_nongeometric;
     mod ur10_cubes;
     mod ur10_import;
 }
