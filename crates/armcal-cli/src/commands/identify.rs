@@ -7,8 +7,8 @@ use super::output::{
 use super::progress::Progress;
 use anyhow::bail;
 use armcal::identify::{
-    held_out, identify, Estimate, FramesRefit, IdentifySettings, LmSettings, Loss, Method,
-    ToleranceSettings,
+    held_out, identify, Candidate, Estimate, FramesRefit, IdentifySettings, LmSettings, Loss,
+    Method, NonGeometric, ToleranceSettings,
 };
 use std::path::{Path, PathBuf};
 
@@ -60,6 +60,16 @@ pub struct Args {
     /// The estimate (estimate.json of the same cell) whose robot parameters --refit keeps.
     #[arg(long, requires = "refit")]
     pub estimate: Option<PathBuf>,
+    /// The cell's non-geometric terms ([parameters] compliance / periodic) the fit keeps:
+    /// `as-cell` (all), `none` (the kinematic model), `compliance`, `periodic`, `both`, or
+    /// `auto`: the candidate chosen by k-fold cross-validation on the training data (the
+    /// fewest terms within one standard error of the best held-out RMS), every candidate's
+    /// table printed and kept in the estimate.
+    #[arg(long, default_value = "as-cell", value_parser = ["as-cell", "none", "compliance", "periodic", "both", "auto"])]
+    pub nongeometric: String,
+    /// Folds of the cross-validation of `--nongeometric auto` (seeded by --seed).
+    #[arg(long, default_value_t = 5)]
+    pub folds: usize,
     #[command(flatten)]
     pub accept: AcceptUnconverged,
 }
@@ -97,6 +107,11 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         },
         refit,
         start: None,
+        nongeometric: match a.nongeometric.as_str() {
+            "as-cell" => NonGeometric::AsCell,
+            "auto" => NonGeometric::Auto { folds: a.folds },
+            other => NonGeometric::Only(Candidate::from_name(other).expect("clap checked")),
+        },
     };
     let est = identify(&cell, &data, &opts, &mut Progress::new(a.quiet))?;
     outputs.commit(&[(&a.out, &serde_json::to_string_pretty(&est)?)])?;
@@ -168,7 +183,8 @@ pub fn print_summary(e: &Estimate) {
     if let Some(d) = &e.rank_deficit {
         println!("\nbelow the generic count: {d}");
     }
-    print_compliance(e);
+    print_nongeometric(e);
+    print_choice(e);
     if !e.strong_correlations.is_empty() {
         println!("\nstrongly correlated pairs (|ρ| > 0.95):");
         for (a, b, r) in &e.strong_correlations {
@@ -311,29 +327,65 @@ fn print_stats_rows(rows: [(&str, &armcal::accuracy::ErrorStats); 3]) {
     }
 }
 
-/// The compliance gate: per term κ ± σ, its largest correlation with the geometry, the
-/// share of its effect the geometry cannot absorb, and the verdict.
-fn print_compliance(e: &Estimate) {
-    if e.compliance.is_empty() {
+/// `--nongeometric auto`: every candidate's cross-validated held-out errors and the choice.
+fn print_choice(e: &Estimate) {
+    let Some(c) = &e.nongeometric_choice else {
+        return;
+    };
+    println!(
+        "
+non-geometric terms chosen by {}-fold cross-validation on the {} training configurations:",
+        c.folds, c.configurations
+    );
+    println!(
+        "  {:<26} {:>5} {:>9} {:>9} {:>9} {:>9}",
+        "candidate", "terms", "mean", "RMS", "± s.e.", "max (mm)"
+    );
+    for s in &c.candidates {
+        let mark = if s.candidate == c.chosen {
+            "  ← chosen"
+        } else {
+            ""
+        };
+        println!(
+            "  {:<26} {:>5} {:>9.4} {:>9.4} {:>9.4} {:>9.4}{mark}",
+            s.candidate.words(),
+            s.terms,
+            s.held_out.mean,
+            s.held_out.rms,
+            s.standard_error,
+            s.held_out.max
+        );
+    }
+    println!("  rule: {}", c.rule);
+}
+
+/// The gate of the non-geometric terms: per term estimate ± σ, its largest correlation with
+/// another parameter, the share of its effect the others cannot absorb, and the verdict.
+fn print_nongeometric(e: &Estimate) {
+    if e.nongeometric.is_empty() {
         return;
     }
-    println!("\njoint compliance (κ = compliance × mass × g, µrad per m of lever):");
-    println!("  term                        κ ± σ (µrad/m)       max |ρ| with geometry   not absorbed   verdict");
-    for v in &e.compliance {
+    println!(
+        "
+non-geometric terms (compliance κ in µrad per m of lever, periodic amplitudes in arcsec):"
+    );
+    println!("  term                        estimate ± σ          max |ρ| with another    not absorbed   verdict");
+    for v in &e.nongeometric {
         let rho = v
             .most_correlated
             .as_ref()
             .map_or("-".to_string(), |(n, r)| format!("{r:+.3} ({n})"));
         let verdict = match (v.separable, v.wrong_sign) {
-            (false, _) => "not separable from the geometry",
+            (false, _) => "not separable",
             (true, true) => "WRONG SIGN: the arm rises against gravity",
             (true, false) => "separable",
         };
         println!(
             "  {:<26} {:>9.1} ± {:<8.1} {:<23} {:>8.1} %   {verdict}",
             v.name,
-            v.estimate_urad_per_m,
-            v.sigma_urad_per_m,
+            v.estimate,
+            v.sigma,
             rho,
             100.0 * v.unabsorbed
         );

@@ -4,6 +4,7 @@ use super::output::{load_cell, Outputs};
 use anyhow::bail;
 use armcal::design::cell_constraints::unmeasurable_poses;
 use armcal::measure::csv;
+use armcal::model::Unit;
 use armcal::sim::{simulate_poses, Perturbation};
 use std::path::{Path, PathBuf};
 
@@ -24,6 +25,14 @@ pub struct Args {
     /// σ of the angle perturbation of the true robot (deg).
     #[arg(long, default_value_t = 0.1)]
     pub perturb_deg: f64,
+    /// σ of the joint compliance terms of the true robot (µrad per m of lever; the cell's
+    /// `[parameters] compliance`): κ = nominal + σ|z|, an arm that sags under gravity.
+    #[arg(long, default_value_t = 200.0)]
+    pub perturb_urad_per_m: f64,
+    /// σ of the periodic joint error amplitudes of the true robot (arcsec; the cell's
+    /// `[parameters] periodic`): nominal + σz.
+    #[arg(long, default_value_t = 20.0)]
+    pub perturb_arcsec: f64,
     /// Perturb every parameter, not only the identifiable (free) ones.
     #[arg(long)]
     pub perturb_all: bool,
@@ -49,6 +58,14 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let mut outs = vec![a.out.as_path()];
     outs.extend(a.truth_out.as_deref());
     let outputs = Outputs::plan(a.force, &[Path::new(&a.cell), &a.poses], &outs)?;
+    for (flag, v) in [
+        ("--perturb-urad-per-m", a.perturb_urad_per_m),
+        ("--perturb-arcsec", a.perturb_arcsec),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            bail!("{flag} {v}: give a magnitude ≥ 0");
+        }
+    }
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
     let poses = csv::read_reachable_configurations(&a.poses, model)?;
@@ -72,6 +89,8 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let pert = Perturbation {
         length: a.perturb_mm,
         angle: a.perturb_deg.to_radians(),
+        compliance: a.perturb_urad_per_m / Unit::RadPerMm.display_factor(),
+        periodic: a.perturb_arcsec / Unit::Arcsec.display_factor(),
         all: a.perturb_all,
         ..Perturbation::default()
     };

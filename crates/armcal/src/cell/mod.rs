@@ -363,6 +363,7 @@ pub(crate) fn assemble_spec(
     }
     ModelSpec {
         compliance: None,
+        periodic: None,
         name: robot.spec.name.clone(),
         instrument: instrument.map(|g| LinkSpec {
             name: instrument_name.into(),

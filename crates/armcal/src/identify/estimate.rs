@@ -182,10 +182,14 @@ pub struct Estimate {
     pub model: ModelSpec,
     /// Every model parameter, free or fixed, in registry order (display units).
     pub parameters: Vec<ParameterEstimate>,
-    /// The identifiability gate of the free compliance terms
-    /// ([`crate::identify::compliance_gate`]); empty for a rigid model.
+    /// The identifiability gate of the free non-geometric terms (compliance, periodic
+    /// errors; [`crate::identify::nongeometric_gate`]); empty for a kinematic model.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub compliance: Vec<crate::identify::compliance_gate::ComplianceVerdict>,
+    pub nongeometric: Vec<crate::identify::nongeometric_gate::TermVerdict>,
+    /// The cross-validated choice of the non-geometric terms (`identify --nongeometric
+    /// auto`, [`crate::identify::nongeometric_choice`]): every candidate's held-out score.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nongeometric_choice: Option<crate::identify::NonGeometricChoice>,
     /// Why each parameter not estimated was left out (identifiability analysis).
     pub fixed_reasons: Vec<(String, String)>,
     /// Why fewer parameters than the generic count were identified (at the fit, from these

@@ -4,13 +4,15 @@
 //! axes by circle point analysis.
 
 pub mod circle_point;
-pub mod compliance_gate;
 pub mod estimate;
 pub mod fingerprint;
+mod free_set;
 pub mod gauss_newton;
 pub mod held_out;
 pub mod kalman;
 pub mod lm;
+pub mod nongeometric_choice;
+pub mod nongeometric_gate;
 pub mod problem;
 pub mod refit;
 pub mod residuals;
@@ -41,6 +43,8 @@ use crate::model::identifiability::{Identifiability, IdentifiabilitySettings, Me
 use crate::model::{Model, Segment, Status as ParamStatus};
 use crate::progress::{Observer, Silent};
 use crate::Error;
+use free_set::{fit_free_set, FreeSetFit};
+pub use nongeometric_choice::{Candidate, NonGeometric, NonGeometricChoice};
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -107,6 +111,9 @@ pub struct IdentifySettings {
     /// starts there instead of at the frames-first start ([`frames_first_start`]), and the
     /// free set is decided there. `None`: the frames-first start.
     pub start: Option<Vec<f64>>,
+    /// Which of the cell's non-geometric terms (compliance, periodic errors) the fit keeps,
+    /// or a choice by cross-validation ([`nongeometric_choice`]).
+    pub nongeometric: NonGeometric,
 }
 
 impl Default for IdentifySettings {
@@ -120,6 +127,7 @@ impl Default for IdentifySettings {
             lm: LmSettings::default(),
             refit: None,
             start: None,
+            nongeometric: NonGeometric::AsCell,
         }
     }
 }
@@ -141,17 +149,19 @@ pub fn identifiable_model(
         return Ok((cell.model.clone(), Vec::new()));
     }
     let generic = cell.identifiability(&cell.identifiability_settings())?;
-    identifiable_model_given(cell, data, at, &generic)
+    identifiable_model_given(cell, data, at, &generic, &[])
 }
 
 /// [`identifiable_model`] of an `auto` cell with the cell's generic analysis (its declared
 /// free set at the nominal, random configurations) already done, so that a fit deciding its
-/// free set more than once does it once.
+/// free set more than once does it once; `dropped` are parameters already left out (a
+/// non-geometric term the gate found not separable), with their reasons.
 fn identifiable_model_given(
     cell: &Cell,
     data: &Dataset,
     at: &[f64],
     generic: &Identifiability,
+    dropped: &[(usize, String)],
 ) -> Result<(Model, Vec<(String, String)>), Error> {
     let rows = data.rows();
     if rows < generic.identifiable.len() {
@@ -164,6 +174,9 @@ fn identifiable_model_given(
         )));
     }
     let mut declared = cell.declared_model();
+    for &(i, _) in dropped {
+        declared.registry.set_status(i, ParamStatus::Fixed);
+    }
     let report = crate::model::identifiability::analyze_at(
         &declared,
         at,
@@ -187,6 +200,11 @@ fn identifiable_model_given(
             };
             (e.name, reason)
         })
+        .chain(
+            dropped
+                .iter()
+                .map(|(i, why)| (declared.registry.get(*i).name.clone(), why.clone())),
+        )
         .collect();
     Ok((declared, reasons))
 }
@@ -329,9 +347,18 @@ pub fn identify(
     let split = Split::of(data, opts)?;
     let train: &Dataset = &split.train;
     let stationed = cell.with_stations(&data.stations)?;
+    let (left_out, choice) = match opts.nongeometric {
+        NonGeometric::AsCell => (Vec::new(), None),
+        NonGeometric::Only(c) => (c.left_out(&stationed.model)?, None),
+        NonGeometric::Auto { folds } => {
+            let choice =
+                nongeometric_choice::choose(&stationed, train, &noise, opts, folds, observer)?;
+            (choice.chosen.left_out(&stationed.model)?, Some(choice))
+        }
+    };
     let fit = match &opts.refit {
         Some(refit) => refit::fit_frames(&stationed, cell, train, &noise, opts, refit, observer)?,
-        None => fit_free_set(&stationed, train, &noise, opts, observer)?,
+        None => fit_free_set(&stationed, train, &noise, opts, &left_out, observer)?,
     };
     observer.start("uncertainty, observability and residuals", None);
     let estimate = estimate_of_fit(&stationed, data, opts, &split, fit, &noise, observer);
@@ -339,6 +366,7 @@ pub fn identify(
     // an estimate belongs to the cell as its file describes it, whatever stations its data name
     estimate.map(|e| Estimate {
         fingerprint: Some(ModelFingerprint::of(&cell.model)),
+        nongeometric_choice: choice,
         ..e
     })
 }
@@ -400,7 +428,7 @@ fn estimate_of_fit(
         (cs, blocks)
     };
     let data_rows = sol.jacobian.nrows() - problem.priors.len();
-    let compliance = compliance_gate::compliance_gate(
+    let nongeometric = nongeometric_gate::nongeometric_gate(
         model,
         &problem.free,
         &sol.jacobian.rows(0, data_rows).into_owned(),
@@ -438,7 +466,8 @@ fn estimate_of_fit(
         data: data.source.clone(),
         model: model.spec_at(&sol.params),
         parameters,
-        compliance,
+        nongeometric,
+        nongeometric_choice: None,
         fixed_reasons: reasons.clone(),
         rank_deficit: rank_deficit.clone(),
         solver: SolverReport {
@@ -484,84 +513,4 @@ fn phase<T>(observer: &mut dyn Observer, task: &str, f: impl FnOnce() -> T) -> T
     let result = f();
     observer.finish();
     result
-}
-
-/// A fit with its free set, as [`fit_free_set`] decided it.
-struct FreeSetFit {
-    model: Model,
-    reasons: Vec<(String, String)>,
-    /// The problem's final row weights (a robust fit's IRLS weights).
-    row_weights: Vec<f64>,
-    solution: SolverResult,
-    outliers: Vec<Outlier>,
-    robust_scale: Option<f64>,
-}
-
-/// The fit with the free set decided where the fit is, never at the nominal: frames first
-/// ([`frames_first_start`] on every parameter the cell declared free), the identifiable set
-/// at that estimate ([`identifiable_model`]), the fit, and the identifiable set again at
-/// the fit. When it grew there (the start sat at a special geometry the fit left), the fit
-/// is repeated from there with the larger set; the set grows every time, so this ends.
-fn fit_free_set(
-    cell: &Cell,
-    train: &Dataset,
-    noise: &crate::measure::NoiseModel,
-    opts: &IdentifySettings,
-    observer: &mut dyn Observer,
-) -> Result<FreeSetFit, Error> {
-    let declared = if cell.auto_free {
-        cell.declared_model()
-    } else {
-        cell.model.clone()
-    };
-    let generic = if cell.auto_free {
-        Some(cell.identifiability(&cell.identifiability_settings())?)
-    } else {
-        None
-    };
-    let decide = |at: &[f64]| match &generic {
-        Some(g) => identifiable_model_given(cell, train, at, g),
-        None => Ok((cell.model.clone(), Vec::new())),
-    };
-    let mut at = match &opts.start {
-        Some(start) if start.len() == declared.param_count() => start.clone(),
-        Some(start) => {
-            return Err(Error::Input(format!(
-                "the warm start has {} parameters; the model of cell `{}` has {}",
-                start.len(),
-                cell.name,
-                declared.param_count()
-            )))
-        }
-        None => phase(observer, "fitting the frames first", || {
-            frames_first_start(&declared, train, noise, opts)
-        })?,
-    };
-    let mut decided = phase(observer, "choosing the identifiable parameters", || {
-        decide(&at)
-    })?;
-    loop {
-        let (model, reasons) = decided;
-        let mut problem = Problem::new(&model, train, noise)?;
-        let (solution, outliers, robust_scale) = solve(&mut problem, &at, opts, observer)?;
-        let row_weights = problem.row_weights.clone();
-        drop(problem);
-        let recheck = phase(
-            observer,
-            "checking the identifiable parameters at the fit",
-            || decide(&solution.params),
-        )?;
-        if recheck.0.registry.free().len() <= model.registry.free().len() {
-            return Ok(FreeSetFit {
-                model,
-                reasons,
-                row_weights,
-                solution,
-                outliers,
-                robust_scale,
-            });
-        }
-        at = solution.params;
-        decided = recheck;
-    }
 }

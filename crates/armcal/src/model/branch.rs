@@ -405,6 +405,7 @@ mod tests {
     fn model_of(links: Vec<LinkSpec>) -> Model {
         Model::from_spec(&ModelSpec {
             compliance: None,
+            periodic: None,
             name: "test".into(),
             instrument: None,
             links,

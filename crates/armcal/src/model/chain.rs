@@ -2,8 +2,9 @@
 //! one parameter registry. A [`Model`] is immutable once built and can be shared across
 //! threads; buffers for one evaluation live in [`crate::model::Data`].
 
-use crate::model::compliance::{CompiledTerm, Compliance, ComplianceSpec, MAX_COMPLIANCE};
+use crate::model::compliance::{Compliance, ComplianceSpec};
 use crate::model::link::{Convention, Joint, JointKind, LinkGeometry, Motion};
+use crate::model::periodic::{CompiledPeriodic, PeriodicSpec};
 use crate::model::registry::{Registry, Segment, Status, Unit};
 use crate::Error;
 use nalgebra::Vector3;
@@ -78,6 +79,9 @@ pub struct ModelSpec {
     /// Joint compliance under gravity ([`crate::model::compliance`]); `None`: rigid joints.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub compliance: Option<ComplianceSpec>,
+    /// Periodic joint errors ([`crate::model::periodic`]); `None`: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub periodic: Option<PeriodicSpec>,
 }
 
 /// A compiled link: its spec plus where its parameters live in the registry.
@@ -147,8 +151,10 @@ pub struct Model {
     pub links: Vec<Link>,
     /// Points or frames attached to the tool, measured by the instrument.
     pub targets: Vec<Link>,
-    /// Joint compliance, compiled; its κ are the registry's last parameters.
+    /// Joint compliance, compiled; its κ follow the link parameters in the registry.
     pub compliance: Option<Compliance>,
+    /// Periodic joint errors, compiled; their amplitudes are the registry's last parameters.
+    pub periodic: Vec<CompiledPeriodic>,
     pub(crate) instrument_steps: Vec<Step>,
     /// The instrument steps of each station (empty without stations).
     pub(crate) station_steps: Vec<Vec<Step>>,
@@ -378,10 +384,17 @@ impl Model {
             target_steps.push(s);
         }
         let link_params = registry.len();
-        let compliance = match &spec.compliance {
-            Some(c) => Some(compile_compliance(c, &joints, link_params, &mut registry)?),
+        let mut compliance = match &spec.compliance {
+            Some(c) => Some(c.compile(&joints, link_params, &mut registry)?),
             None => None,
         };
+        let periodic = match &spec.periodic {
+            Some(p) => p.compile(&joints, &mut registry)?,
+            None => Vec::new(),
+        };
+        if let Some(c) = &mut compliance {
+            c.levers.resize(registry.len(), 0.0);
+        }
         Ok(Model {
             name: spec.name.clone(),
             registry,
@@ -391,6 +404,7 @@ impl Model {
             links,
             targets,
             compliance,
+            periodic,
             instrument_steps,
             station_steps,
             chain_steps,
@@ -422,7 +436,32 @@ impl Model {
                     })
                     .collect(),
             }),
+            periodic: (!self.periodic.is_empty()).then(|| PeriodicSpec {
+                terms: self
+                    .periodic
+                    .iter()
+                    .map(|t| crate::model::periodic::PeriodicTerm {
+                        value: params[t.param],
+                        ..t.spec.clone()
+                    })
+                    .collect(),
+            }),
         }
+    }
+
+    /// The joint-space correction terms ([`crate::model::joint_correction`]) in registry
+    /// order, each as (registry index, index of the joint it turns): the compliance terms,
+    /// then the periodic terms.
+    pub fn joint_corrections(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        let compliance = self.compliance.iter().flat_map(|c| &c.terms);
+        compliance
+            .map(|t| (t.param, t.joint))
+            .chain(self.periodic.iter().map(|t| (t.param, t.joint)))
+    }
+
+    /// Whether registry parameter `i` is a joint-space correction (a non-geometric term).
+    pub fn is_joint_correction(&self, i: usize) -> bool {
+        self.joint_corrections().any(|(p, _)| p == i)
     }
 
     /// The spec with nominal values.
@@ -531,68 +570,4 @@ impl Model {
             self.joints.iter().map(|j| j.upper).collect(),
         )
     }
-}
-
-/// Checks a [`ComplianceSpec`] against the chain and adds its κ to the registry (unit
-/// µrad/m, segment chain, free).
-fn compile_compliance(
-    c: &ComplianceSpec,
-    joints: &[Joint],
-    link_params: usize,
-    registry: &mut Registry,
-) -> Result<Compliance, Error> {
-    let g = crate::model::compliance::gravity_direction(c.gravity)
-        .map_err(|e| Error::Model(format!("compliance: {e}")))?;
-    if c.levers.len() != link_params || !c.levers.iter().all(|x| x.is_finite()) {
-        return Err(Error::Model(format!(
-            "compliance: the lever geometry has {} values, the chain {link_params}",
-            c.levers.len()
-        )));
-    }
-    let joint = |name: &str| {
-        joints
-            .iter()
-            .position(|j| j.name == name)
-            .ok_or_else(|| Error::Model(format!("compliance: no joint `{name}`")))
-    };
-    let mut terms = Vec::new();
-    for t in &c.terms {
-        let (i, at) = (joint(&t.joint)?, joint(&t.at)?);
-        if joints[i].kind != JointKind::Revolute || at <= i {
-            return Err(Error::Model(format!(
-                "compliance term `{}`: joint `{}` must be revolute and the mass joint `{}` \
-                 beyond it",
-                ComplianceSpec::parameter_name(t),
-                t.joint,
-                t.at
-            )));
-        }
-        if !Unit::RadPerMm.holds(t.value) {
-            return Err(Error::Model(format!(
-                "compliance term `{}` = {:e} µrad/m is outside |x| ≤ {:e} µrad/m",
-                ComplianceSpec::parameter_name(t),
-                t.value * Unit::RadPerMm.display_factor(),
-                MAX_COMPLIANCE * Unit::RadPerMm.display_factor()
-            )));
-        }
-        let param = registry.add(
-            ComplianceSpec::parameter_name(t),
-            Unit::RadPerMm,
-            t.value,
-            Segment::Chain,
-        )?;
-        terms.push(CompiledTerm {
-            joint: i,
-            at,
-            param,
-            spec: t.clone(),
-        });
-    }
-    let mut levers = c.levers.clone();
-    levers.resize(registry.len(), 0.0);
-    Ok(Compliance {
-        gravity: g,
-        levers,
-        terms,
-    })
 }

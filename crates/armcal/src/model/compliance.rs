@@ -56,10 +56,13 @@
 //! sags: the potential `−F·x` falls by `κ ℓ² ≥ 0`); a negative estimate is flagged.
 
 use crate::model::chain::Model;
+use crate::model::joint_correction::revolute_joints;
 use crate::model::kinematics::{forward_kinematics, Data};
-use crate::model::link::JointKind;
+use crate::model::link::{Joint, JointKind};
 use crate::model::pose::Twist;
-use nalgebra::{convert, DMatrix, RealField, Vector3};
+use crate::model::registry::{Registry, Segment, Unit};
+use crate::Error;
+use nalgebra::{convert, RealField, Vector3};
 use serde::{Deserialize, Serialize};
 
 /// Largest |κ| a model holds (rad/mm; 10⁶ µrad/m).
@@ -115,75 +118,62 @@ pub struct CompiledTerm {
 pub struct Compliance {
     /// Unit gravity in the base frame.
     pub gravity: Vector3<f64>,
-    /// Lever parameter vector (a full parameter vector; compliance entries unused).
+    /// Lever parameter vector (a full parameter vector; non-geometric entries unused).
     pub levers: Vec<f64>,
     /// The terms, in registry order.
     pub terms: Vec<CompiledTerm>,
+    /// Number of link parameters (the registry before the κ).
+    link_params: usize,
 }
 
 impl Compliance {
     /// Number of link parameters (the registry before the κ).
     pub fn link_params(&self) -> usize {
-        self.levers.len() - self.terms.len()
-    }
-
-    /// Whether registry parameter `i` is a compliance term.
-    pub fn is_term(&self, i: usize) -> bool {
-        i >= self.link_params()
+        self.link_params
     }
 }
 
-/// The per-evaluation state of the compliance ([`Data::compliance`]).
+/// The compliance's lever pass ([`crate::model::joint_correction::CorrectionData`]).
 #[derive(Clone, Debug)]
 pub struct ComplianceData<T: RealField + Copy> {
-    /// The lever pass: the model at the lever parameters and the commanded `q`.
+    /// The model at the lever parameters and the commanded `q`.
     pub levers: Data<T>,
-    /// The deflected joints `q + Δq` at which the chain is evaluated.
-    pub q: Vec<T>,
-    /// Per term, the lever `ℓ` (mm).
-    pub lever: Vec<T>,
-    /// Per term and joint (row-major, `term · dof + k`), `∂ℓ/∂q_k`.
-    pub lever_rate: Vec<T>,
-    /// Per term, κ (rad/mm), the compliant joint's index.
-    pub kappa: Vec<(T, usize)>,
 }
 
 impl<T: RealField + Copy> ComplianceData<T> {
     /// Buffers for `model` (which has compliance).
-    pub(crate) fn new(model: &Model, c: &Compliance) -> Self {
-        let n = c.terms.len();
+    pub(crate) fn new(model: &Model, _c: &Compliance) -> Self {
         ComplianceData {
-            levers: Data::without_compliance(model),
-            q: vec![T::zero(); model.dof()],
-            lever: vec![T::zero(); n],
-            lever_rate: vec![T::zero(); n * model.dof()],
-            kappa: vec![(T::zero(), 0); n],
+            levers: Data::without_corrections(model),
         }
     }
 
-    /// The levers and their q-derivatives at `q` and the deflected joints `q + Δq`.
+    /// The levers `ℓ_t` (into `lever`) and their q-derivatives (into `lever_rate`, row-major
+    /// `term · dof + k`) at `q`.
     ///
     /// `∂ℓ_i/∂q_k` with `c = ω_i × x + v_i` (the velocity of the mass point under joint i):
     /// for `k ≤ i` joint k turns axis i and the point rigidly, `ċ = ω_k × c`; for `k > i`
     /// the axis stays and the point moves if joint k comes before it in the chain,
     /// `ċ = ω_i × (ω_k × x + v_k)`, else nothing moves. `ℓ̇ = ĝ · ċ` (ĝ fixed in the world).
-    pub(crate) fn evaluate(&mut self, model: &Model, c: &Compliance, params: &[f64], q: &[T]) {
+    pub(crate) fn evaluate(
+        &mut self,
+        model: &Model,
+        c: &Compliance,
+        q: &[T],
+        lever: &mut [T],
+        lever_rate: &mut [T],
+    ) {
         forward_kinematics(model, &mut self.levers, &c.levers, q);
         let dof = model.dof();
         let g: Vector3<T> = self.levers.frames[0].rot * c.gravity.map(convert::<f64, T>);
-        self.q.copy_from_slice(q);
         for (t, term) in c.terms.iter().enumerate() {
             let twists = &self.levers.joint_twists;
             let x = self.levers.joint_points[term.at];
             let axis = twists[term.joint];
             let vel = axis.point_velocity(&x);
-            let kappa: T = convert(params[term.param]);
-            let lever = g.dot(&vel);
-            self.lever[t] = lever;
-            self.kappa[t] = (kappa, term.joint);
-            self.q[term.joint] += kappa * lever;
+            lever[t] = g.dot(&vel);
             for (k, tw) in twists.iter().enumerate() {
-                self.lever_rate[t * dof + k] = if k <= term.joint {
+                lever_rate[t * dof + k] = if k <= term.joint {
                     g.dot(&tw.w.cross(&vel))
                 } else if k < term.at {
                     g.dot(&axis.w.cross(&tw.point_velocity(&x)))
@@ -191,26 +181,6 @@ impl<T: RealField + Copy> ComplianceData<T> {
                     T::zero()
                 };
             }
-        }
-    }
-
-    /// Writes the compliance parameters' twists into `data` (after the deflected pass): a
-    /// unit change of κ_t turns joint i by ℓ_t, so its twist is `ℓ_t ξ_i`, and it has no
-    /// rate of its own.
-    pub(crate) fn set_twists(
-        &self,
-        c: &Compliance,
-        data_twists: &mut [Twist<T>],
-        joints: &[Twist<T>],
-        rates: &mut [Twist<T>],
-    ) {
-        for (t, term) in c.terms.iter().enumerate() {
-            let j = joints[term.joint];
-            data_twists[term.param] = Twist {
-                w: j.w * self.lever[t],
-                v: j.v * self.lever[t],
-            };
-            rates[term.param] = Twist::zero();
         }
     }
 }
@@ -224,25 +194,7 @@ impl ComplianceSpec {
     pub fn lumped(model: &Model, joints: &[String], gravity: [f64; 3]) -> Result<Self, String> {
         let g = gravity_direction(gravity)?;
         let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
-        let mut index = Vec::new();
-        for name in joints {
-            let i = names.iter().position(|n| n == name).ok_or_else(|| {
-                format!(
-                    "unknown joint `{name}` (the robot's joints: {})",
-                    names.join(", ")
-                )
-            })?;
-            if model.joints[i].kind == JointKind::Prismatic {
-                return Err(format!(
-                    "joint `{name}` is prismatic; compliance is modelled for revolute joints only"
-                ));
-            }
-            if index.contains(&i) {
-                return Err(format!("joint `{name}` is listed twice"));
-            }
-            index.push(i);
-        }
-        index.sort_unstable();
+        let index = revolute_joints(&model.joints, joints, "compliance is")?;
         let dof = model.dof();
         let Some(&first) = index.first() else {
             return Err("give at least one joint, e.g. [\"j2\", \"j3\"]".into());
@@ -301,6 +253,71 @@ impl ComplianceSpec {
         })
     }
 
+    /// Checks a [`ComplianceSpec`] against the chain and adds its κ to the registry (unit
+    /// µrad/m, segment chain, free).
+    pub(crate) fn compile(
+        &self,
+        joints: &[Joint],
+        link_params: usize,
+        registry: &mut Registry,
+    ) -> Result<Compliance, Error> {
+        let c = self;
+        let g =
+            gravity_direction(c.gravity).map_err(|e| Error::Model(format!("compliance: {e}")))?;
+        if c.levers.len() != link_params || !c.levers.iter().all(|x| x.is_finite()) {
+            return Err(Error::Model(format!(
+                "compliance: the lever geometry has {} values, the chain {link_params}",
+                c.levers.len()
+            )));
+        }
+        let joint = |name: &str| {
+            joints
+                .iter()
+                .position(|j| j.name == name)
+                .ok_or_else(|| Error::Model(format!("compliance: no joint `{name}`")))
+        };
+        let mut terms = Vec::new();
+        for t in &c.terms {
+            let (i, at) = (joint(&t.joint)?, joint(&t.at)?);
+            if joints[i].kind != JointKind::Revolute || at <= i {
+                return Err(Error::Model(format!(
+                    "compliance term `{}`: joint `{}` must be revolute and the mass joint `{}` \
+                     beyond it",
+                    Self::parameter_name(t),
+                    t.joint,
+                    t.at
+                )));
+            }
+            if !Unit::RadPerMm.holds(t.value) {
+                return Err(Error::Model(format!(
+                    "compliance term `{}` = {:e} µrad/m is outside |x| ≤ {:e} µrad/m",
+                    Self::parameter_name(t),
+                    t.value * Unit::RadPerMm.display_factor(),
+                    MAX_COMPLIANCE * Unit::RadPerMm.display_factor()
+                )));
+            }
+            let param = registry.add(
+                Self::parameter_name(t),
+                Unit::RadPerMm,
+                t.value,
+                Segment::Chain,
+            )?;
+            terms.push(CompiledTerm {
+                joint: i,
+                at,
+                param,
+                spec: t.clone(),
+            });
+        }
+        // the levers grow to the full registry once every term is in it (Model::from_spec)
+        Ok(Compliance {
+            gravity: g,
+            levers: c.levers.clone(),
+            terms,
+            link_params,
+        })
+    }
+
     /// Name of term `t`'s parameter: `<joint>.compliance.<mass>`.
     pub fn parameter_name(term: &ComplianceTerm) -> String {
         format!("{}.compliance.{}", term.joint, term.mass)
@@ -336,7 +353,7 @@ impl LeverSample {
 
 fn lever_samples(model: &Model, levers: &[f64], g: Vector3<f64>) -> Vec<LeverSample> {
     let qs = crate::model::random_configurations(model, LEVER_SAMPLES, 14);
-    let mut data = Data::without_compliance(model);
+    let mut data = Data::without_corrections(model);
     qs.iter()
         .map(|q| {
             forward_kinematics(model, &mut data, levers, q);
@@ -352,19 +369,4 @@ fn lever_samples(model: &Model, levers: &[f64], g: Vector3<f64>) -> Vec<LeverSam
 fn orthonormalise(v: &mut [f64]) {
     let n = v.iter().map(|x| x * x).sum::<f64>().sqrt();
     v.iter_mut().for_each(|x| *x /= n);
-}
-
-/// `J_q = J̃ (I + K ∂ℓ/∂q)`: the derivative w.r.t. the commanded joints of columns `jac`
-/// given w.r.t. the deflected joints (one column per joint), in place.
-pub(crate) fn commanded_columns<T: RealField + Copy>(c: &ComplianceData<T>, jac: &mut DMatrix<T>) {
-    let dof = jac.ncols();
-    let deflected = jac.clone_owned();
-    for (t, &(kappa, joint)) in c.kappa.iter().enumerate() {
-        for k in 0..dof {
-            let a = kappa * c.lever_rate[t * dof + k];
-            for r in 0..jac.nrows() {
-                jac[(r, k)] += deflected[(r, joint)] * a;
-            }
-        }
-    }
 }

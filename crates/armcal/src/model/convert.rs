@@ -119,6 +119,7 @@ pub fn dh_to_mdh(spec: &ModelSpec) -> Result<ModelSpec, Error> {
     }
     Ok(ModelSpec {
         compliance: None,
+        periodic: None,
         links,
         ..spec.clone()
     })
@@ -189,6 +190,7 @@ pub fn mdh_to_dh(spec: &ModelSpec) -> Result<ModelSpec, Error> {
     }
     Ok(ModelSpec {
         compliance: None,
+        periodic: None,
         links,
         ..spec.clone()
     })
@@ -283,6 +285,7 @@ pub fn to_zrp(model: &Model, params: &[f64]) -> ModelSpec {
     links.push(fixed_link(&tool, frame6_geometry(&t0)));
     ModelSpec {
         compliance: None,
+        periodic: None,
         name: spec.name,
         instrument: spec.instrument,
         links,
@@ -424,6 +427,7 @@ pub(crate) fn link_pose(g: &LinkGeometry, kind: Option<JointKind>) -> Result<Pos
     });
     let spec = ModelSpec {
         compliance: None,
+        periodic: None,
         name: String::new(),
         instrument: None,
         links: vec![LinkSpec {
@@ -559,6 +563,7 @@ pub fn zrp_to_dh(spec: &ModelSpec, nominal: Option<&ModelSpec>) -> Result<ModelS
     ));
     Ok(ModelSpec {
         compliance: None,
+        periodic: None,
         name: spec.name.clone(),
         instrument: spec.instrument.clone(),
         links,

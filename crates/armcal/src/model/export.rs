@@ -17,6 +17,7 @@ fn suffix(u: Unit) -> &'static str {
         Unit::Rad => "_deg",
         Unit::Unitless => "",
         Unit::RadPerMm => "_urad_per_m",
+        Unit::Arcsec => "_arcsec",
     }
 }
 

@@ -10,7 +10,7 @@
 //!   twists (Lie brackets of joint and parameter twists), for the pose-design gradients.
 
 use crate::model::chain::{Model, Step};
-use crate::model::compliance::commanded_columns;
+use crate::model::joint_correction::commanded_columns;
 use crate::model::kinematics::{forward_kinematics, Data};
 use crate::model::pose::Pose;
 use crate::model::registry::Segment;
@@ -115,8 +115,8 @@ pub fn identification_jacobian<T: RealField + Copy>(
 }
 
 /// Geometric joint Jacobian of the observed frame in the world frame: rows 0–2 the
-/// velocity of its origin, rows 3–5 its angular velocity, one column per joint. With
-/// compliance, w.r.t. the commanded joints: `J̃ ∂(q + Δq)/∂q`.
+/// velocity of its origin, rows 3–5 its angular velocity, one column per joint. With joint
+/// corrections (compliance, periodic errors), w.r.t. the commanded joints: `J̃ ∂(q + Δq)/∂q`.
 pub fn joint_jacobian<T: RealField + Copy>(data: &Data<T>, obs: Observed) -> DMatrix<T> {
     let p = observed_world(data, obs).trans;
     let n = data.joint_twists.len();
@@ -128,7 +128,7 @@ pub fn joint_jacobian<T: RealField + Copy>(data: &Data<T>, obs: Observed) -> DMa
             j[(r + 3, c)] = tw.w[r];
         }
     }
-    if let Some(c) = &data.compliance {
+    if let Some(c) = &data.corrections {
         commanded_columns(c, &mut j);
     }
     j
@@ -144,7 +144,7 @@ pub struct MixedWorkspace {
     /// Per joint, in the instrument frame: `R_Iᵀ ω_k` and the point's velocity `R_Iᵀ ṗ`.
     joint_w: Vec<Vector3<f64>>,
     joint_p_dot: Vec<Vector3<f64>>,
-    /// With compliance: per joint, its derivative matrix w.r.t. the deflected joint.
+    /// With joint corrections: per joint, its derivative matrix w.r.t. the corrected joint.
     deflected: Vec<DMatrix<f64>>,
 }
 
@@ -174,9 +174,9 @@ impl MixedWorkspace {
         for step in model.target_steps.iter().flatten() {
             mark(step, usize::MAX);
         }
-        // κ_t turns joint i: it acts where joint i acts, with no rate of its own
-        for t in model.compliance.iter().flat_map(|c| &c.terms) {
-            param_order[t.param] = joint_order[t.joint];
+        // θ_t turns joint i: it acts where joint i acts, with no rate of its own
+        for (param, joint) in model.joint_corrections() {
+            param_order[param] = joint_order[joint];
         }
         MixedWorkspace {
             data: Data::new(model),
@@ -207,9 +207,10 @@ impl MixedWorkspace {
 /// `J^ω_j = s R_Iᵀ ω_j` (the orientation column). Orientation rows: `(R_Iᵀω_k) × J^ω_j`
 /// after joint k, the screw's `s R_Iᵀ ω̇_j`, zero before.
 ///
-/// With compliance ([`crate::model::compliance`]) the chain runs at `q̃ = q + Δq(q)`, so
-/// `∂J/∂q_k = Σ_l ∂J/∂q̃_l (δ_lk + Σ_{t: joint l} κ_t ∂ℓ_t/∂q_k)`, and the column of κ_t,
-/// `ℓ_t J̃_i` (joint i's column scaled by the lever), gains `(∂ℓ_t/∂q_k) J̃_i`. Allocates
+/// With joint corrections ([`crate::model::joint_correction`]: compliance, periodic errors)
+/// the chain runs at `q̃ = q + Δq(q)`, so
+/// `∂J/∂q_k = Σ_l ∂J/∂q̃_l (δ_lk + Σ_{t: joint l} θ_t ∂f_t/∂q_k)`, and the column of θ_t,
+/// `f_t J̃_i` (joint i's column scaled by the basis), gains `(∂f_t/∂q_k) J̃_i`. Allocates
 /// nothing after the first call with a given shape.
 #[allow(clippy::too_many_arguments)]
 pub fn identification_jacobian_dq(
@@ -263,26 +264,26 @@ pub fn identification_jacobian_dq(
             }
         }
     }
-    if let (Some(comp), Some(state)) = (&model.compliance, &data.compliance) {
+    if let Some(state) = &data.corrections {
         let dof = model.dof();
         ws.deflected.resize(dof, DMatrix::zeros(0, 0));
         for (d, src) in ws.deflected.iter_mut().zip(dq.iter()) {
             d.clone_from(src);
         }
-        for (t, &(kappa, joint)) in state.kappa.iter().enumerate() {
-            for (k, out) in dq.iter_mut().enumerate().take(dof) {
-                let a = kappa * state.lever_rate[t * dof + k];
-                *out += &ws.deflected[joint] * a;
-            }
+        for (_, joint, k, a) in state.rates() {
+            dq[k] += &ws.deflected[joint] * a;
         }
         for (c, &j) in columns.iter().enumerate() {
-            let Some(t) = comp.terms.iter().position(|t| t.param == j) else {
+            let Some((t, (_, joint))) = model
+                .joint_corrections()
+                .enumerate()
+                .find(|(_, (param, _))| *param == j)
+            else {
                 continue;
             };
-            let joint = comp.terms[t].joint;
             let (w, p_dot) = (ws.joint_w[joint], ws.joint_p_dot[joint]);
             for (k, out) in dq.iter_mut().enumerate().take(dof) {
-                let rate = state.lever_rate[t * dof + k];
+                let rate = state.basis_rate[t * dof + k];
                 for r in 0..3 {
                     out[(r, c)] += p_dot[r] * rate;
                 }

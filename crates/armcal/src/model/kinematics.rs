@@ -4,7 +4,7 @@
 //! the pose of every frame and all the data the analytic Jacobians need.
 
 use crate::model::chain::{Model, Step};
-use crate::model::compliance::ComplianceData;
+use crate::model::joint_correction::CorrectionData;
 use crate::model::link::Motion;
 use crate::model::pose::{rot_axis, Pose, Twist};
 use nalgebra::{convert, RealField, Vector3};
@@ -35,25 +35,22 @@ pub struct Data<T: RealField + Copy> {
     /// DH/MDH joint factor, a zero-reference screw's axis point), world frame (mm): where
     /// [`crate::model::compliance`] puts its point masses.
     pub joint_points: Vec<Vector3<T>>,
-    /// The lever pass and the deflected joints of a compliant model
-    /// ([`crate::model::compliance`]); `None` without compliance. `joint_twists` are then
-    /// the twists of the deflected joints `q + Δq`.
-    pub compliance: Option<Box<ComplianceData<T>>>,
+    /// The joint-space corrections (compliance, periodic errors;
+    /// [`crate::model::joint_correction`]) and the corrected joints; `None` without them.
+    /// `joint_twists` are then the twists of the corrected joints `q + Δq`.
+    pub corrections: Option<Box<CorrectionData<T>>>,
 }
 
 impl<T: RealField + Copy> Data<T> {
     /// Buffers sized for `model`, every pose the identity and every twist zero.
     pub fn new(model: &Model) -> Self {
-        let mut data = Self::without_compliance(model);
-        data.compliance = model
-            .compliance
-            .as_ref()
-            .map(|c| Box::new(ComplianceData::new(model, c)));
+        let mut data = Self::without_corrections(model);
+        data.corrections = CorrectionData::new(model).map(Box::new);
         data
     }
 
-    /// Buffers for the chain alone, with no compliance state (the lever pass).
-    pub(crate) fn without_compliance(model: &Model) -> Self {
+    /// Buffers for the chain alone, with no joint corrections (the compliance's lever pass).
+    pub(crate) fn without_corrections(model: &Model) -> Self {
         Data {
             station: 0,
             instrument: Pose::identity(),
@@ -63,7 +60,7 @@ impl<T: RealField + Copy> Data<T> {
             joint_twists: vec![Twist::zero(); model.dof()],
             param_twist_rates: vec![Twist::zero(); model.param_count()],
             joint_points: vec![Vector3::zeros(); model.dof()],
-            compliance: None,
+            corrections: None,
         }
     }
 
@@ -74,9 +71,10 @@ impl<T: RealField + Copy> Data<T> {
 }
 
 /// Evaluates the model at parameters `params` (internal units) and joints `q`, filling
-/// `data` with every frame pose and every parameter and joint twist. A compliant model
-/// ([`crate::model::compliance`]) first computes its levers at `q`, then evaluates the chain
-/// at the deflected joints `q + Δq`. Allocates nothing.
+/// `data` with every frame pose and every parameter and joint twist. A model with joint
+/// corrections ([`crate::model::joint_correction`]: compliance, periodic errors) first
+/// computes them at `q`, then evaluates the chain at the corrected joints `q + Δq`.
+/// Allocates nothing.
 pub fn forward_kinematics<T: RealField + Copy>(
     model: &Model,
     data: &mut Data<T>,
@@ -85,26 +83,23 @@ pub fn forward_kinematics<T: RealField + Copy>(
 ) {
     debug_assert_eq!(params.len(), model.param_count());
     debug_assert_eq!(q.len(), model.dof());
-    match (&model.compliance, data.compliance.take()) {
-        (Some(c), Some(mut state)) => {
-            state.evaluate(model, c, params, q);
+    match data.corrections.take() {
+        Some(mut state) => {
+            state.evaluate(model, params, q);
             chain_pass(model, data, params, &state.q);
             state.set_twists(
-                c,
+                model,
                 &mut data.param_twists,
                 &data.joint_twists,
                 &mut data.param_twist_rates,
             );
-            data.compliance = Some(state);
+            data.corrections = Some(state);
         }
-        (_, state) => {
-            data.compliance = state;
-            chain_pass(model, data, params, q);
-        }
+        None => chain_pass(model, data, params, q),
     }
 }
 
-/// One pass over instrument, chain and targets at joints `q` (no compliance).
+/// One pass over instrument, chain and targets at joints `q` (no joint corrections).
 fn chain_pass<T: RealField + Copy>(model: &Model, data: &mut Data<T>, params: &[f64], q: &[T]) {
     let mut pose = Pose::identity();
     let steps = match model.station_steps.get(data.station) {

@@ -21,6 +21,9 @@ pub enum Unit {
     /// mm of lever, shown in µrad/m.
     #[serde(rename = "urad_per_m")]
     RadPerMm,
+    /// A small joint angle: a periodic joint error's amplitude
+    /// ([`crate::model::periodic`]), stored in radians, shown in arcseconds.
+    Arcsec,
 }
 
 impl Unit {
@@ -29,12 +32,13 @@ impl Unit {
         match self {
             Unit::Rad => 180.0 / std::f64::consts::PI,
             Unit::RadPerMm => 1e9,
+            Unit::Arcsec => 648_000.0 / std::f64::consts::PI,
             _ => 1.0,
         }
     }
 
     /// The largest magnitude a model value of this unit may have, in internal units: lengths
-    /// 10⁶ mm (1 km), angles 3600° (ten turns, 20π rad), dimensionless 10⁶, compliance 10⁶ µrad/m. Beyond these the
+    /// 10⁶ mm (1 km), angles 3600° (ten turns, 20π rad), dimensionless 10⁶, compliance 10⁶ µrad/m, periodic amplitudes 0.1 rad. Beyond these the
     /// kinematics and the conversions between conventions lose every digit (and overflow), so
     /// a model refuses them ([`crate::model::LinkSpec::check_values`]).
     pub fn max_abs(self) -> f64 {
@@ -42,6 +46,7 @@ impl Unit {
             Unit::Mm | Unit::Unitless => 1e6,
             Unit::Rad => 20.0 * std::f64::consts::PI,
             Unit::RadPerMm => crate::model::compliance::MAX_COMPLIANCE,
+            Unit::Arcsec => crate::model::periodic::MAX_AMPLITUDE,
         }
     }
 
@@ -66,6 +71,7 @@ impl Unit {
             Unit::Rad => "deg",
             Unit::Unitless => "1",
             Unit::RadPerMm => "µrad/m",
+            Unit::Arcsec => "arcsec",
         }
     }
 }

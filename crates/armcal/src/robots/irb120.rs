@@ -74,6 +74,7 @@ pub fn irb120() -> Robot {
             .into(),
         spec: ModelSpec {
             compliance: None,
+            periodic: None,
             name: "irb120".into(),
             instrument: None,
             links,

@@ -89,6 +89,7 @@ fn build(k: Kr) -> Robot {
         source: format!("{} {COMMON}", k.source),
         spec: ModelSpec {
             compliance: None,
+            periodic: None,
             name: k.name.into(),
             instrument: None,
             links,

@@ -98,6 +98,7 @@ pub fn motoman(arm: Arm) -> Robot {
             .into(),
         spec: ModelSpec {
             compliance: None,
+            periodic: None,
             name,
             instrument: None,
             links,

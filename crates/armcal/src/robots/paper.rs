@@ -88,6 +88,7 @@ pub fn notional(lambda: f64, mu: f64) -> Robot {
             .into(),
         spec: ModelSpec {
             compliance: None,
+            periodic: None,
             name: format!("paper-{lambda}-{mu}"),
             instrument: None,
             links,

@@ -260,6 +260,7 @@ fn dh_spec(name: &str, rows: &[BookRow]) -> Result<ModelSpec, Error> {
     links.push(frame_link("tool", [0.0; 3], [0.0; 3]));
     Ok(ModelSpec {
         compliance: None,
+        periodic: None,
         name: name.into(),
         instrument: None,
         links,
@@ -301,6 +302,7 @@ fn zrp_spec(name: &str, rows: &[ZrpRow], t0: &[[f64; 4]; 3], mm: f64) -> Result<
     });
     Ok(ModelSpec {
         compliance: None,
+        periodic: None,
         name: name.into(),
         instrument: None,
         links,

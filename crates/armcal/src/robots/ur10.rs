@@ -64,6 +64,7 @@ pub fn ur10() -> Robot {
             .into(),
         spec: ModelSpec {
             compliance: None,
+            periodic: None,
             name: "ur10".into(),
             instrument: None,
             links,

@@ -26,6 +26,10 @@ pub struct Perturbation {
     /// Default 2·10⁻⁷ rad/mm = 200 µrad/m (e.g. 10⁻⁶ rad/(N·m) with 20 kg beyond the joint).
     #[serde(default = "default_compliance")]
     pub compliance: f64,
+    /// Periodic joint error amplitudes ([`crate::model::periodic`], rad): the truth draws
+    /// `nominal + σ z`. Default 20 arcsec (9.7·10⁻⁵ rad), a gear's transmission error.
+    #[serde(default = "default_periodic")]
+    pub periodic: f64,
     /// Perturb every parameter (`true`) or only the free ones (`false`, the default: the
     /// truth then lies in the identifiable set and identification can recover it exactly).
     pub all: bool,
@@ -38,6 +42,7 @@ impl Default for Perturbation {
             angle: 0.1f64.to_radians(),
             unitless: 1e-3,
             compliance: default_compliance(),
+            periodic: default_periodic(),
             all: false,
         }
     }
@@ -45,6 +50,10 @@ impl Default for Perturbation {
 
 fn default_compliance() -> f64 {
     2e-7
+}
+
+fn default_periodic() -> f64 {
+    20.0 / Unit::Arcsec.display_factor()
 }
 
 /// The true parameters: nominal + N(0, σ_kind²) per parameter (free ones unless `all`).
@@ -65,6 +74,7 @@ pub fn perturbed_truth(model: &Model, p: &Perturbation, seed: u64) -> Vec<f64> {
                 Unit::Rad => p.angle,
                 Unit::Unitless => p.unitless,
                 Unit::RadPerMm => return par.nominal + p.compliance * z.abs(),
+                Unit::Arcsec => p.periodic,
             };
             par.nominal + s * z
         })

@@ -22,6 +22,7 @@ pub fn random_geometry(c: Convention, kind: Option<JointKind>, r: &mut ChaCha8Rn
             Unit::Rad => r.random_range(-3.0..3.0),
             Unit::Unitless => r.random_range(-1.5..1.5),
             Unit::RadPerMm => r.random_range(0.0..1e-6),
+            Unit::Arcsec => r.random_range(-1e-3..1e-3),
         })
         .collect();
     let mut g = LinkGeometry::new(c, values);
@@ -83,6 +84,7 @@ pub fn every_convention_model(seed: u64) -> Model {
     });
     let spec = ModelSpec {
         compliance: None,
+        periodic: None,
         name: "every-convention".into(),
         instrument: Some(LinkSpec {
             name: "tracker".into(),
@@ -139,9 +141,36 @@ pub fn compliant_model(seed: u64) -> Model {
     Model::from_spec(&spec).expect("valid compliant model")
 }
 
-/// Both test models of a seed: every convention, rigid and compliant.
-pub fn derivative_models(seed: u64) -> [Model; 2] {
-    [every_convention_model(seed), compliant_model(seed)]
+/// [`compliant_model`] with periodic joint errors as well: harmonics 1 and 3 on `q1`, 2 on
+/// `q7` and `q13` (two of them compliant too), amplitudes of 0.01–0.05 rad so that the
+/// chain rule through `q + Δq` matters.
+pub fn corrected_model(seed: u64) -> Model {
+    use armcal::model::periodic::{PeriodicSpec, PeriodicTerm, Phase};
+    let mut r = rng(2000 + seed);
+    let mut spec = compliant_model(seed).spec();
+    let mut terms = Vec::new();
+    for (joint, harmonic) in [("q1", 1), ("q1", 3), ("q7", 2), ("q13", 2)] {
+        for phase in [Phase::Sin, Phase::Cos] {
+            terms.push(PeriodicTerm {
+                joint: joint.into(),
+                harmonic,
+                phase,
+                value: r.random_range(0.01..0.05) * if r.random_bool(0.5) { 1.0 } else { -1.0 },
+            });
+        }
+    }
+    spec.periodic = Some(PeriodicSpec { terms });
+    Model::from_spec(&spec).expect("valid model with periodic errors")
+}
+
+/// The test models of a seed: every convention rigid, compliant, and compliant with periodic
+/// joint errors.
+pub fn derivative_models(seed: u64) -> [Model; 3] {
+    [
+        every_convention_model(seed),
+        compliant_model(seed),
+        corrected_model(seed),
+    ]
 }
 
 pub fn random_q(model: &Model, r: &mut ChaCha8Rng) -> Vec<f64> {

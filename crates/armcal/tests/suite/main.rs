@@ -22,6 +22,7 @@ mod identify {
     mod identification_input;
     mod identification_validation;
     mod mixed_measurements;
+    mod periodic;
     mod priors_and_noise;
     mod stations;
 }
@@ -61,6 +62,7 @@ mod accuracy {
 mod real_data {
     mod motoman_calibration;
     mod motoman_nominal;
+    mod motoman_nongeometric;
     mod ur10_cubes;
     mod ur10_import;
     mod ur10_stations;

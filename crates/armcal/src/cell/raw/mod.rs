@@ -89,6 +89,16 @@ struct RawParameters {
     measurement: Option<String>,
     /// Compliant joints, `["j2", "j3"]` ([`crate::model::compliance`]).
     compliance: Option<Vec<String>>,
+    /// Periodic joint errors ([`crate::model::periodic`]).
+    periodic: Option<RawPeriodic>,
+}
+
+/// `periodic = { joints = ["j1", "j2"], harmonics = [1, 2] }`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawPeriodic {
+    joints: Vec<String>,
+    harmonics: Vec<u32>,
 }
 
 /// Error helper: file, line of a span, field path.
@@ -147,7 +157,7 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
     let shaped = shape_robot(&mut robot, &given, spec, form, &mut tool_capsules)
         .map_err(|e| ctx.err(rspan.clone(), "robot.convention", e))?;
     let mut model = Model::from_spec(&shaped.spec).map_err(model_error)?;
-    parameters::compliance(&ctx, raw.parameters.as_ref(), rr.gravity, &mut model)?;
+    parameters::joint_corrections(&ctx, raw.parameters.as_ref(), rr.gravity, &mut model)?;
 
     let (measurement, auto_free) =
         parameters::parameters(&ctx, raw.parameters.as_ref(), &mut model)?;

@@ -1,9 +1,11 @@
 //! `[parameters]`: the free set (`auto`, `all` or patterns), `fixed`, `priors`, the
-//! measurement type and the compliant joints (with `[robot] gravity`).
+//! measurement type, the compliant joints (with `[robot] gravity`) and the periodic joint
+//! errors.
 
 use super::fields::*;
 use super::*;
 use crate::model::compliance::ComplianceSpec;
+use crate::model::periodic::PeriodicSpec;
 
 /// Applies `[parameters]` to `model`; returns the measurement type (pose if every target is
 /// a frame, else position, unless given) and whether the free set is `auto`.
@@ -76,7 +78,9 @@ pub(super) fn parameters(
             }
             let mut used = Vec::new();
             let s = unit_value(t, "sigma", unit, &mut used)
-                .and_then(|v| v.ok_or_else(|| "missing `sigma_deg` / `sigma_mm`".into()))
+                .and_then(|v| {
+                    v.ok_or_else(|| format!("missing `{}`", unit_spellings("sigma", unit)))
+                })
                 .and_then(|v| {
                     check_unused(t, &used, &[], &[unit_spellings("sigma", unit)]).map(|_| v)
                 })
@@ -91,16 +95,12 @@ pub(super) fn parameters(
             priors.push((name.clone(), s));
         }
         if !free.is_empty() {
-            // An explicit free list: everything else is fixed, but the compliance terms the
-            // section asks for stay free (unless `fixed` names them).
+            // An explicit free list: everything else is fixed, but the compliance and periodic
+            // terms the section asks for stay free (unless `fixed` names them).
             model
                 .set_status("*", Status::Fixed)
                 .expect("every model has parameters");
-            let terms: Vec<usize> = model
-                .compliance
-                .iter()
-                .flat_map(|c| c.terms.iter().map(|t| t.param))
-                .collect();
+            let terms: Vec<usize> = model.joint_corrections().map(|(p, _)| p).collect();
             for i in terms {
                 model.registry.set_status(i, Status::Free);
             }
@@ -120,10 +120,11 @@ pub(super) fn parameters(
     Ok((measurement, auto_free))
 }
 
-/// `[parameters] compliance = ["j2", "j3"]`: rebuilds `model` with the lumped compliance
-/// terms of those joints ([`ComplianceSpec::lumped`], gravity from `[robot] gravity`, default
-/// `[0, 0, -1]`), free. The error names the joint and the line.
-pub(super) fn compliance(
+/// `[parameters] compliance = ["j2", "j3"]` and `periodic = { joints = ["j1"], harmonics =
+/// [1, 2] }`: rebuilds `model` with the lumped compliance terms of those joints
+/// ([`ComplianceSpec::lumped`], gravity from `[robot] gravity`, default `[0, 0, -1]`) and the
+/// periodic terms ([`PeriodicSpec::new`]), free. The error names the joint and the line.
+pub(super) fn joint_corrections(
     ctx: &Ctx,
     section: Option<&Spanned<RawParameters>>,
     gravity: Option<[f64; 3]>,
@@ -132,14 +133,22 @@ pub(super) fn compliance(
     let Some(p) = section else {
         return Ok(());
     };
-    let Some(joints) = &p.get_ref().compliance else {
-        return Ok(());
-    };
     let span = p.span();
-    let c = ComplianceSpec::lumped(model, joints, gravity.unwrap_or([0.0, 0.0, -1.0]))
-        .map_err(|e| ctx.err(span.clone(), "parameters.compliance", e))?;
+    let p = p.get_ref();
+    if p.compliance.is_none() && p.periodic.is_none() {
+        return Ok(());
+    }
     let mut spec = model.spec();
-    spec.compliance = Some(c);
-    *model = Model::from_spec(&spec).map_err(|e| ctx.err(span, "parameters.compliance", e))?;
+    if let Some(joints) = &p.compliance {
+        let c = ComplianceSpec::lumped(model, joints, gravity.unwrap_or([0.0, 0.0, -1.0]))
+            .map_err(|e| ctx.err(span.clone(), "parameters.compliance", e))?;
+        spec.compliance = Some(c);
+    }
+    if let Some(periodic) = &p.periodic {
+        let t = PeriodicSpec::new(&model.joints, &periodic.joints, &periodic.harmonics)
+            .map_err(|e| ctx.err(span.clone(), "parameters.periodic", e))?;
+        spec.periodic = Some(t);
+    }
+    *model = Model::from_spec(&spec).map_err(|e| ctx.err(span, "parameters", e))?;
     Ok(())
 }

@@ -71,6 +71,7 @@ pub(super) fn robot(
             source: format!("cell file {file}"),
             spec: ModelSpec {
                 compliance: None,
+                periodic: None,
                 name,
                 instrument: None,
                 links,
@@ -225,6 +226,7 @@ fn inline_link(t: &toml::Table, index: usize) -> Result<LinkSpec, String> {
                     Unit::Rad => "_deg",
                     Unit::Unitless => "",
                     Unit::RadPerMm => "_urad_per_m",
+                    Unit::Arcsec => "_arcsec",
                 };
                 return Err(format!(
                     "missing `{field}{hint}` for convention {convention}"

@@ -455,6 +455,7 @@ pub fn axes_to_zrp(axes: &AxesResult, tool_pose_at_zero: &Pose<f64>) -> Result<M
     });
     let spec = ModelSpec {
         compliance: None,
+        periodic: None,
         name: format!("{}-cpa", axes.model),
         instrument: None,
         links,
@@ -541,6 +542,7 @@ pub fn axes_to_s_model(
     links.push(frame6("tool", &Pose::identity()));
     let spec = ModelSpec {
         compliance: None,
+        periodic: None,
         name: format!("{}-cpa-s", axes.model),
         instrument: None,
         links,

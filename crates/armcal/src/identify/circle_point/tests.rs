@@ -274,6 +274,7 @@ fn untrustworthy_axes_are_warned_about() {
 fn prismatic_axis_and_zero_reference_check() {
     let spec = ModelSpec {
         compliance: None,
+        periodic: None,
         name: "rp".into(),
         instrument: None,
         links: vec![

@@ -175,6 +175,7 @@ pub fn from_urdf_robot(robot: &urdf_rs::Robot, tip: Option<&str>) -> Result<Mode
     out.push(identity_frame("tool"));
     Ok(ModelSpec {
         compliance: None,
+        periodic: None,
         name: robot.name.clone(),
         instrument: None,
         links: out,

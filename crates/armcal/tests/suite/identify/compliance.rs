@@ -6,21 +6,26 @@
 use armcal::cell::Cell;
 use armcal::identify::*;
 use armcal::measure::{Dataset, MeasurementKind, NoiseModel};
-use armcal::model::{forward_kinematics, observed_position, random_configurations, Data, Unit};
+use armcal::model::{
+    forward_kinematics, observed_position, random_configurations, Data, Model, Unit,
+};
 use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use std::path::Path;
 
 /// The paper cell's text with `extra` added to its `[parameters]` section.
-fn paper_cell_with(extra: &str, tag: &str) -> Result<Cell, armcal::Error> {
+pub(super) fn paper_cell_with(extra: &str, tag: &str) -> Result<Cell, armcal::Error> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
     let text = std::fs::read_to_string(dir.join("paper-cell.toml")).unwrap();
     let text = text.replace(
         "measurement = \"position\"",
         &format!("measurement = \"position\"\n{extra}"),
     );
+    // one file per call: tests run in parallel and share tags
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let path = std::env::temp_dir().join(format!(
-        "armcal-compliance-{tag}-{}.toml",
+        "armcal-compliance-{tag}-{}-{call}.toml",
         std::process::id()
     ));
     std::fs::write(&path, text).unwrap();
@@ -33,7 +38,7 @@ fn compliant_cell() -> Cell {
     paper_cell_with("compliance = [\"q2\", \"q3\"]", "compliant").unwrap()
 }
 
-fn fit(cell: &Cell, data: &Dataset, noise: &NoiseModel) -> Vec<f64> {
+pub(super) fn fit(cell: &Cell, data: &Dataset, noise: &NoiseModel) -> Vec<f64> {
     let mut problem = Problem::new(&cell.model, data, noise).unwrap();
     let (sol, _, _) = solve(
         &mut problem,
@@ -47,7 +52,7 @@ fn fit(cell: &Cell, data: &Dataset, noise: &NoiseModel) -> Vec<f64> {
 }
 
 /// RMS (mm) of the distance between what `params` predict and the measured positions.
-fn rms(cell: &Cell, params: &[f64], data: &Dataset) -> f64 {
+pub(super) fn rms(cell: &Cell, params: &[f64], data: &Dataset) -> f64 {
     let mut fk = Data::new(&cell.model);
     let mut sum = 0.0;
     for m in &data.measurements {
@@ -118,13 +123,17 @@ fn noise_free_data_recover_geometry_and_compliance() {
     let data = simulate(model, &truth, &qs, None, 0).unwrap();
     let noise = cell.instrument.as_ref().unwrap().noise.clone();
     let est = fit(&cell, &data, &noise);
+    assert_recovered(model, &est, &truth);
+}
+
+/// Every free parameter of `est` equals `truth` to 1e-8, relative to itself for the
+/// non-geometric terms (κ ~10⁻⁷ rad/mm, periodic amplitudes ~10⁻⁴ rad), else to max(1, |x|).
+pub(super) fn assert_recovered(model: &Model, est: &[f64], truth: &[f64]) {
     for i in model.registry.free() {
         let p = model.registry.get(i);
-        // κ are ~10⁻⁷ rad/mm: relative to themselves, not to 1
-        let scale = if p.unit == Unit::RadPerMm {
-            truth[i].abs()
-        } else {
-            truth[i].abs().max(1.0)
+        let scale = match p.unit {
+            Unit::RadPerMm | Unit::Arcsec => truth[i].abs(),
+            _ => truth[i].abs().max(1.0),
         };
         assert!(
             (est[i] - truth[i]).abs() <= 1e-8 * scale,

@@ -96,6 +96,7 @@ fn random_chain(c: Convention, n: usize, seed: u64) -> ModelSpec {
     });
     ModelSpec {
         compliance: None,
+        periodic: None,
         name: format!("random-{c}"),
         instrument: None,
         links,

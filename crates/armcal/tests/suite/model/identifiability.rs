@@ -81,6 +81,7 @@ fn random_chain(kinds: &str, seed: u64) -> Model {
     });
     Model::from_spec(&ModelSpec {
         compliance: None,
+        periodic: None,
         name: kinds.into(),
         instrument: None,
         links,

@@ -12,8 +12,9 @@ fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
-fn calibrate(arm: &str) -> armcal::identify::Validation {
-    let cell = Cell::from_file(&root().join(format!("examples/motoman-{arm}-cell.toml"))).unwrap();
+/// The Motoman cell `examples/motoman-{cell}.toml` and the grid of its `arm`.
+pub(super) fn motoman(cell: &str, arm: &str) -> (Cell, armcal::measure::Dataset) {
+    let cell = Cell::from_file(&root().join(format!("examples/motoman-{cell}.toml"))).unwrap();
     let cols = cell.data_columns.as_ref().unwrap().joints.clone();
     let (data, _) = csv::read(
         &root().join(format!("data/motoman-leica/{arm}_arm_grid_6x6x6.csv")),
@@ -21,6 +22,11 @@ fn calibrate(arm: &str) -> armcal::identify::Validation {
         Some(&cols),
     )
     .unwrap();
+    (cell, data)
+}
+
+fn calibrate(arm: &str) -> armcal::identify::Validation {
+    let (cell, data) = motoman(&format!("{arm}-cell"), arm);
     let opts = IdentifySettings {
         holdout: 1.0 / 3.0,
         seed: 1,

@@ -1,0 +1,254 @@
+//! Which non-geometric terms a fit keeps (issue 14 item 3, `identify --nongeometric`): the
+//! kinematic model alone, with the cell's compliance, with its periodic joint errors, or with
+//! both — chosen by the user, or by k-fold cross-validation on the training data.
+//!
+//! # Cross-validation
+//! The training configurations are shuffled (seeded) and dealt into `k` folds. Each
+//! candidate is fitted `k` times, on all folds but one, exactly as the final fit (frames
+//! first, the identifiable set, the gate's drops), and predicts the held-out fold; its score
+//! is the RMS of the position errors of every held-out measurement over all folds, with the
+//! standard error of the per-fold RMS values. The choice is the candidate with the smallest
+//! score — unless a candidate with fewer terms scores within one standard error of it (the
+//! one-standard-error rule of Hastie, Tibshirani & Friedman, *The Elements of Statistical
+//! Learning*, §7.10): a term has to buy more than the noise of its own score to be kept, so
+//! nothing overfits silently. The test split is never seen.
+
+use super::free_set::fit_free_set;
+use super::{IdentifySettings, Problem};
+use crate::accuracy::ErrorStats;
+use crate::cell::Cell;
+use crate::measure::{Dataset, NoiseModel};
+use crate::model::{Model, Unit};
+use crate::progress::{Observer, Silent};
+use crate::Error;
+use rand::seq::SliceRandom;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+/// A set of non-geometric terms a fit keeps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Candidate {
+    /// No non-geometric term: the kinematic model.
+    Kinematic,
+    /// The cell's compliance terms.
+    Compliance,
+    /// The cell's periodic joint errors.
+    Periodic,
+    /// Both.
+    Both,
+}
+
+/// What [`super::identify`] does with the cell's non-geometric terms.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum NonGeometric {
+    /// Keep every term the cell declares (the gate still drops what is not separable).
+    #[default]
+    AsCell,
+    /// Keep only this candidate's terms.
+    Only(Candidate),
+    /// Choose the candidate by cross-validation with this many folds (≥ 2).
+    Auto {
+        /// Number of folds.
+        folds: usize,
+    },
+}
+
+impl Candidate {
+    /// `none`/`kinematic`, `compliance`, `periodic` or `both`; `None` for another name.
+    pub fn from_name(s: &str) -> Option<Candidate> {
+        match s {
+            "none" | "kinematic" => Some(Candidate::Kinematic),
+            "compliance" => Some(Candidate::Compliance),
+            "periodic" => Some(Candidate::Periodic),
+            "both" => Some(Candidate::Both),
+            _ => None,
+        }
+    }
+
+    /// The candidate in words, for a table.
+    pub fn words(self) -> &'static str {
+        match self {
+            Candidate::Kinematic => "kinematic",
+            Candidate::Compliance => "+ compliance",
+            Candidate::Periodic => "+ periodic",
+            Candidate::Both => "+ compliance + periodic",
+        }
+    }
+
+    /// The candidates `model` offers, simplest first: kinematic, then each kind of term it
+    /// has, then both when it has both.
+    pub fn offered(model: &Model) -> Vec<Candidate> {
+        let (c, p) = kinds(model);
+        let mut out = vec![Candidate::Kinematic];
+        out.extend(c.then_some(Candidate::Compliance));
+        out.extend(p.then_some(Candidate::Periodic));
+        out.extend((c && p).then_some(Candidate::Both));
+        out
+    }
+
+    /// The terms of `model` this candidate leaves out, each with its reason; an error if the
+    /// candidate keeps a kind of term the cell does not declare.
+    pub fn left_out(self, model: &Model) -> Result<Vec<(usize, String)>, Error> {
+        if !Candidate::offered(model).contains(&self) {
+            return Err(Error::Input(format!(
+                "`{}`: the cell declares no such terms ([parameters] compliance / periodic)",
+                self.words()
+            )));
+        }
+        let (keep_c, keep_p) = match self {
+            Candidate::Kinematic => (false, false),
+            Candidate::Compliance => (true, false),
+            Candidate::Periodic => (false, true),
+            Candidate::Both => (true, true),
+        };
+        Ok(model
+            .joint_corrections()
+            .map(|(i, _)| i)
+            .filter(|&i| match model.registry.get(i).unit {
+                Unit::RadPerMm => !keep_c,
+                _ => !keep_p,
+            })
+            .map(|i| {
+                let name = &model.registry.get(i).name;
+                (
+                    i,
+                    format!(
+                        "`{name}` left out: the non-geometric model is `{}`",
+                        self.words()
+                    ),
+                )
+            })
+            .collect())
+    }
+}
+
+/// Whether `model` has compliance terms and periodic terms.
+fn kinds(model: &Model) -> (bool, bool) {
+    (model.compliance.is_some(), !model.periodic.is_empty())
+}
+
+/// One candidate's cross-validated score.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct CandidateScore {
+    /// The candidate.
+    pub candidate: Candidate,
+    /// Non-geometric terms the candidate declares (a fold's fit may drop some: the
+    /// identifiable set, the gate).
+    pub terms: usize,
+    /// Position errors (mm) of every held-out measurement over all folds.
+    pub held_out: ErrorStats,
+    /// RMS (mm) of each fold.
+    pub fold_rms: Vec<f64>,
+    /// Standard error of the mean of the per-fold RMS (mm).
+    pub standard_error: f64,
+}
+
+/// The cross-validation of [`NonGeometric::Auto`], recorded in the estimate.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct NonGeometricChoice {
+    /// Number of folds.
+    pub folds: usize,
+    /// Training configurations dealt into the folds.
+    pub configurations: usize,
+    /// Every candidate's score, simplest first.
+    pub candidates: Vec<CandidateScore>,
+    /// The candidate chosen.
+    pub chosen: Candidate,
+    /// The rule, in words.
+    pub rule: String,
+}
+
+/// Cross-validates every candidate the cell offers on `train` with `folds` folds (seeded by
+/// `opts.seed`) and chooses one (see the module notes).
+pub(super) fn choose(
+    cell: &Cell,
+    train: &Dataset,
+    noise: &NoiseModel,
+    opts: &IdentifySettings,
+    folds: usize,
+    observer: &mut dyn Observer,
+) -> Result<NonGeometricChoice, Error> {
+    let n = train.configurations.len();
+    if folds < 2 || folds > n {
+        return Err(Error::Input(format!(
+            "{folds} cross-validation folds of {n} training configurations: give 2 to {n}"
+        )));
+    }
+    let mut order: Vec<usize> = (0..n).collect();
+    order.shuffle(&mut ChaCha8Rng::seed_from_u64(opts.seed));
+    let fold_of = |f: usize| -> (Vec<usize>, Vec<usize>) {
+        let (mut fit, mut held): (Vec<usize>, Vec<usize>) = (Vec::new(), Vec::new());
+        for (k, &c) in order.iter().enumerate() {
+            if k % folds == f {
+                held.push(c)
+            } else {
+                fit.push(c)
+            }
+        }
+        fit.sort_unstable();
+        held.sort_unstable();
+        (fit, held)
+    };
+    let inner = IdentifySettings {
+        holdout: 0.0,
+        test: None,
+        start: None,
+        ..opts.clone()
+    };
+    let offered = Candidate::offered(&cell.model);
+    observer.start(
+        "cross-validating the non-geometric terms",
+        Some(offered.len() * folds),
+    );
+    let mut candidates = Vec::new();
+    for &candidate in &offered {
+        let left_out = candidate.left_out(&cell.model)?;
+        let mut errors = Vec::new();
+        let mut fold_rms = Vec::new();
+        for f in 0..folds {
+            let (fit_idx, held_idx) = fold_of(f);
+            let (fit_data, held) = (train.subset(&fit_idx), train.subset(&held_idx));
+            let fit = fit_free_set(cell, &fit_data, noise, &inner, &left_out, &mut Silent)?;
+            let eval = Problem::new(&fit.model, &held, noise)?;
+            let e = eval.errors(&mut eval.workspace(), &fit.solution.params);
+            fold_rms.push(ErrorStats::of(&e).rms);
+            errors.extend(e);
+            observer.step();
+        }
+        let terms = cell.model.joint_corrections().count() - left_out.len();
+        let mean = fold_rms.iter().sum::<f64>() / folds as f64;
+        let var = fold_rms.iter().map(|r| (r - mean).powi(2)).sum::<f64>() / (folds - 1) as f64;
+        candidates.push(CandidateScore {
+            candidate,
+            terms,
+            held_out: ErrorStats::of(&errors),
+            standard_error: (var / folds as f64).sqrt(),
+            fold_rms,
+        });
+    }
+    observer.finish();
+    let best = candidates
+        .iter()
+        .min_by(|a, b| a.held_out.rms.total_cmp(&b.held_out.rms))
+        .expect("the kinematic candidate is always offered");
+    let bound = best.held_out.rms + best.standard_error;
+    let chosen = candidates
+        .iter()
+        .filter(|c| c.held_out.rms <= bound)
+        .min_by_key(|c| c.terms)
+        .expect("the best is within its own bound")
+        .candidate;
+    Ok(NonGeometricChoice {
+        folds,
+        configurations: n,
+        rule: format!(
+            "the candidate with the fewest terms whose cross-validated RMS is within one \
+             standard error of the best ({:.4} + {:.4} mm)",
+            best.held_out.rms, best.standard_error
+        ),
+        candidates,
+        chosen,
+    })
+}
