@@ -38,7 +38,9 @@ fn the_exchange_names_the_cause_it_hit() {
     ]);
     assert!(!ok);
     assert!(
-        err.contains("KPI criteria need at least one [[working]] configuration or [[working_path]]"),
+        err.contains(
+            "KPI criteria need at least one [[working]] configuration or [[working_path]]"
+        ),
         "{err}"
     );
     assert!(!err.contains("no random set"), "{err}");
