@@ -26,6 +26,9 @@ pub struct DesignObjective<'a> {
     pub criterion: Criterion,
     /// Whitened Jacobian rows of configurations already measured (design augmentation).
     pub prior_rows: DMatrix<f64>,
+    /// The same information in at most n_p rows: `R₀` with `R₀ᵀR₀ = prior_rowsᵀ prior_rows`
+    /// (the rows themselves when there are fewer), stacked above each design's rows.
+    prior_factor: DMatrix<f64>,
     /// Identity of this objective (see [`ObjectiveWorkspace`]).
     id: u64,
 }
@@ -64,9 +67,15 @@ impl<'a> DesignObjective<'a> {
             design.jacobian(&mut ws, q);
             prior_rows.rows_mut(i * rows, rows).copy_from(&ws.jac);
         }
+        let prior_factor = if prior_rows.nrows() > design.n() {
+            triangular_factor(prior_rows.clone())
+        } else {
+            prior_rows.clone()
+        };
         DesignObjective {
             design,
             criterion,
+            prior_factor,
             prior_rows,
             id: NEXT_OBJECTIVE_ID.fetch_add(1, Ordering::Relaxed),
         }
@@ -117,9 +126,9 @@ impl<'a> DesignObjective<'a> {
             ws.cached_q.clear();
             ws.cached_q.extend_from_slice(q);
             let rows = self.design.rows();
-            let np = self.prior_rows.nrows();
+            let np = self.prior_factor.nrows();
             let mut stacked = DMatrix::zeros(np + rows * nconf, self.design.n());
-            stacked.rows_mut(0, np).copy_from(&self.prior_rows);
+            stacked.rows_mut(0, np).copy_from(&self.prior_factor);
             for i in 0..nconf {
                 let qi = &q[i * k..(i + 1) * k];
                 if gradient.is_some() {
