@@ -148,12 +148,15 @@ fn the_next_batch_is_planned_at_the_estimate_not_the_nominal() {
     let set = armcal::design::plan::constraint_set(&cell, true).unwrap();
     let nominal = model.nominal();
     // The fit's frames on the nominal links.
-    let mut frames_at_fit = nominal.clone();
-    for i in 0..model.param_count() {
-        if !matches!(model.registry.get(i).segment, armcal::model::Segment::Chain) {
-            frames_at_fit[i] = fit.params[i];
-        }
-    }
+    let frames_at_fit: Vec<f64> = model
+        .registry
+        .iter()
+        .zip(nominal.iter().zip(&fit.params))
+        .map(|(p, (&n, &f))| match p.segment {
+            armcal::model::Segment::Chain => n,
+            _ => f,
+        })
+        .collect();
     let at_fit = armcal::design::plan::CellConstraints::new(&set, &frames_at_fit);
     let at_nominal = armcal::design::plan::CellConstraints::new(&set, &nominal);
     let next: Vec<Vec<f64>> = r.state.next.iter().map(|p| p.q(model)).collect();
