@@ -321,3 +321,24 @@ pub fn assert_estimate_is(model: &Model, e: &armcal::identify::Estimate, truth: 
         );
     }
 }
+
+/// The paper cell's text with `extra` added to its `[parameters]` section.
+pub fn paper_cell_with(extra: &str, tag: &str) -> Result<Cell, armcal::Error> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let text = std::fs::read_to_string(dir.join("paper-cell.toml")).unwrap();
+    let text = text.replace(
+        "measurement = \"position\"",
+        &format!("measurement = \"position\"\n{extra}"),
+    );
+    // one file per call: tests run in parallel and share tags
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let path = std::env::temp_dir().join(format!(
+        "armcal-compliance-{tag}-{}-{call}.toml",
+        std::process::id()
+    ));
+    std::fs::write(&path, text).unwrap();
+    let cell = Cell::from_file(&path);
+    std::fs::remove_file(&path).unwrap();
+    cell
+}

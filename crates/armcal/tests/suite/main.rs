@@ -40,6 +40,7 @@ mod design {
     mod design_pool;
     mod design_refine;
     mod measurable;
+    mod nongeometric_design;
     mod paper_cell_geometry;
     mod working_paths;
 }

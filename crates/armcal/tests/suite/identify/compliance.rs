@@ -3,6 +3,7 @@
 //! a kinematic-only fit leaves a systematic held-out error that the compliant fit removes
 //! down to the noise floor; the cell refuses joints it cannot model.
 
+pub(super) use crate::common::paper_cell_with;
 use armcal::cell::Cell;
 use armcal::identify::*;
 use armcal::measure::{Dataset, MeasurementKind, NoiseModel};
@@ -11,28 +12,6 @@ use armcal::model::{
 };
 use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
-use std::path::Path;
-
-/// The paper cell's text with `extra` added to its `[parameters]` section.
-pub(super) fn paper_cell_with(extra: &str, tag: &str) -> Result<Cell, armcal::Error> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
-    let text = std::fs::read_to_string(dir.join("paper-cell.toml")).unwrap();
-    let text = text.replace(
-        "measurement = \"position\"",
-        &format!("measurement = \"position\"\n{extra}"),
-    );
-    // one file per call: tests run in parallel and share tags
-    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let path = std::env::temp_dir().join(format!(
-        "armcal-compliance-{tag}-{}-{call}.toml",
-        std::process::id()
-    ));
-    std::fs::write(&path, text).unwrap();
-    let cell = Cell::from_file(&path);
-    std::fs::remove_file(&path).unwrap();
-    cell
-}
 
 fn compliant_cell() -> Cell {
     paper_cell_with("compliance = [\"q2\", \"q3\"]", "compliant").unwrap()
