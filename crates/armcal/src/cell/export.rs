@@ -9,7 +9,7 @@
 use super::{Cell, NoiseModel, Obstacle};
 use crate::model::complete::LinkForm;
 use crate::model::export::{self as model_export, to_cell_toml_with, CellSections};
-use crate::model::{urdf, Model, ModelSpec, Status, Unit};
+use crate::model::{urdf, Model, ModelSpec, Status};
 use crate::robots::transfer_capsules;
 use crate::toml_text;
 use crate::Error;
@@ -125,9 +125,9 @@ fn parameters(cell: &Cell, exported: &Model) -> String {
         match p.status {
             Status::Fixed => fixed.push(toml_text::string(&p.name)),
             Status::Prior { sigma } => priors.push(format!(
-                "{} = {{ sigma_{} = {:?} }}",
+                "{} = {{ sigma{} = {:?} }}",
                 toml_text::string(&p.name),
-                if p.unit == Unit::Rad { "deg" } else { "mm" },
+                model_export::suffix(p.unit),
                 sigma * p.unit.display_factor()
             )),
             Status::Free => {}
@@ -204,7 +204,18 @@ pub fn export_model(
         Some(c) => model_export::export_form(&c.model.spec(), form)?,
         None => spec.clone(),
     };
-    let warnings = model_export::suspicious_values(&Model::from_spec(&reference)?, &spec)?;
+    let mut warnings = model_export::suspicious_values(&Model::from_spec(&reference)?, &spec)?;
+    let terms: Vec<&str> = model
+        .joint_corrections()
+        .map(|(p, _)| model.registry.get(p).name.as_str())
+        .collect();
+    if format == ExportFormat::Urdf && !terms.is_empty() {
+        warnings.push(format!(
+            "URDF has no form for the non-geometric terms ({}): the file holds the geometry \
+             alone and predicts without the deflection; export `cell` or `json` to keep them",
+            terms.join(", ")
+        ));
+    }
     let (content, table_csv) = match format {
         ExportFormat::Json => (
             serde_json::to_string_pretty(&spec).map_err(|e| Error::Input(e.to_string()))?,

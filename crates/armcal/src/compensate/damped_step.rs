@@ -6,10 +6,19 @@
 use crate::model::Data;
 use nalgebra::{Cholesky, SMatrix, SVector, Vector6};
 
-/// Columns of the weighted task Jacobian `Q^{1/2} J` of the tool frame, one per joint, from
-/// evaluated kinematics: joint j's world twist (ω, v) moves the tool origin p with
-/// `ω × p + v` (rows 0–2) and turns it with ω, scaled by L (rows 3–5).
-pub fn task_jacobian_columns(data: &Data<f64>, length: f64, columns: &mut [Vector6<f64>]) {
+/// Columns of the weighted task Jacobian `Q^{1/2} J` of the tool frame, one per commanded
+/// joint, from evaluated kinematics: joint j's world twist (ω, v) moves the tool origin p
+/// with `ω × p + v` (rows 0–2) and turns it with ω, scaled by L (rows 3–5). With joint
+/// corrections (compliance, periodic errors; [`crate::model::joint_correction`]) the twists
+/// are those of the corrected joints `q̃ = q + Δq(q)` and the columns w.r.t. the commanded
+/// joints follow by the chain rule, `J = J̃ ∂q̃/∂q`; `corrected` (one column per joint) then
+/// holds `J̃` and is otherwise untouched.
+pub fn task_jacobian_columns(
+    data: &Data<f64>,
+    length: f64,
+    columns: &mut [Vector6<f64>],
+    corrected: &mut [Vector6<f64>],
+) {
     let p = data.tool().trans;
     for (col, tw) in columns.iter_mut().zip(&data.joint_twists) {
         let v = tw.point_velocity(&p);
@@ -21,6 +30,12 @@ pub fn task_jacobian_columns(data: &Data<f64>, length: f64, columns: &mut [Vecto
             tw.w.y * length,
             tw.w.z * length,
         );
+    }
+    if let Some(c) = &data.corrections {
+        corrected.copy_from_slice(columns);
+        for (_, joint, k, a) in c.rates() {
+            columns[k] += corrected[joint] * a;
+        }
     }
 }
 

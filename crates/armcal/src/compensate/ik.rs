@@ -201,7 +201,7 @@ impl IkResult {
 }
 
 /// Reusable buffers (sized for one model): kinematics, joint limits, iterate and trial
-/// joints, Jacobian columns, and the warm start of the σ_min inverse iteration.
+/// joints, Jacobian columns (and those w.r.t. the corrected joints), and the warm start of the σ_min inverse iteration.
 pub struct IkWorkspace {
     data: Data<f64>,
     lower: Vec<f64>,
@@ -213,6 +213,7 @@ pub struct IkWorkspace {
     direction: Vec<f64>,
     best: Vec<f64>,
     columns: Vec<Vector6<f64>>,
+    corrected: Vec<Vector6<f64>>,
     eigenvector: Vector6<f64>,
 }
 
@@ -236,6 +237,7 @@ impl IkWorkspace {
             direction: vec![0.0; n],
             best: vec![0.0; n],
             columns: vec![Vector6::zeros(); n],
+            corrected: vec![Vector6::zeros(); n],
             eigenvector: Vector6::repeat(1.0 / 6f64.sqrt()),
         }
     }
@@ -302,7 +304,7 @@ fn run_dls<const R: usize>(
                 stalled: false,
             };
         }
-        task_jacobian_columns(&ws.data, length, &mut ws.columns);
+        task_jacobian_columns(&ws.data, length, &mut ws.columns, &mut ws.corrected);
         let a = normal_matrix::<R>(&ws.columns);
         if iterations >= settings.max_iterations || stalls >= 5 {
             let sigma_min = smallest_eigenvalue(&a, &mut ws.eigenvector).sqrt();

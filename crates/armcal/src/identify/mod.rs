@@ -346,6 +346,7 @@ pub fn identify(
     let noise = cell.noise();
     let split = Split::of(data, opts)?;
     let train: &Dataset = &split.train;
+    crate::model::station::check_stations(data)?;
     let stationed = cell.with_stations(&data.stations)?;
     let (left_out, choice) = match opts.nongeometric {
         NonGeometric::AsCell => (Vec::new(), None),

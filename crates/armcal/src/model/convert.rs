@@ -228,11 +228,13 @@ pub(crate) struct Axis {
     pub(crate) point: Vector3<f64>,
 }
 
-/// The joint axes in the world and the world pose of the tool, at q = 0. The world twist of
+/// The joint axes in the world and the world pose of the tool, at q = 0, of the chain alone
+/// (joint corrections such as a compliance's deflection are not part of the link geometry and
+/// ride along separately, [`crate::model::export::export_form`]). The world twist of
 /// a revolute joint is `(ω, p × ω)` for any point `p` of its axis, so `ω × v / |ω|²` is the
 /// axis point nearest the origin; a prismatic joint's twist is `(0, û)`.
 pub(crate) fn axes_at_zero(model: &Model, params: &[f64]) -> (Vec<Axis>, Pose<f64>) {
-    let mut data = Data::<f64>::new(model);
+    let mut data = Data::<f64>::without_corrections(model);
     forward_kinematics(model, &mut data, params, &vec![0.0; model.dof()]);
     let axes = model
         .joints

@@ -3,15 +3,20 @@
 
 use crate::model::chain::{LinkSpec, Model, ModelSpec};
 use crate::model::complete::LinkForm;
+use crate::model::compliance::ComplianceSpec;
 use crate::model::convert;
+use crate::model::kinematics::{forward_kinematics, Data};
 use crate::model::link::{Convention, JointKind};
+use crate::model::periodic::PeriodicSpec;
 use crate::model::registry::{Segment, Unit};
 use crate::table::Table;
 use crate::toml_text;
 use crate::Error;
+use nalgebra::{Matrix3, Vector3};
 use std::fmt::Write;
 
-fn suffix(u: Unit) -> &'static str {
+/// The unit suffix of a cell field in `u`'s display unit (`_mm`, `_deg`, …).
+pub(crate) fn suffix(u: Unit) -> &'static str {
     match u {
         Unit::Mm => "_mm",
         Unit::Rad => "_deg",
@@ -100,11 +105,16 @@ pub fn to_cell_toml(spec: &ModelSpec) -> Result<String, Error> {
 pub fn to_cell_toml_with(spec: &ModelSpec, sections: &CellSections) -> Result<String, Error> {
     let name = sections.name.as_deref().unwrap_or(&spec.name);
     let mut out = format!(
-        "# armcal model export: {}\nname = {}\n\n[robot]\nname = {}\n\n",
+        "# armcal model export: {}\nname = {}\n\n[robot]\nname = {}\n",
         toml_text::string(&spec.name),
         toml_text::string(name),
         toml_text::string(&spec.name)
     );
+    if let Some(c) = &spec.compliance {
+        let g = c.gravity;
+        let _ = writeln!(out, "gravity = [{:?}, {:?}, {:?}]", g[0], g[1], g[2]);
+    }
+    out.push('\n');
     for l in &spec.links {
         link_toml(&mut out, "robot.links", l, true);
     }
@@ -155,8 +165,95 @@ pub fn to_cell_toml_with(spec: &ModelSpec, sections: &CellSections) -> Result<St
     }
     out.push_str("[parameters]\n");
     out.push_str(sections.parameters.as_deref().unwrap_or("free = \"all\"\n"));
+    out.push_str(&joint_corrections_toml(spec)?);
     out.push_str(&sections.tail);
     Ok(out)
+}
+
+/// The `[parameters]` lines of `spec`'s joint corrections as the cell reader takes them: the
+/// compliant joints, the periodic joints and harmonics, and every non-zero term's `values`
+/// (µrad/m, arcsec). A compliance whose terms are not the default lumped terms of its joints
+/// at the written geometry ([`ComplianceSpec::lumped`]) has no cell form: the error says so.
+fn joint_corrections_toml(spec: &ModelSpec) -> Result<String, Error> {
+    let mut out = String::new();
+    let mut values = Vec::new();
+    let quoted = |names: Vec<String>| -> String {
+        let q: Vec<String> = joints_once(&names)
+            .iter()
+            .map(|n| toml_text::string(n))
+            .collect();
+        q.join(", ")
+    };
+    if let Some(c) = &spec.compliance {
+        let joints: Vec<String> = c.terms.iter().map(|t| t.joint.clone()).collect();
+        let rigid = Model::from_spec(&ModelSpec {
+            compliance: None,
+            periodic: None,
+            ..spec.clone()
+        })?;
+        let names = |terms: &[crate::model::compliance::ComplianceTerm]| -> Vec<String> {
+            terms.iter().map(ComplianceSpec::parameter_name).collect()
+        };
+        let mut read_back = ComplianceSpec::lumped(&rigid, &joints_once(&joints), c.gravity)
+            .map(|r| names(&r.terms))
+            .unwrap_or_default();
+        read_back.sort();
+        let mut own = names(&c.terms);
+        own.sort();
+        if read_back != own {
+            return Err(Error::Conversion(format!(
+                "the compliance terms {} are not the lumped terms a cell makes of joints {} \
+                 ({}); export to json to keep them",
+                own.join(", "),
+                joints_once(&joints).join(", "),
+                read_back.join(", ")
+            )));
+        }
+        let _ = writeln!(out, "compliance = [{}]", quoted(joints));
+        for t in &c.terms {
+            values.push((ComplianceSpec::parameter_name(t), Unit::RadPerMm, t.value));
+        }
+    }
+    if let Some(p) = &spec.periodic {
+        let mut harmonics: Vec<u32> = p.terms.iter().map(|t| t.harmonic).collect();
+        harmonics.sort_unstable();
+        harmonics.dedup();
+        let _ = writeln!(
+            out,
+            "periodic = {{ joints = [{}], harmonics = {harmonics:?} }}",
+            quoted(p.terms.iter().map(|t| t.joint.clone()).collect())
+        );
+        for t in &p.terms {
+            values.push((PeriodicSpec::parameter_name(t), Unit::Arcsec, t.value));
+        }
+    }
+    let set: Vec<String> = values
+        .iter()
+        .filter(|v| v.2 != 0.0)
+        .map(|(name, unit, v)| {
+            format!(
+                "{} = {{ value{} = {:?} }}",
+                toml_text::string(name),
+                suffix(*unit),
+                display(*unit, *v)
+            )
+        })
+        .collect();
+    if !set.is_empty() {
+        let _ = writeln!(out, "values = {{ {} }}", set.join(", "));
+    }
+    Ok(out)
+}
+
+/// `names` with repeats removed, first occurrence kept.
+fn joints_once(names: &[String]) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for n in names {
+        if !out.contains(n) {
+            out.push(n.clone());
+        }
+    }
+    out
 }
 
 /// A parameter table: one row per link with its convention and fields (mm, deg).
@@ -194,18 +291,48 @@ pub fn to_table_csv(spec: &ModelSpec) -> String {
 /// zero-reference model; `Dh` DH links by the common normals, Hayati links where `spec` has
 /// them (book §6.3.4); `Mdh` Craig's modified DH of that DH form, with β where it has a
 /// Hayati link ([`convert::dh_to_mdh`]); anything else `spec` as it is.
+///
+/// The joint corrections (compliance, periodic errors) are not link geometry and ride along:
+/// the same joints, terms and values. A converted compliance takes the converted links as its
+/// levers, as a cell file does when it is read ([`ComplianceSpec::lumped`]), where `spec` may
+/// keep the nominal ones: the deflection then changes by the lever change, a share of it of
+/// the order of the calibrated angles' change (0.2 % for 0.1°; test
+/// `model::export_reload::a_nongeometric_calibration_exported_as_a_cell_keeps_its_terms_and_its_deflection`).
+/// Its gravity keeps its direction in the world, re-expressed in the new base frame.
 pub fn export_form(spec: &ModelSpec, form: LinkForm) -> Result<ModelSpec, Error> {
     let model = Model::from_spec(spec)?;
     let zrp = || convert::to_zrp(&model, &model.nominal());
-    Ok(match form {
+    let mut out = match form {
         LinkForm::Zrp => zrp(),
         LinkForm::Dh => convert::zrp_to_dh(&zrp(), Some(spec))?,
         // The DH form with Hayati links regroups with β; where it cannot (a book Type 3
         // last link), the pure DH form.
         LinkForm::Mdh => convert::dh_to_mdh(&convert::zrp_to_dh(&zrp(), Some(spec))?)
             .or_else(|_| convert::dh_to_mdh(&convert::zrp_to_dh(&zrp(), None)?))?,
-        LinkForm::Auto | LinkForm::AsGiven => spec.clone(),
-    })
+        LinkForm::Auto | LinkForm::AsGiven => return Ok(spec.clone()),
+    };
+    if let Some(c) = &spec.compliance {
+        let mut at = c.levers.clone();
+        at.extend_from_slice(&model.nominal()[c.levers.len()..]);
+        let world = base_rotation(&model, &at) * Vector3::from(c.gravity);
+        let links = Model::from_spec(&out)?;
+        let levers = links.nominal();
+        let g = base_rotation(&links, &levers).transpose() * world;
+        out.compliance = Some(ComplianceSpec {
+            gravity: g.into(),
+            levers,
+            terms: c.terms.clone(),
+        });
+    }
+    out.periodic = spec.periodic.clone();
+    Ok(out)
+}
+
+/// The world rotation of `model`'s base frame (the chain's first frame) at `params`.
+fn base_rotation(model: &Model, params: &[f64]) -> Matrix3<f64> {
+    let mut data = Data::<f64>::without_corrections(model);
+    forward_kinematics(model, &mut data, params, &vec![0.0; model.dof()]);
+    data.frames[0].rot
 }
 
 /// Exported values a user should look at before loading the cell: lengths beyond twice the

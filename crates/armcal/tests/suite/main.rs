@@ -73,6 +73,7 @@ mod hostile {
     mod cell_values;
     mod input_size;
     mod report_ranges;
+    mod stations;
     mod urdf_depth;
     mod urdf_parser_panic;
 }

@@ -69,6 +69,16 @@ pub(super) fn unit_value(
     }
 }
 
+/// A required number with a unit suffix and nothing else in `t` (`{ sigma_mm = 0.1 }`), in
+/// internal units; the error names the spellings.
+pub(super) fn sole_unit_value(t: &toml::Table, key: &str, unit: Unit) -> Result<f64, String> {
+    let mut used = Vec::new();
+    let spellings = unit_spellings(key, unit);
+    let v = unit_value(t, key, unit, &mut used)?.ok_or_else(|| format!("missing `{spellings}`"))?;
+    check_unused(t, &used, &[], &[spellings])?;
+    Ok(v)
+}
+
 /// Three numbers with a unit suffix (see [`find_with_unit`]), in internal units.
 pub(super) fn unit_triple(
     t: &toml::Table,

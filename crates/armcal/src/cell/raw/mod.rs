@@ -91,6 +91,10 @@ struct RawParameters {
     compliance: Option<Vec<String>>,
     /// Periodic joint errors ([`crate::model::periodic`]).
     periodic: Option<RawPeriodic>,
+    /// Values of the compliance and periodic terms, `{ "j2.compliance.elbow" = {
+    /// value_urad_per_m = 120 } }` (an exported calibration); default 0.
+    #[serde(default)]
+    values: BTreeMap<String, toml::Table>,
 }
 
 /// `periodic = { joints = ["j1", "j2"], harmonics = [1, 2] }`.

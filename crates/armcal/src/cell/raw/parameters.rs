@@ -76,14 +76,7 @@ pub(super) fn parameters(
                     ),
                 ));
             }
-            let mut used = Vec::new();
-            let s = unit_value(t, "sigma", unit, &mut used)
-                .and_then(|v| {
-                    v.ok_or_else(|| format!("missing `{}`", unit_spellings("sigma", unit)))
-                })
-                .and_then(|v| {
-                    check_unused(t, &used, &[], &[unit_spellings("sigma", unit)]).map(|_| v)
-                })
+            let s = sole_unit_value(t, "sigma", unit)
                 .map_err(|e| ctx.err(span.clone(), &format!("parameters.priors.{name}"), e))?;
             if s <= 0.0 {
                 return Err(ctx.err(
@@ -136,7 +129,15 @@ pub(super) fn joint_corrections(
     let span = p.span();
     let p = p.get_ref();
     if p.compliance.is_none() && p.periodic.is_none() {
-        return Ok(());
+        return match p.values.keys().next() {
+            Some(name) => Err(ctx.err(
+                span,
+                &format!("parameters.values.{name}"),
+                "`values` sets compliance and periodic terms, and this cell has none: add \
+                 `compliance` or `periodic` to [parameters]",
+            )),
+            None => Ok(()),
+        };
     }
     let mut spec = model.spec();
     if let Some(joints) = &p.compliance {
@@ -149,6 +150,46 @@ pub(super) fn joint_corrections(
             .map_err(|e| ctx.err(span.clone(), "parameters.periodic", e))?;
         spec.periodic = Some(t);
     }
+    let names = term_names(&spec);
+    for (name, t) in &p.values {
+        let field = format!("parameters.values.{name}");
+        let (unit, value) = term_value(&mut spec, name).ok_or_else(|| {
+            ctx.err(
+                span.clone(),
+                &field,
+                format!(
+                    "not a compliance or periodic term of this cell; they are: {}",
+                    names.join(", ")
+                ),
+            )
+        })?;
+        *value = sole_unit_value(t, "value", unit).map_err(|e| ctx.err(span.clone(), &field, e))?;
+    }
     *model = Model::from_spec(&spec).map_err(|e| ctx.err(span, "parameters", e))?;
     Ok(())
+}
+
+/// The unit and value slot of the joint-correction term `name` in `spec`.
+fn term_value<'a>(spec: &'a mut ModelSpec, name: &str) -> Option<(Unit, &'a mut f64)> {
+    let compliance = spec.compliance.iter_mut().flat_map(|c| c.terms.iter_mut());
+    let periodic = spec.periodic.iter_mut().flat_map(|p| p.terms.iter_mut());
+    compliance
+        .filter(|t| ComplianceSpec::parameter_name(t) == name)
+        .map(|t| (Unit::RadPerMm, &mut t.value))
+        .chain(
+            periodic
+                .filter(|t| PeriodicSpec::parameter_name(t) == name)
+                .map(|t| (Unit::Arcsec, &mut t.value)),
+        )
+        .next()
+}
+
+/// The names of `spec`'s joint-correction terms.
+fn term_names(spec: &ModelSpec) -> Vec<String> {
+    let compliance = spec.compliance.iter().flat_map(|c| &c.terms);
+    let periodic = spec.periodic.iter().flat_map(|p| &p.terms);
+    compliance
+        .map(ComplianceSpec::parameter_name)
+        .chain(periodic.map(PeriodicSpec::parameter_name))
+        .collect()
 }

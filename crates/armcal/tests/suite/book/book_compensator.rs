@@ -175,7 +175,7 @@ fn lqr_is_the_one_step_damped_step_on_the_puma560() {
         let reference = *data.tool();
         let b = joint_jacobian(&data, Observed::Tool);
         let mut jw = [nalgebra::Vector6::zeros(); 6];
-        task_jacobian_columns(&data, length, &mut jw);
+        task_jacobian_columns(&data, length, &mut jw, &mut []);
         // Initial error x_c: the truth robot's pose at q0 minus the nominal pose (eq. 5.140).
         let x_c = world_pose_error(&tool_pose(&model, &truth, q0), &reference);
         for gamma2 in [1e-4, 1.0, 1e3] {

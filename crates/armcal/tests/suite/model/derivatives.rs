@@ -89,6 +89,40 @@ fn joint_jacobian_matches_finite_differences() {
 }
 
 #[test]
+fn calibrated_ik_steps_with_the_joint_jacobian_of_the_commanded_joints() {
+    // Calibrated IK's task columns (position rows, rotation rows scaled by L) are the joint
+    // Jacobian above, finite-difference checked: with compliance and periodic errors, the
+    // chain rule through q + Δq(q) included (issue 14, compensation with the deflection).
+    use armcal::compensate::ik::task_jacobian_columns;
+    use nalgebra::Vector6;
+    let length = 800.0;
+    for seed in 0..3 {
+        for model in derivative_models(seed) {
+            let mut r = rng(250 + seed);
+            let q = random_q(&model, &mut r);
+            let mut data = Data::new(&model);
+            forward_kinematics(&model, &mut data, &model.nominal(), &q);
+            let jq = joint_jacobian(&data, Observed::Tool);
+            let n = model.dof();
+            let (mut columns, mut corrected) =
+                (vec![Vector6::zeros(); n], vec![Vector6::zeros(); n]);
+            task_jacobian_columns(&data, length, &mut columns, &mut corrected);
+            for (k, c) in columns.iter().enumerate() {
+                for row in 0..6 {
+                    let scale = if row < 3 { 1.0 } else { length };
+                    assert_close(
+                        c[row],
+                        jq[(row, k)] * scale,
+                        1e-12,
+                        &format!("seed {seed} task column {k} row {row}"),
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
 fn mixed_derivative_matches_finite_differences_of_jacobian() {
     for seed in 0..3 {
         for model in derivative_models(seed) {
