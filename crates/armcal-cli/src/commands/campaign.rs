@@ -60,6 +60,7 @@ impl Target {
             budget: self.budget,
             seed,
             planner: Planner::Kpi,
+            prior: None,
         }
     }
 
@@ -162,14 +163,14 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
 }
 
 /// The campaign's files in `dir`.
-struct Files {
-    state: PathBuf,
-    next: PathBuf,
-    estimate: PathBuf,
+pub(super) struct Files {
+    pub(super) state: PathBuf,
+    pub(super) next: PathBuf,
+    pub(super) estimate: PathBuf,
 }
 
 impl Files {
-    fn of(dir: &Path) -> Files {
+    pub(super) fn of(dir: &Path) -> Files {
         Files {
             state: dir.join("campaign.json"),
             next: dir.join("next.csv"),
@@ -259,23 +260,38 @@ fn run_step(a: &StepArgs) -> anyhow::Result<()> {
     let cell = load_cell(&state.cell_source)?;
     let batch = load_data(&cell, &a.data)?;
     let r = campaign::step(&cell, &state, &batch, &mut Progress::new(a.quiet))?;
-    let state_json = r.state.to_json()?;
-    let next = next_csv(&cell, &r.state);
-    let mut written = vec![
-        (files.state.as_path(), state_json.as_str()),
-        (files.next.as_path(), next.as_str()),
-    ];
-    let estimate = r
-        .estimate
-        .as_ref()
-        .map(serde_json::to_string_pretty)
-        .transpose()?;
-    written.extend(estimate.as_deref().map(|e| (files.estimate.as_path(), e)));
-    outputs.commit(&written)?;
-    let last = r.state.steps.last().expect("a step");
-    print_step(r.state.steps.len(), last);
-    print_decision(&r.state, &files);
+    let written = step_files(&cell, &r, &files)?;
+    let refs: Vec<(&Path, &str)> = written
+        .iter()
+        .map(|(p, t)| (p.as_path(), t.as_str()))
+        .collect();
+    outputs.commit(&refs)?;
+    print_last_step(&r.state, &files);
     Ok(())
+}
+
+/// What a step writes into the campaign's directory: the state, `next.csv` and (with a
+/// fit) the estimate.
+pub(super) fn step_files(
+    cell: &armcal::Cell,
+    r: &campaign::StepResult,
+    files: &Files,
+) -> anyhow::Result<Vec<(PathBuf, String)>> {
+    let mut written = vec![
+        (files.state.clone(), r.state.to_json()?),
+        (files.next.clone(), next_csv(cell, &r.state)),
+    ];
+    if let Some(e) = &r.estimate {
+        written.push((files.estimate.clone(), serde_json::to_string_pretty(e)?));
+    }
+    Ok(written)
+}
+
+/// The last step of `state` and the decision, as `campaign step` prints them.
+pub(super) fn print_last_step(state: &CampaignState, files: &Files) {
+    let last = state.steps.last().expect("a step");
+    print_step(state.steps.len(), last);
+    print_decision(state, files);
 }
 
 fn mm_list(v: &[f64]) -> String {

@@ -2,10 +2,14 @@
 //! calibrated model's prediction (χ² with its p-value) and, per parameter group, which
 //! parameters most likely moved (a score test).
 
+use super::campaign::{print_last_step, step_files, Files};
 use super::output::{
     load_cell, load_data, load_estimate, with_note, AcceptUnconverged, NoteStyle, Outputs,
 };
 use armcal::campaign::drift::{check, CheckSettings, DriftVerdict};
+use armcal::campaign::prior::CampaignPrior;
+use armcal::campaign::{self, CampaignSettings};
+use armcal::progress::Silent;
 use std::path::{Path, PathBuf};
 
 /// Groups printed, smallest p-value first (the record holds them all).
@@ -33,22 +37,78 @@ pub struct Args {
     pub force: bool,
     #[command(flatten)]
     pub accept: AcceptUnconverged,
+    /// When the check says "drifted", start a re-identification campaign in DIR: the old
+    /// estimate is the prior, the groups that moved are released from it, and the check
+    /// poses are its first step (writes DIR/campaign.json, DIR/next.csv,
+    /// DIR/estimate.json); then `armcal campaign step DIR --data …`.
+    #[arg(long, value_name = "DIR", requires = "target_sigma_mm")]
+    pub campaign: Option<PathBuf>,
+    /// The campaign's target: every working pose's TCP σ at or below this (mm).
+    #[arg(long, requires = "campaign")]
+    pub target_sigma_mm: Option<f64>,
+    /// Groups to release from the prior, comma-separated (`j2,tracker`); default: the
+    /// groups whose score test rejects at α (at least the first).
+    #[arg(long, value_delimiter = ',', requires = "campaign")]
+    pub release: Vec<String>,
+    /// The campaign's poses per batch.
+    #[arg(long, default_value_t = 5, requires = "campaign")]
+    pub batch: usize,
+    /// The campaign's most poses in all, the check poses included.
+    #[arg(long, requires = "campaign")]
+    pub budget: Option<usize>,
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
+    let files = a.campaign.as_deref().map(Files::of);
+    let mut planned: Vec<&Path> = vec![&a.out];
+    if let Some(f) = &files {
+        planned.extend([f.state.as_path(), f.next.as_path(), f.estimate.as_path()]);
+    }
     let outputs = Outputs::plan(
         a.force,
         &[Path::new(&a.cell), &a.estimate, &a.data],
-        &[&a.out],
+        &planned,
     )?;
     let cell = load_cell(&a.cell)?;
     let (est, note) = load_estimate(&a.estimate, &a.accept, Some(&cell.model))?;
     let data = load_data(&cell, &a.data)?;
     let c = check(&cell, &est, &data, &CheckSettings { alpha: a.alpha })?;
-    outputs.commit(&[(
-        &a.out,
-        &with_note(c.to_json()?, note.as_deref(), NoteStyle::Json),
-    )])?;
+    let mut written = vec![(
+        a.out.clone(),
+        with_note(c.to_json()?, note.as_deref(), NoteStyle::Json),
+    )];
+    let started = match (&files, a.target_sigma_mm) {
+        (Some(f), Some(target)) if c.verdict == DriftVerdict::Drifted => {
+            let release = if a.release.is_empty() {
+                c.moved_groups()
+            } else {
+                a.release.clone()
+            };
+            let source = a.estimate.display().to_string();
+            let settings = CampaignSettings {
+                target_sigma_mm: target,
+                batch: a.batch,
+                budget: a.budget,
+                prior: Some(CampaignPrior::from_estimate(
+                    &cell, &est, &source, &release,
+                )?),
+                ..CampaignSettings::default()
+            };
+            let cell_source = std::fs::canonicalize(&a.cell)
+                .map(|p| p.display().to_string())
+                .unwrap_or_else(|_| a.cell.clone());
+            let r =
+                campaign::start_after_check(&cell, &cell_source, &settings, &data, &mut Silent)?;
+            written.extend(step_files(&cell, &r, f)?);
+            Some((r.state, release))
+        }
+        _ => None,
+    };
+    let refs: Vec<(&Path, &str)> = written
+        .iter()
+        .map(|(p, t)| (p.as_path(), t.as_str()))
+        .collect();
+    outputs.commit(&refs)?;
     println!(
         "check of {} poses ({} residual components) against {}",
         c.poses,
@@ -84,6 +144,18 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         );
     }
     println!("→ {}", a.out.display());
+    match (&started, &files) {
+        (Some((state, release)), Some(f)) => {
+            println!(
+                "campaign from {} (prior: its estimate and covariance; released: {}), the check poses its first step:",
+                a.estimate.display(),
+                release.join(", ")
+            );
+            print_last_step(state, f);
+        }
+        (None, Some(_)) => println!("consistent: no campaign started"),
+        _ => {}
+    }
     Ok(())
 }
 

@@ -40,8 +40,8 @@ fn check_prints_its_verdict_writes_its_record_and_refuses_a_bad_file() {
         &check_data,
     ]);
     assert!(ok, "{err}");
-    let check = |data: &str, out: &str| {
-        armcal(&[
+    let check_with = |data: &str, out: &str, extra: &[&str]| {
+        let mut args = vec![
             "check",
             "--cell",
             "examples/paper-cell.toml",
@@ -51,9 +51,11 @@ fn check_prints_its_verdict_writes_its_record_and_refuses_a_bad_file() {
             data,
             "--out",
             out,
-            "--force",
-        ])
+        ];
+        args.extend_from_slice(extra);
+        armcal(&args)
     };
+    let check = |data: &str, out: &str| check_with(data, out, &["--force"]);
     let (ok, out, err) = check(&check_data, &record);
     assert!(ok, "{err}");
     assert!(
@@ -96,6 +98,30 @@ fn check_prints_its_verdict_writes_its_record_and_refuses_a_bad_file() {
         .nth(1)
         .unwrap();
     assert!(first.trim_start().starts_with("tracker"), "{out}");
+
+    // With --campaign: a consistent check starts nothing; the drifted one starts a
+    // campaign with the old estimate as prior, the tracker released, the check poses its
+    // first step, and `campaign status` reads it.
+    let with_campaign = |data: &str, out: &str, dir: &str| {
+        check_with(data, out, &["--campaign", dir, "--target-sigma-mm", "0.3"])
+    };
+    let (ok, out, err) = with_campaign(&check_data, &p("c1.json"), &p("none"));
+    assert!(ok, "{err}");
+    assert!(out.contains("no campaign started"), "{out}");
+    assert!(!dir.join("none").exists());
+    let (ok, out, err) = with_campaign(&moved_path, &p("c2.json"), &p("again"));
+    assert!(ok, "{err}");
+    assert!(out.contains("released: tracker"), "{out}");
+    assert!(out.contains("step 1: 10 poses measured (+10)"), "{out}");
+    let state: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("again/campaign.json")).unwrap())
+            .unwrap();
+    assert_eq!(state["settings"]["prior"]["released"][0], "tracker");
+    assert!(dir.join("again/estimate.json").exists());
+    let (ok, out, err) = armcal(&["campaign", "status", &p("again")]);
+    assert!(ok, "{err}");
+    assert!(out.contains("10"), "{out}");
+    eprintln!("{out}");
 
     // A check file with a broken number: file and line.
     let mut bad: Vec<String> = text.lines().map(String::from).collect();

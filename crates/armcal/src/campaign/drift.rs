@@ -118,6 +118,23 @@ pub struct DriftCheck {
 }
 
 impl DriftCheck {
+    /// The groups that most likely moved: every group whose score test rejects "did not
+    /// move" at the check's α, and at least the first when the check says "drifted" (the
+    /// groups a campaign after the check releases from the old estimate's prior,
+    /// [`crate::campaign::prior`]). Empty for a consistent check without such a group.
+    pub fn moved_groups(&self) -> Vec<String> {
+        let mut moved: Vec<String> = self
+            .groups
+            .iter()
+            .filter(|g| g.p_value < self.alpha)
+            .map(|g| g.group.clone())
+            .collect();
+        if moved.is_empty() && self.verdict == DriftVerdict::Drifted {
+            moved.extend(self.groups.first().map(|g| g.group.clone()));
+        }
+        moved
+    }
+
     /// The record as JSON (keys in alphabetical order, see [`crate::json`]).
     pub fn to_json(&self) -> Result<String, Error> {
         crate::json::sorted_pretty(self)

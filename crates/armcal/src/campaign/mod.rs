@@ -12,6 +12,7 @@
 
 pub mod drift;
 pub mod precision;
+pub mod prior;
 pub mod simulate;
 pub mod state;
 pub mod study;
@@ -51,6 +52,96 @@ pub fn start(
     settings: &CampaignSettings,
     observer: &mut dyn Observer,
 ) -> Result<CampaignState, Error> {
+    check_settings(cell, settings)?;
+    if settings.prior.is_some() {
+        return Err(Error::Input(
+            "a campaign with a prior starts from the check poses that found the drift \
+             (`start_after_check`)"
+                .into(),
+        ));
+    }
+    let first = fewest_poses(cell)?;
+    if let Some(b) = settings.budget {
+        if b < first {
+            return Err(Error::Input(format!(
+                "a budget of {b} poses cannot identify the {} free parameters of `{}`: the first batch alone needs {first} poses",
+                DesignModel::from_cell(cell)?.n(),
+                cell.name
+            )));
+        }
+    }
+    let qs = plan_batch(cell, settings, &[], first, 0, observer)?;
+    let first_predicted_sigma_mm = predicted_sigmas(cell, &qs, 1.0)?;
+    Ok(initial_state(
+        cell,
+        cell_source,
+        settings,
+        numbered(cell, &qs, 0),
+        first_predicted_sigma_mm,
+    ))
+}
+
+/// Starts a campaign from an earlier calibration after a drift check (issue 16 item 2):
+/// `settings.prior` holds the old estimate as a prior ([`prior::CampaignPrior`]) and the
+/// check measurements `check` are the first step, so the fit, the TCP precision and the
+/// decision come at once; the next batch is planned given the check poses and the prior.
+pub fn start_after_check(
+    cell: &Cell,
+    cell_source: &str,
+    settings: &CampaignSettings,
+    check: &Dataset,
+    observer: &mut dyn Observer,
+) -> Result<StepResult, Error> {
+    check_settings(cell, settings)?;
+    let Some(prior) = &settings.prior else {
+        return Err(Error::Input(
+            "a campaign after a drift check needs the old estimate as its prior".into(),
+        ));
+    };
+    let at = prior.apply(cell)?;
+    let poses: Vec<CampaignPose> = check
+        .config_ids
+        .iter()
+        .zip(&check.configurations)
+        .map(|(id, q)| CampaignPose::of(&cell.model, id.clone(), q))
+        .collect();
+    let predicted = predicted_sigmas(&at, &check.configurations, 1.0)?;
+    let state = initial_state(cell, cell_source, settings, poses, predicted);
+    step(cell, &state, check, observer)
+}
+
+/// The state of a campaign about to measure its first batch `next` (predicted σ
+/// `first_predicted_sigma_mm` once measured).
+fn initial_state(
+    cell: &Cell,
+    cell_source: &str,
+    settings: &CampaignSettings,
+    next: Vec<CampaignPose>,
+    first_predicted_sigma_mm: Vec<f64>,
+) -> CampaignState {
+    CampaignState {
+        campaign: "adaptive".into(),
+        cell: cell.name.clone(),
+        cell_source: cell_source.into(),
+        fingerprint: ModelFingerprint::of(&cell.model),
+        settings: settings.clone(),
+        sigma_definition: precision::SIGMA_DEFINITION.into(),
+        confidence: precision::CONFIDENCE,
+        chi2_quantile: precision::chi2_quantile(),
+        variance_rule: precision::VARIANCE_RULE.into(),
+        first_batch: next.len(),
+        first_predicted_sigma_mm,
+        working: cell.working.iter().map(|w| w.name.clone()).collect(),
+        steps: Vec::new(),
+        next,
+        decision: Decision::Measure,
+        simulation_seed: None,
+    }
+}
+
+/// Checks a campaign's settings against its cell: a positive target, a batch of at least
+/// one pose, and a working pose to reach it at.
+fn check_settings(cell: &Cell, settings: &CampaignSettings) -> Result<(), Error> {
     if !(settings.target_sigma_mm > 0.0 && settings.target_sigma_mm.is_finite()) {
         return Err(Error::Input(format!(
             "the target TCP σ must be a positive number of mm, not {}",
@@ -68,36 +159,7 @@ pub fn start(
             cell.name
         )));
     }
-    let first = fewest_poses(cell)?;
-    if let Some(b) = settings.budget {
-        if b < first {
-            return Err(Error::Input(format!(
-                "a budget of {b} poses cannot identify the {} free parameters of `{}`: the first batch alone needs {first} poses",
-                DesignModel::from_cell(cell)?.n(),
-                cell.name
-            )));
-        }
-    }
-    let qs = plan_batch(cell, settings, &[], first, 0, observer)?;
-    let first_predicted_sigma_mm = predicted_sigmas(cell, &qs, 1.0)?;
-    Ok(CampaignState {
-        campaign: "adaptive".into(),
-        cell: cell.name.clone(),
-        cell_source: cell_source.into(),
-        fingerprint: ModelFingerprint::of(&cell.model),
-        settings: settings.clone(),
-        sigma_definition: precision::SIGMA_DEFINITION.into(),
-        confidence: precision::CONFIDENCE,
-        chi2_quantile: precision::chi2_quantile(),
-        variance_rule: precision::VARIANCE_RULE.into(),
-        first_batch: first,
-        first_predicted_sigma_mm,
-        working: cell.working.iter().map(|w| w.name.clone()).collect(),
-        steps: Vec::new(),
-        next: numbered(cell, &qs, 0),
-        decision: Decision::Measure,
-        simulation_seed: None,
-    })
+    Ok(())
 }
 
 /// `cell` with the instrument and target frames of its model at `params` (every parameter
@@ -279,6 +341,16 @@ pub fn step(
         )));
     }
     check_batch(cell, state, batch)?;
+    // a campaign from an earlier calibration fits the old free set with the old estimate
+    // as prior (`prior`)
+    let with_prior;
+    let fit_cell = match &state.settings.prior {
+        Some(p) => {
+            with_prior = p.apply(cell)?;
+            &with_prior
+        }
+        None => cell,
+    };
     let mut data = state.data();
     data.append(batch);
     data.source = format!(
@@ -286,13 +358,18 @@ pub fn step(
         data.configurations.len(),
         state.steps.len() + 1
     );
-    let warm = state.warm_start().map(<[f64]>::to_vec);
+    let warm = state
+        .warm_start()
+        .or(state.settings.prior.as_ref().map(|p| p.params.as_slice()))
+        .map(<[f64]>::to_vec);
     let settings = IdentifySettings {
         start: warm.clone(),
         ..IdentifySettings::default()
     };
-    let (estimate, fit, fit_error, working) = match identify(cell, &data, &settings, observer) {
-        Ok(e) => {
+    let (estimate, fit, fit_error, working) = match identify(fit_cell, &data, &settings, observer) {
+        Ok(mut e) => {
+            // the estimate is of the campaign's cell, whatever prior the fit had
+            e.fingerprint = Some(ModelFingerprint::of(&cell.model));
             let s = precision::scale(&e);
             let params = e.params_for(&cell.model)?;
             let fit = FitSummary {
@@ -371,7 +448,7 @@ pub fn step(
             .filter(|f| f.status.is_converged())
             .map(|f| f.params.as_slice())
             .or(state.warm_start());
-        let at = cell_at(cell, latest);
+        let at = cell_at(fit_cell, latest);
         let qs = plan_batch(&at, &state.settings, &data.configurations, n, k, observer)?;
         let mut all = data.configurations.clone();
         all.extend(qs.iter().cloned());

@@ -39,16 +39,36 @@ pub fn simulate(
     let mut settings = settings.clone();
     settings.budget = Some(settings.budget.unwrap_or(2_000));
     let truth = perturbed_truth(model, perturbation, seed);
-    let noise = cell.noise();
     let mut state = start(cell, cell_source, &settings, observer)?;
     state.simulation_seed = Some(seed);
-    let mut estimate = None;
+    let (state, estimate) = measure_until_stopped(cell, state, None, &truth, seed, observer)?;
+    Ok(SimulatedCampaign {
+        truth: TruthRecord::new(&cell.name, model, &truth, seed),
+        state,
+        estimate,
+    })
+}
+
+/// Measures the poses `state` asks for on the robot `truth` with the cell's instrument
+/// noise (batch `k` with noise seed `seed · 1000 + k`) and steps until the campaign stops;
+/// every step records the true TCP error at the working poses. `estimate`: the estimate of
+/// the state's last step, if any. Returns the final state and the last fit's estimate.
+pub fn measure_until_stopped(
+    cell: &Cell,
+    mut state: CampaignState,
+    mut estimate: Option<Estimate>,
+    truth: &[f64],
+    seed: u64,
+    observer: &mut dyn Observer,
+) -> Result<(CampaignState, Option<Estimate>), Error> {
+    let model = &cell.model;
+    let noise = cell.noise();
     while state.decision == Decision::Measure {
         let k = state.steps.len() as u64 + 1;
         let qs: Vec<Vec<f64>> = state.next.iter().map(|p| p.q(model)).collect();
         let mut batch = crate::sim::simulate(
             model,
-            &truth,
+            truth,
             &qs,
             Some(&noise),
             seed.wrapping_mul(1000).wrapping_add(k),
@@ -61,15 +81,11 @@ pub fn simulate(
             let params = e.params_for(model)?;
             for (w, working) in last.working.iter_mut().zip(&cell.working) {
                 let err = tcp_position(model, &params, &working.q)
-                    - tcp_position(model, &truth, &working.q);
+                    - tcp_position(model, truth, &working.q);
                 *w = w.clone().with_true_error(err);
             }
         }
         estimate = r.estimate.or(estimate);
     }
-    Ok(SimulatedCampaign {
-        truth: TruthRecord::new(&cell.name, model, &truth, seed),
-        state,
-        estimate,
-    })
+    Ok((state, estimate))
 }

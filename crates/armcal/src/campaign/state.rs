@@ -3,6 +3,7 @@
 //! draw its σ-vs-poses curve.
 
 use crate::campaign::precision::WorkingSigma;
+use crate::campaign::prior::CampaignPrior;
 use crate::identify::ModelFingerprint;
 use crate::measure::Dataset;
 use crate::model::Model;
@@ -34,6 +35,10 @@ pub struct CampaignSettings {
     pub seed: u64,
     /// How batches are chosen.
     pub planner: Planner,
+    /// The earlier calibration the campaign starts from, as a prior (a campaign after a
+    /// drift check, [`crate::campaign::prior`]); `None`: from the cell's nominal model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub prior: Option<CampaignPrior>,
 }
 
 impl Default for CampaignSettings {
@@ -44,6 +49,7 @@ impl Default for CampaignSettings {
             budget: None,
             seed: 1,
             planner: Planner::Kpi,
+            prior: None,
         }
     }
 }

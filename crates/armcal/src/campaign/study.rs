@@ -216,6 +216,7 @@ fn campaign_run(
             budget: Some(settings.budget),
             seed,
             planner,
+            prior: None,
         },
         &Perturbation::default(),
         seed,

@@ -86,7 +86,8 @@ pub fn path_precision(cell: &Cell, d: &DesignModel, cp: &DMatrix<f64>) -> Vec<Pa
 pub fn assess(cell: &Cell, design: &[Vec<f64>]) -> Result<DesignAssessment, Error> {
     let d = DesignModel::from_cell(cell)?;
     let mut ws = InformationWorkspace::new(&d);
-    let mut j = DMatrix::zeros(d.rows() * design.len(), d.n());
+    let data_rows = d.rows() * design.len();
+    let mut j = DMatrix::zeros(data_rows + d.prior_rows.nrows(), d.n());
     for (i, q) in design.iter().enumerate() {
         d.model
             .check_joints(q)
@@ -94,6 +95,9 @@ pub fn assess(cell: &Cell, design: &[Vec<f64>]) -> Result<DesignAssessment, Erro
         d.jacobian(&mut ws, q);
         j.rows_mut(i * d.rows(), d.rows()).copy_from(&ws.jac);
     }
+    // the cell's prior information, after the poses' rows
+    j.rows_mut(data_rows, d.prior_rows.nrows())
+        .copy_from(&d.prior_rows);
     let names: Vec<String> = d
         .free
         .iter()
@@ -123,7 +127,7 @@ pub fn assess(cell: &Cell, design: &[Vec<f64>]) -> Result<DesignAssessment, Erro
         sigma: unc.sigma,
         c_p: unc.covariance,
         tcp,
-        observability: uncertainty::observability(j.as_view()),
+        observability: uncertainty::observability(j.rows(0, data_rows)),
         criteria,
     })
 }

@@ -33,6 +33,9 @@ pub struct DesignModel {
     pub kpi_rows: DMatrix<f64>,
     /// Weight of each KPI configuration in the mean KPI.
     pub kpi_weights: Vec<f64>,
+    /// The cell's prior information over the free columns, as whitened rows
+    /// ([`crate::model::prior::prior_rows`]): part of every design's information.
+    pub prior_rows: DMatrix<f64>,
 }
 
 impl DesignModel {
@@ -75,6 +78,7 @@ impl DesignModel {
                 ))
             }
         };
+        let prior_rows = crate::model::prior::prior_rows(&model.registry, &free)?.0;
         Ok(DesignModel {
             model,
             params,
@@ -83,6 +87,7 @@ impl DesignModel {
             sigma,
             kpi_rows,
             kpi_weights: kpi.iter().map(|(_, w)| *w).collect(),
+            prior_rows,
         })
     }
 

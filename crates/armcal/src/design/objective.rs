@@ -21,7 +21,8 @@ pub struct DesignObjective<'a> {
     pub design: &'a DesignModel,
     /// The criterion φ minimised.
     pub criterion: Criterion,
-    /// Whitened Jacobian rows of configurations already measured (design augmentation).
+    /// Whitened Jacobian rows of configurations already measured (design augmentation),
+    /// then the cell's prior rows ([`DesignModel::prior_rows`]).
     pub prior_rows: DMatrix<f64>,
     /// Identity of this objective (see [`ObjectiveWorkspace`]).
     id: u64,
@@ -49,15 +50,20 @@ pub struct ObjectiveWorkspace {
 
 impl<'a> DesignObjective<'a> {
     /// φ of `criterion` on `design`, with the configurations `measured` already taken as the
-    /// prior information `M₀ = Σ J_iᵀWJ_i` (design augmentation).
+    /// prior information `M₀ = Σ J_iᵀWJ_i` (design augmentation), plus the cell's prior
+    /// information (`W_pᵀW_p`, [`DesignModel::prior_rows`]).
     pub fn new(design: &'a DesignModel, criterion: Criterion, measured: &[Vec<f64>]) -> Self {
         let mut ws = InformationWorkspace::new(design);
         let rows = design.rows();
-        let mut prior_rows = DMatrix::zeros(rows * measured.len(), design.n());
+        let cell_prior = design.prior_rows.nrows();
+        let mut prior_rows = DMatrix::zeros(rows * measured.len() + cell_prior, design.n());
         for (i, q) in measured.iter().enumerate() {
             design.jacobian(&mut ws, q);
             prior_rows.rows_mut(i * rows, rows).copy_from(&ws.jac);
         }
+        prior_rows
+            .rows_mut(rows * measured.len(), cell_prior)
+            .copy_from(&design.prior_rows);
         DesignObjective {
             design,
             criterion,

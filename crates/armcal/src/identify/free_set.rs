@@ -132,7 +132,7 @@ fn least_separable(
     let names = problem.free_names();
     let unc =
         uncertainty::parameter_uncertainty(&solution.jacobian, &solution.residual, &names).ok()?;
-    let data_rows = solution.jacobian.nrows() - problem.priors.len();
+    let data_rows = problem.data_rows();
     let gate = nongeometric_gate::nongeometric_gate(
         model,
         &problem.free,

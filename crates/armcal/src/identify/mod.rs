@@ -346,7 +346,7 @@ pub fn identify(
     let noise = cell.noise();
     let split = Split::of(data, opts)?;
     let train: &Dataset = &split.train;
-    crate::model::station::check_stations(data)?;
+    crate::measure::stations::check_stations(data)?;
     let stationed = cell.with_stations(&data.stations)?;
     let (left_out, choice) = match opts.nongeometric {
         NonGeometric::AsCell => (Vec::new(), None),
@@ -428,7 +428,7 @@ fn estimate_of_fit(
             .collect();
         (cs, blocks)
     };
-    let data_rows = sol.jacobian.nrows() - problem.priors.len();
+    let data_rows = problem.data_rows();
     let nongeometric = nongeometric_gate::nongeometric_gate(
         model,
         &problem.free,

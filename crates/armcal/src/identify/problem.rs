@@ -4,22 +4,12 @@
 
 use crate::measure::residual::{residual_rows, Prediction};
 use crate::measure::{Dataset, MeasurementKind, NoiseModel};
+use crate::model::prior::prior_rows;
 use crate::model::{
-    forward_kinematics, identification_jacobian, observed_pose, Data, Model, Observed, Rows, Status,
+    forward_kinematics, identification_jacobian, observed_pose, Data, Model, Observed, Rows,
 };
 use crate::Error;
 use nalgebra::{DMatrix, DVector};
-
-/// A parameter with a Gaussian prior: residual row `(p − nominal)/σ` (MAP estimation).
-#[derive(Clone, Debug)]
-pub struct Prior {
-    /// Column (index into the free set).
-    pub column: usize,
-    /// Prior mean: the parameter's nominal value (internal units: mm, rad).
-    pub mean: f64,
-    /// Prior standard deviation (internal units: mm, rad).
-    pub sigma: f64,
-}
 
 /// Data of an identification problem; immutable, shareable.
 #[derive(Clone, Debug)]
@@ -30,8 +20,11 @@ pub struct Problem<'a> {
     pub data: &'a Dataset,
     /// Parameter index of each estimated column.
     pub free: Vec<usize>,
-    /// Prior rows, appended after the data rows in this order.
-    pub priors: Vec<Prior>,
+    /// Prior rows `W` over the free columns, appended after the data rows: the prior adds
+    /// `W p_free − prior_offset` to the residual ([`crate::model::prior`]).
+    pub prior_rows: DMatrix<f64>,
+    /// `W μ` of the prior rows.
+    pub prior_offset: DVector<f64>,
     /// σ of every data row, in row order.
     pub sigmas: Vec<f64>,
     /// First row of each measurement.
@@ -137,23 +130,15 @@ impl<'a> Problem<'a> {
             let s = noise.sigmas(m, range)?;
             sigmas.extend_from_slice(&s[..m.kind.rows()]);
         }
-        let mut priors = Vec::new();
-        for (column, &i) in free.iter().enumerate() {
-            if let Status::Prior { sigma } = model.registry.get(i).status {
-                priors.push(Prior {
-                    column,
-                    mean: model.registry.get(i).nominal,
-                    sigma,
-                });
-            }
-        }
+        let (prior_rows, prior_offset) = prior_rows(&model.registry, &free)?;
         let rows = sigmas.len();
         let (by_config, config_start) = group_by_config(data);
         Ok(Problem {
             model,
             data,
             free,
-            priors,
+            prior_rows,
+            prior_offset,
             sigmas,
             row_of,
             slots,
@@ -207,7 +192,7 @@ impl<'a> Problem<'a> {
 
     /// Rows of the whitened residual (data rows + prior rows).
     pub fn rows(&self) -> usize {
-        self.sigmas.len() + self.priors.len()
+        self.sigmas.len() + self.prior_rows.nrows()
     }
 
     /// Number of data rows (without priors).
@@ -330,11 +315,17 @@ impl<'a> Problem<'a> {
             }
         });
         let n = self.sigmas.len();
-        for (k, pr) in self.priors.iter().enumerate() {
-            r[n + k] = (params[self.free[pr.column]] - pr.mean) / pr.sigma;
+        for k in 0..self.prior_rows.nrows() {
+            let w = self.prior_rows.row(k);
+            r[n + k] = self
+                .free
+                .iter()
+                .zip(w.iter())
+                .map(|(&i, x)| x * params[i])
+                .sum::<f64>()
+                - self.prior_offset[k];
             if with_j {
-                jac.row_mut(n + k).fill(0.0);
-                jac[(n + k, pr.column)] = 1.0 / pr.sigma;
+                jac.row_mut(n + k).copy_from(&w);
             }
         }
     }

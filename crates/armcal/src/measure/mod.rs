@@ -14,6 +14,7 @@ pub mod csv;
 pub mod format;
 pub mod noise;
 pub mod residual;
+pub mod stations;
 
 pub use noise::NoiseModel;
 

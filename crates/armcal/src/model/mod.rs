@@ -15,6 +15,7 @@ pub mod kinematics;
 pub mod link;
 pub mod periodic;
 pub mod pose;
+pub mod prior;
 pub mod rank_deficit;
 pub mod registry;
 pub mod sampling;

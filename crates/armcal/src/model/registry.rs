@@ -2,6 +2,7 @@
 //! `tracker.x`, `smr1.y`), a unit, a nominal value and a status. Parameter vectors are
 //! indexed through the registry. Internal units are millimetres and radians.
 
+use crate::model::prior::CorrelatedPrior;
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::fmt;
@@ -139,6 +140,10 @@ pub struct Registry {
     params: Vec<Parameter>,
     #[serde(skip)]
     index: HashMap<String, usize>,
+    /// A correlated Gaussian prior over some of the parameters
+    /// ([`crate::model::prior`]); `None`: the per-parameter priors alone.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    correlated: Option<CorrelatedPrior>,
 }
 
 impl Registry {
@@ -261,6 +266,25 @@ impl Registry {
     /// that a design is planned where the frame is now believed to be.
     pub fn set_nominal(&mut self, i: usize, value: f64) {
         self.params[i].nominal = value;
+    }
+
+    /// The correlated prior, if any ([`crate::model::prior`]).
+    pub fn correlated_prior(&self) -> Option<&CorrelatedPrior> {
+        self.correlated.as_ref()
+    }
+
+    /// Sets (or with `None` removes) the correlated prior, after checking it
+    /// ([`CorrelatedPrior::check`]); its parameters keep their statuses (a fit estimates the
+    /// free ones with it).
+    pub fn set_correlated_prior(
+        &mut self,
+        prior: Option<CorrelatedPrior>,
+    ) -> Result<(), crate::Error> {
+        if let Some(p) = &prior {
+            p.check()?;
+        }
+        self.correlated = prior;
+        Ok(())
     }
 
     /// Nominal parameter vector.

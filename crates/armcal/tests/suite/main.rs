@@ -28,6 +28,7 @@ mod identify {
 }
 mod campaign {
     mod adaptive;
+    mod after_drift;
     mod drift;
 }
 mod design {

@@ -7,7 +7,7 @@
 use armcal::cell::Cell;
 use armcal::identify::{identify, IdentifySettings};
 use armcal::measure::csv::read_str;
-use armcal::model::station::MAX_STATIONS;
+use armcal::measure::stations::MAX_STATIONS;
 use armcal::progress::Silent;
 use std::path::Path;
 
