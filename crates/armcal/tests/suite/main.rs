@@ -67,6 +67,7 @@ mod real_data {
     mod motoman_nongeometric;
     mod ur10_cubes;
     mod ur10_import;
+    mod ur10_nongeometric;
     mod ur10_stations;
 }
 mod hostile {

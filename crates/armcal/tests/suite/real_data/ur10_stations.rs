@@ -17,11 +17,16 @@ fn root() -> PathBuf {
 }
 
 fn cell() -> Cell {
-    Cell::from_file(&root().join("examples/ur10-leica-cell.toml")).unwrap()
+    ur10_cell("ur10-leica-cell")
+}
+
+/// The UR10 cell `examples/{name}.toml`.
+pub(super) fn ur10_cell(name: &str) -> Cell {
+    Cell::from_file(&root().join(format!("examples/{name}.toml"))).unwrap()
 }
 
 /// The series' data file, read through the cell's `[data]`.
-fn series(cell: &Cell, name: &str) -> Dataset {
+pub(super) fn series(cell: &Cell, name: &str) -> Dataset {
     let file = match name {
         "A" => "Series_A/measurements_grid.csv",
         "B" => "Series_B/measurements_joint_configurations.csv",
@@ -34,7 +39,7 @@ fn series(cell: &Cell, name: &str) -> Dataset {
 }
 
 /// 30 % held out, seed 1: the README's split.
-fn held_out_settings() -> IdentifySettings {
+pub(super) fn held_out_settings() -> IdentifySettings {
     IdentifySettings {
         holdout: 0.3,
         seed: 1,
