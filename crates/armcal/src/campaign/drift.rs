@@ -166,6 +166,7 @@ pub fn check(
             data.source
         )));
     }
+    estimate.check_consistent()?;
     let params = estimate.params_for(&cell.model)?;
     // The estimate's free set, all plainly free: a prior's rows belong to the calibration,
     // not to the check.

@@ -46,6 +46,7 @@ impl CampaignPrior {
         source: &str,
         released: &[String],
     ) -> Result<CampaignPrior, Error> {
+        estimate.check_consistent()?;
         let params = estimate.params_for(&cell.model)?;
         let groups: Vec<&str> = {
             let mut g: Vec<&str> = estimate.free.iter().map(|n| group_of(n)).collect();
@@ -63,6 +64,7 @@ impl CampaignPrior {
             .collect();
         let s = precision::scale(estimate);
         let c = &estimate.uncertainty.covariance;
+
         let prior = CorrelatedPrior {
             source: source.to_string(),
             parameters: kept.iter().map(|&k| estimate.free[k].clone()).collect(),

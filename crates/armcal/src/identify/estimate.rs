@@ -283,6 +283,23 @@ impl Estimate {
         })
     }
 
+    /// Whether the record hangs together where its consumers index it: C_p and the σ's
+    /// sized by the free set (a damaged or edited file is an error, never a panic).
+    pub fn check_consistent(&self) -> Result<(), Error> {
+        let n = self.free.len();
+        let u = &self.uncertainty;
+        if u.covariance.shape() == (n, n) && u.sigma.len() == n {
+            return Ok(());
+        }
+        Err(Error::Input(format!(
+            "the estimate (cell `{}`) names {n} free parameters but holds a {}×{} C_p and {} σ's: the file is damaged or was edited; identify again",
+            self.cell,
+            u.covariance.nrows(),
+            u.covariance.ncols(),
+            u.sigma.len()
+        )))
+    }
+
     /// Whether the estimate may be used: an estimate whose fit did not converge — or that
     /// records no verdicts (written by an older armcal) — is an error naming the status,
     /// unless `acceptance.accepted`, when [`Usability::overridden`] says what every output
@@ -290,6 +307,8 @@ impl Estimate {
     /// ([`Acceptance`]). The χ² and identifiability verdicts worth knowing come back as
     /// notes.
     pub fn check_usable(&self, acceptance: &Acceptance) -> Result<Usability, Error> {
+        // no acceptance makes a damaged record usable
+        self.check_consistent()?;
         let accept = acceptance.accept;
         let flag = format!("pass {accept} to use it anyway");
         let Some(v) = &self.verdicts else {

@@ -132,7 +132,7 @@ fn least_separable(
     let names = problem.free_names();
     let unc =
         uncertainty::parameter_uncertainty(&solution.jacobian, &solution.residual, &names).ok()?;
-    let data_rows = problem.data_rows();
+    let data_rows = solution.jacobian.nrows() - problem.prior_rows.nrows();
     let gate = nongeometric_gate::nongeometric_gate(
         model,
         &problem.free,

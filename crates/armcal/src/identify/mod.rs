@@ -428,7 +428,7 @@ fn estimate_of_fit(
             .collect();
         (cs, blocks)
     };
-    let data_rows = problem.data_rows();
+    let data_rows = sol.jacobian.nrows() - problem.prior_rows.nrows();
     let nongeometric = nongeometric_gate::nongeometric_gate(
         model,
         &problem.free,

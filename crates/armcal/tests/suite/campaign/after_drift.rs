@@ -100,3 +100,24 @@ fn a_campaign_from_the_old_calibration_needs_only_what_moved() {
         moved[j2]
     );
 }
+
+#[test]
+fn a_damaged_estimate_is_an_error_for_the_check_and_the_prior() {
+    // An estimate file whose C_p does not match its free set (edited or damaged) would be
+    // indexed out of range by the check and by the campaign's prior: an error instead.
+    let cell = Cell::from_toml(PAPER_CELL, "paper-cell.toml", ".".as_ref()).unwrap();
+    let model = &cell.model;
+    let truth = perturbed_truth(model, &Perturbation::default(), 3);
+    let qs = random_configurations(model, 30, 3);
+    let data = armcal::sim::simulate(model, &truth, &qs, Some(&cell.noise()), 3).unwrap();
+    let mut est = identify(&cell, &data, &IdentifySettings::default(), &mut Silent).unwrap();
+    est.uncertainty.covariance = nalgebra::DMatrix::identity(2, 2);
+    let e = check(&cell, &est, &data, &CheckSettings::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("damaged"), "{e}");
+    let e = CampaignPrior::from_estimate(&cell, &est, "bad.json", &[])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("damaged"), "{e}");
+}
