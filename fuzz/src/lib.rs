@@ -210,6 +210,7 @@ pub fn records(text: &str) {
                     let _ = armcal::sim::predict(&model, &params, &poses);
                 }
             }
+            drift_check(e);
         }
         Document::Design(d) => {
             let cell = &data_cells()[0];
@@ -217,7 +218,13 @@ pub fn records(text: &str) {
                 let _ = evaluate_design(cell, &design, true);
             }
         }
-        Document::Study(_) | Document::Demo(_) | Document::Truth(_) | Document::Campaign(_) => {}
+        Document::Campaign(state) => {
+            // a campaign after a drift check: its prior applied to the paper cell
+            if let Some(prior) = &state.settings.prior {
+                let _ = prior.apply(&data_cells()[0]);
+            }
+        }
+        Document::Study(_) | Document::Demo(_) | Document::Truth(_) => {}
     }
     let inputs = [Input {
         label: "fuzz".into(),
@@ -230,5 +237,27 @@ pub fn records(text: &str) {
         ..ReportContent::default()
     }) {
         let _ = p.render();
+    }
+}
+
+/// An estimate of the paper cell → a drift check on three simulated poses of its robot, and
+/// the prior of a campaign after it (the first group released).
+fn drift_check(e: &armcal::identify::Estimate) {
+    let cell = &data_cells()[0];
+    let Ok(params) = e.params_for(&cell.model) else {
+        return;
+    };
+    let qs = random_configurations(&cell.model, 3, 2);
+    let Ok(data) = armcal::sim::simulate(&cell.model, &params, &qs, None, 0) else {
+        return;
+    };
+    let settings = armcal::campaign::drift::CheckSettings::default();
+    if let Ok(c) = armcal::campaign::drift::check(cell, e, &data, &settings) {
+        let released = c.moved_groups().into_iter().take(1).collect::<Vec<_>>();
+        if let Ok(p) =
+            armcal::campaign::prior::CampaignPrior::from_estimate(cell, e, "fuzz.json", &released)
+        {
+            let _ = p.apply(cell);
+        }
     }
 }
