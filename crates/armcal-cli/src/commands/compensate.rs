@@ -28,6 +28,12 @@ pub struct Args {
     /// targets the pose to send, then status, position_error_mm, orientation_error_deg).
     #[arg(long)]
     pub out: PathBuf,
+    /// The payload the robot carries along the program (a cell's `[[payload]]` name, or
+    /// `none`): the compensation includes its deflection, and the output's first line says
+    /// which payload it is for. Default: the payload the calibration data carried if they
+    /// carried one only, else none.
+    #[arg(long)]
+    pub payload: Option<String>,
     /// Overwrite existing output files (never an input file).
     #[arg(long)]
     pub force: bool,
@@ -57,6 +63,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let model = &cell.model;
     let (est, note) = load_estimate(&a.estimate, &a.accept, Some(model))?;
     let calibrated = est.params_for(model)?;
+    let (payload, payload_how) = est.payload_for(model, a.payload.as_deref())?;
     let program = ProgramFile::read(
         armcal::input::read_capped(&a.targets, armcal::input::DATA_CAP)?,
         &a.targets.display().to_string(),
@@ -90,12 +97,24 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         model,
         &calibrated,
         &program,
-        &IkSettings::default(),
+        &IkSettings {
+            payload,
+            ..IkSettings::default()
+        },
         correction.as_ref(),
     )?;
+    let with_payload = if model.payloads.is_empty() {
+        comp.csv
+    } else {
+        with_note(
+            comp.csv,
+            Some(&format!("compensated for {payload_how}")),
+            NoteStyle::Hash,
+        )
+    };
     outputs.commit(&[(
         &a.out,
-        &with_note(comp.csv, note.as_deref(), NoteStyle::Hash),
+        &with_note(with_payload, note.as_deref(), NoteStyle::Hash),
     )])?;
     println!(
         "{} {} filtered through the calibrated model → {} ({} not converged; see the status column)",
@@ -104,5 +123,8 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         a.out.display(),
         comp.not_converged
     );
+    if !model.payloads.is_empty() {
+        println!("payload: {payload_how}");
+    }
     Ok(())
 }

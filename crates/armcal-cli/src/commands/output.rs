@@ -281,19 +281,33 @@ pub fn load_estimate(
     Ok((est, usable.overridden))
 }
 
-/// The parameters of the estimate at `path` for `model` ([`load_estimate`]), or the nominal
-/// ones without an estimate; with the line every output made with them must carry.
-pub fn load_params(
+/// As [`load_params`], with the payload the robot carries: `name` checked against the
+/// estimate ([`armcal::identify::Estimate::payload_for`]) — the payload index and the
+/// sentence saying how it is predicted (`None` for a model without payloads and no
+/// `--payload`). Without an estimate, the nominal model at payload `name`.
+pub fn load_params_at_payload(
     path: Option<&Path>,
     accept: &AcceptUnconverged,
     model: &armcal::model::Model,
-) -> anyhow::Result<(Vec<f64>, Option<String>)> {
+    name: Option<&str>,
+) -> anyhow::Result<(Vec<f64>, Option<String>, (Option<usize>, Option<String>))> {
+    let quiet = name.is_none() && model.payloads.is_empty();
     match path {
         Some(p) => {
             let (est, note) = load_estimate(p, accept, Some(model))?;
-            Ok((est.params_for(model)?, note))
+            let (payload, how) = est.payload_for(model, name)?;
+            Ok((
+                est.params_for(model)?,
+                note,
+                (payload, (!quiet).then_some(how)),
+            ))
         }
-        None => Ok((model.nominal(), None)),
+        None => {
+            let payload = model
+                .payload_index(name.unwrap_or("none"))
+                .map_err(|e| anyhow::anyhow!("--payload: {e}"))?;
+            Ok((model.nominal(), None, (payload, None)))
+        }
     }
 }
 

@@ -1,6 +1,8 @@
 //! `armcal predict`: what the (nominal or identified) model says the instrument measures.
 
-use super::output::{load_cell, load_params, with_note, AcceptUnconverged, NoteStyle, Outputs};
+use super::output::{
+    load_cell, load_params_at_payload, with_note, AcceptUnconverged, NoteStyle, Outputs,
+};
 use armcal::measure::csv;
 use armcal::sim::predict;
 use std::path::{Path, PathBuf};
@@ -19,6 +21,11 @@ pub struct Args {
     /// Output (CSV, the columns of a data file).
     #[arg(long)]
     pub out: PathBuf,
+    /// The payload the robot carries (a cell's `[[payload]]` name, or `none`); default: the
+    /// payload the calibration data carried if they carried one only, else none. A payload
+    /// the calibration did not measure needs its joint compliances identified.
+    #[arg(long)]
+    pub payload: Option<String>,
     /// Overwrite existing output files (never an input file).
     #[arg(long)]
     pub force: bool,
@@ -32,9 +39,14 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let outputs = Outputs::plan(a.force, &inputs, &[&a.out])?;
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
-    let (params, note) = load_params(a.estimate.as_deref(), &a.accept, model)?;
+    let (params, note, payload) = load_params_at_payload(
+        a.estimate.as_deref(),
+        &a.accept,
+        model,
+        a.payload.as_deref(),
+    )?;
     let poses = csv::read_configurations_with(&a.joints, model, &cell.data_format())?;
-    let data = predict(model, &params, &poses)?;
+    let data = predict(model, &params, &poses, payload.0)?;
     outputs.commit(&[(
         &a.out,
         &with_note(
@@ -54,5 +66,8 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         },
         a.out.display()
     );
+    if let Some(how) = payload.1 {
+        println!("payload: {how}");
+    }
     Ok(())
 }

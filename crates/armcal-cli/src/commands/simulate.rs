@@ -33,6 +33,16 @@ pub struct Args {
     /// `[parameters] periodic`): nominal + σz.
     #[arg(long, default_value_t = 20.0)]
     pub perturb_arcsec: f64,
+    /// σ of the joints' own compliance in the true robot (µrad/(N·m); the payload terms
+    /// `<joint>.compliance.payload` of a cell with `[parameters] compliance` and
+    /// `[[payload]]`): c = nominal + σ|z|.
+    #[arg(long, default_value_t = 5.0)]
+    pub perturb_urad_per_nm: f64,
+    /// The payload the robot carries at every pose (a cell's `[[payload]]` name; default
+    /// none); the data get a `payload` column. Simulate each payload with the same --seed
+    /// (the same true robot) and give both files to `identify`.
+    #[arg(long)]
+    pub payload: Option<String>,
     /// Perturb every parameter, not only the identifiable (free) ones.
     #[arg(long)]
     pub perturb_all: bool,
@@ -61,6 +71,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     for (flag, v) in [
         ("--perturb-urad-per-m", a.perturb_urad_per_m),
         ("--perturb-arcsec", a.perturb_arcsec),
+        ("--perturb-urad-per-nm", a.perturb_urad_per_nm),
     ] {
         if !(v.is_finite() && v >= 0.0) {
             bail!("{flag} {v}: give a magnitude ≥ 0");
@@ -68,6 +79,9 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     }
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
+    let payload = model
+        .payload_index(a.payload.as_deref().unwrap_or("none"))
+        .map_err(|e| anyhow::anyhow!("--payload: {e}"))?;
     let poses = csv::read_reachable_configurations(&a.poses, model)?;
     let unmeasurable = unmeasurable_poses(&cell, &poses)?;
     if !unmeasurable.is_empty() {
@@ -91,6 +105,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         angle: a.perturb_deg.to_radians(),
         compliance: a.perturb_urad_per_m / Unit::RadPerMm.display_factor(),
         periodic: a.perturb_arcsec / Unit::Arcsec.display_factor(),
+        joint_compliance: a.perturb_urad_per_nm / Unit::RadPerNmm.display_factor(),
         all: a.perturb_all,
         ..Perturbation::default()
     };
@@ -99,6 +114,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         &cell.name,
         model,
         &poses,
+        payload,
         &pert,
         (!a.noise_free).then_some(&noise),
         a.seed,

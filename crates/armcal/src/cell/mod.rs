@@ -364,6 +364,7 @@ pub(crate) fn assemble_spec(
     ModelSpec {
         compliance: None,
         periodic: None,
+        payloads: Vec::new(),
         name: robot.spec.name.clone(),
         instrument: instrument.map(|g| LinkSpec {
             name: instrument_name.into(),

@@ -119,6 +119,10 @@ pub struct IkSettings {
     pub epsilon: f64,
     /// Largest damping γ_max (mm), reached at σ_min = 0; capped by ‖e_w‖.
     pub gamma_max: f64,
+    /// The payload the robot carries at the targets (an index into
+    /// [`Model::payloads`]; `None`: none): a compliant model deflects under its weight, and
+    /// the solve includes that deflection ([`crate::identify::Estimate::payload_for`]).
+    pub payload: Option<usize>,
 }
 
 impl Default for IkSettings {
@@ -131,6 +135,7 @@ impl Default for IkSettings {
             length: 1000.0,
             epsilon: 1.0,
             gamma_max: 1.0,
+            payload: None,
         }
     }
 }
@@ -286,6 +291,7 @@ fn run_dls<const R: usize>(
 ) -> Run {
     let eps2 = settings.epsilon * settings.epsilon;
     let length = settings.length;
+    ws.data.payload = settings.payload;
     forward_kinematics(model, &mut ws.data, params, &ws.q);
     let mut best = f64::INFINITY;
     let mut stalls = 0;

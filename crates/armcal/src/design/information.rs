@@ -42,7 +42,12 @@ impl DesignModel {
     /// The design model of a cell: its free parameters, point targets (or the tool origin),
     /// the instrument noise, and its working configurations.
     pub fn from_cell(cell: &Cell) -> Result<DesignModel, Error> {
-        let model = cell.model.clone();
+        let mut model = cell.model.clone();
+        // A planned pose carries no payload: the payload terms are not designed for (measure
+        // the plan with and without the payload to identify them).
+        for (i, _) in crate::identify::payload_terms(&cell.model) {
+            model.registry.set_status(i, crate::model::Status::Fixed);
+        }
         let params = model.nominal();
         let free = model.registry.free();
         if free.is_empty() {

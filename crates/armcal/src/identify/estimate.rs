@@ -182,6 +182,11 @@ pub struct Estimate {
     pub model: ModelSpec,
     /// Every model parameter, free or fixed, in registry order (display units).
     pub parameters: Vec<ParameterEstimate>,
+    /// The payload states the fitted data carried (a payload's name, `none` for rows without
+    /// one), in order of first appearance; empty: no row named a payload
+    /// ([`Estimate::payload_for`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub payloads_measured: Vec<String>,
     /// The identifiability gate of the free non-geometric terms (compliance, periodic
     /// errors; [`crate::identify::nongeometric_gate`]); empty for a kinematic model.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -368,6 +373,74 @@ impl Estimate {
             model.name,
             differences.join("; ")
         )))
+    }
+
+    /// The payload (an index into `model`'s payloads) at which this estimate can predict the
+    /// robot carrying `name` (`none`: no payload), with a sentence on how; `name` `None`:
+    /// the payload the calibration carried if it carried one only, else none. A rigid model
+    /// predicts alike at every payload (said). With compliance, a payload state the
+    /// calibration measured in is always honest (its deflection is in the fit, whether the
+    /// payload terms were kept or absorbed); another needs every payload term
+    /// (`<joint>.compliance.payload`) identified, else the error names them and what to do.
+    pub fn payload_for(
+        &self,
+        model: &Model,
+        name: Option<&str>,
+    ) -> Result<(Option<usize>, String), Error> {
+        let measured: Vec<&str> = if self.payloads_measured.is_empty() {
+            vec!["none"]
+        } else {
+            self.payloads_measured.iter().map(String::as_str).collect()
+        };
+        let name = name.unwrap_or(if measured.len() == 1 {
+            measured[0]
+        } else {
+            "none"
+        });
+        let index = model.payload_index(name).map_err(Error::Input)?;
+        let label = match index {
+            Some(k) => format!("payload `{name}` ({} kg)", model.payloads[k].mass_kg),
+            None => "no payload".to_string(),
+        };
+        let Some(c) = &model.compliance else {
+            return Ok((
+                index,
+                format!("{label}: the model is rigid, so the payload changes no prediction"),
+            ));
+        };
+        if measured.contains(&name) {
+            return Ok((index, format!("{label}, as in the calibration data")));
+        }
+        let unknown: Vec<&str> = c
+            .terms
+            .iter()
+            .filter(|t| t.spec.is_payload())
+            .map(|t| model.registry.get(t.param).name.as_str())
+            .filter(|n| !self.parameters.iter().any(|p| p.name == *n && p.free))
+            .collect();
+        let terms = c.terms.iter().filter(|t| t.spec.is_payload()).count();
+        if terms == 0 || !unknown.is_empty() {
+            return Err(Error::Input(format!(
+                "the estimate cannot predict the robot with {label}: its data carried {} only, and \
+                 the joints' own compliance was not identified{}; calibrate with rows carrying \
+                 different payloads (a `payload` column naming the cell's [[payload]] entries), \
+                 or predict at {}",
+                measured.join(", "),
+                if unknown.is_empty() {
+                    " (the cell declares no payload term)".to_string()
+                } else {
+                    format!(" ({})", unknown.join(", "))
+                },
+                measured.join(" or ")
+            )));
+        }
+        Ok((
+            index,
+            format!(
+                "{label}, with the identified joint compliances (the data carried {})",
+                measured.join(", ")
+            ),
+        ))
     }
 
     /// The full parameter vector of `model` from this estimate (by parameter name), after

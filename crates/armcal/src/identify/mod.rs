@@ -183,6 +183,7 @@ fn identifiable_model_given(
         &data.configurations,
         &IdentifiabilitySettings {
             stations: data.config_stations.clone(),
+            payloads: Some(data.model_payloads(&declared)?),
             ..cell.identifiability_settings()
         },
     )?;
@@ -257,6 +258,7 @@ fn frames_model(
         &IdentifiabilitySettings {
             measurement: data_measurement(data),
             stations: data.config_stations.clone(),
+            payloads: Some(data.model_payloads(&frames)?),
             ..Default::default()
         },
     )?;
@@ -348,7 +350,7 @@ pub fn identify(
     let train: &Dataset = &split.train;
     crate::measure::stations::check_stations(data)?;
     let stationed = cell.with_stations(&data.stations)?;
-    let (left_out, choice) = match opts.nongeometric {
+    let (mut left_out, choice) = match opts.nongeometric {
         NonGeometric::AsCell => (Vec::new(), None),
         NonGeometric::Only(c) => (c.left_out(&stationed.model)?, None),
         NonGeometric::Auto { folds } => {
@@ -357,6 +359,12 @@ pub fn identify(
             (choice.chosen.left_out(&stationed.model)?, Some(choice))
         }
     };
+    if !train.carries_payloads() {
+        let new: Vec<(usize, String)> = payload_terms(&stationed.model)
+            .filter(|(i, _)| !left_out.iter().any(|(j, _)| j == i))
+            .collect();
+        left_out.extend(new);
+    }
     let fit = match &opts.refit {
         Some(refit) => refit::fit_frames(&stationed, cell, train, &noise, opts, refit, observer)?,
         None => fit_free_set(&stationed, train, &noise, opts, &left_out, observer)?,
@@ -370,6 +378,40 @@ pub fn identify(
         nongeometric_choice: choice,
         ..e
     })
+}
+
+/// The payload terms of `model` (`<joint>.compliance.payload`, [`crate::model::compliance`])
+/// with the reason data that carry no payload leave them out.
+pub(crate) fn payload_terms(model: &Model) -> impl Iterator<Item = (usize, String)> + '_ {
+    model
+        .compliance
+        .iter()
+        .flat_map(|c| &c.terms)
+        .filter(|t| t.spec.is_payload())
+        .map(|t| {
+            (
+                t.param,
+                "no measurement carried a payload, so the joint's own compliance has no effect \
+                 on these data: measure some poses with a [[payload]] (a `payload` column)"
+                    .to_string(),
+            )
+        })
+}
+
+/// The payload states `data` carried in order of first appearance (`none` for rows without
+/// a payload); empty when no row named one.
+fn payload_states(data: &Dataset) -> Vec<String> {
+    if !data.carries_payloads() {
+        return Vec::new();
+    }
+    let mut states: Vec<String> = Vec::new();
+    for c in 0..data.configurations.len() {
+        let s = data.payload_of(c).unwrap_or("none");
+        if !states.iter().any(|x| x == s) {
+            states.push(s.to_string());
+        }
+    }
+    states
 }
 
 /// The estimate of a fit: covariance, TCP covariance at the working configurations,
@@ -467,6 +509,7 @@ fn estimate_of_fit(
         data: data.source.clone(),
         model: model.spec_at(&sol.params),
         parameters,
+        payloads_measured: payload_states(train),
         nongeometric,
         nongeometric_choice: None,
         fixed_reasons: reasons.clone(),

@@ -107,7 +107,7 @@ impl Candidate {
             .joint_corrections()
             .map(|(i, _)| i)
             .filter(|&i| match model.registry.get(i).unit {
-                Unit::RadPerMm => !keep_c,
+                Unit::RadPerMm | Unit::RadPerNmm => !keep_c,
                 _ => !keep_p,
             })
             .map(|i| {

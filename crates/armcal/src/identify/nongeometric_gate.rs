@@ -105,7 +105,8 @@ pub fn nongeometric_gate(
                 sigma: sigma * f,
                 most_correlated,
                 unabsorbed,
-                wrong_sign: p.unit == Unit::RadPerMm && value < -2.0 * sigma,
+                wrong_sign: matches!(p.unit, Unit::RadPerMm | Unit::RadPerNmm)
+                    && value < -2.0 * sigma,
                 separable: unabsorbed >= MIN_UNABSORBED && rho < MAX_CORRELATION,
             }
         })

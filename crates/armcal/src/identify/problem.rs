@@ -41,6 +41,8 @@ pub struct Problem<'a> {
     by_config: Vec<usize>,
     /// Offsets into `by_config`, one per configuration and one past the end.
     config_start: Vec<usize>,
+    /// The payload each configuration carried, an index into the model's payloads.
+    payloads: Vec<Option<usize>>,
 }
 
 /// Buffers for evaluating a [`Problem`]: their size does not depend on the number of
@@ -73,6 +75,7 @@ impl<'a> Problem<'a> {
                 stations.join(", ")
             )));
         }
+        let payloads = data.model_payloads(model)?;
         for (c, q) in data.configurations.iter().enumerate() {
             model.check_measured_joints(q).map_err(|e| {
                 Error::Input(format!("configuration `{}`: {e}", data.config_ids[c]))
@@ -146,6 +149,7 @@ impl<'a> Problem<'a> {
             row_weights: vec![1.0; rows],
             by_config,
             config_start,
+            payloads,
         })
     }
 
@@ -262,6 +266,7 @@ impl<'a> Problem<'a> {
                 continue;
             }
             data.station = self.data.station_of(c);
+            data.payload = self.payloads[c];
             forward_kinematics(self.model, data, params, q);
             for (s, p) in current.iter_mut().enumerate() {
                 self.predict_slot(data, s, p, with_jacobian);
@@ -272,6 +277,7 @@ impl<'a> Problem<'a> {
                     MeasurementKind::Distance { other: o, .. } => {
                         let q = &self.data.configurations[*o];
                         other_data.station = self.data.station_of(*o);
+                        other_data.payload = self.payloads[*o];
                         forward_kinematics(self.model, other_data, params, q);
                         self.predict_slot(other_data, slot, other, with_jacobian);
                         Some(&*other)

@@ -35,6 +35,8 @@ pub(crate) struct Layout {
     pub target: Option<usize>,
     /// The `station` column ([`crate::model::station`]).
     pub station: Option<usize>,
+    /// The `payload` column (a cell's `[[payload]]`, [`crate::model::compliance`]).
+    pub payload: Option<usize>,
     /// Header names no column of the layout uses.
     pub ignored: Vec<String>,
 }
@@ -138,7 +140,8 @@ impl DataFormat {
         let pose_id = find("pose_id");
         let target = find("target");
         let station = find("station");
-        for c in [pose_id, target, station].into_iter().flatten() {
+        let payload = find("payload");
+        for c in [pose_id, target, station, payload].into_iter().flatten() {
             used[c] = true;
         }
         let ignored = header
@@ -157,6 +160,7 @@ impl DataFormat {
             pose_id,
             target,
             station,
+            payload,
             ignored,
         })
     }

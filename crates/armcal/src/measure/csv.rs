@@ -14,7 +14,11 @@
 //!   and `sigma_roll` … for pose rows (σ of the residual's rotation rows);
 //! * `temperature_c` — air temperature at the measurement, °C (a covariate);
 //! * `station` — the instrument station the row was measured from
-//!   ([`crate::model::station`]); with it, a configuration is a (station, `pose_id`) pair.
+//!   ([`crate::model::station`]); with it, a configuration is a (station, `pose_id`) pair;
+//! * `payload` — the payload the robot carried (a cell's `[[payload]]` name; empty or
+//!   `none`: no payload; [`crate::model::compliance`]); with it, a configuration is a
+//!   (station, payload, `pose_id`) triple, so one pose list measured with two payloads
+//!   gives two configurations per pose.
 //!
 //! That is [`DataFormat::armcal`]; a cell's `[data]` section maps any other layout
 //! ([`crate::measure::format`]: delimiter, decimal comma, column names, units, orientation
@@ -214,6 +218,16 @@ impl Row<'_> {
         Ok(s)
     }
 
+    /// The row's payload: `None` for an empty cell or `none`, else one of the model's
+    /// payloads (the error lists them).
+    fn payload(&self, c: usize, model: &Model) -> Result<Option<&str>, Error> {
+        let p = self.text(c);
+        model
+            .payload_index(p)
+            .map(|k| k.map(|_| p))
+            .map_err(|why| err(self.file, format!("line {}: `payload`: {why}", self.line)))
+    }
+
     /// The joint values (internal units).
     fn joints(&self, joints: &[Column], model: &Model) -> Result<Vec<f64>, Error> {
         joints
@@ -408,7 +422,7 @@ fn read_rows(
         source: file.to_string(),
         ..Default::default()
     };
-    let mut config_of: HashMap<(usize, String), usize> = HashMap::new();
+    let mut config_of: HashMap<(usize, Option<String>, String), usize> = HashMap::new();
     let mut warnings = Vec::new();
     let targets: Vec<&str> = model.targets.iter().map(|t| t.spec.name.as_str()).collect();
     for (r, record) in rdr.records().enumerate() {
@@ -433,7 +447,15 @@ fn read_rows(
             Some(c) => Some(row.station(c, model)?),
             None => None,
         };
-        let key = (station.map_or(0, |s| data.station_index(s)), id.clone());
+        let payload = match layout.payload {
+            Some(c) => row.payload(c, model)?,
+            None => None,
+        };
+        let key = (
+            station.map_or(0, |s| data.station_index(s)),
+            payload.map(str::to_string),
+            id.clone(),
+        );
         let config = match config_of.get(&key) {
             Some(&c) => {
                 if data.configurations[c]
@@ -453,6 +475,7 @@ fn read_rows(
                 if let Some(s) = data.config_stations.last_mut() {
                     *s = key.0;
                 }
+                data.set_payload(c, payload);
                 config_of.insert(key, c);
                 c
             }
@@ -574,6 +597,7 @@ pub fn import(path: &Path, model: &Model, format: &DataFormat) -> Result<Import,
 }
 
 /// Writes a dataset in armcal's format: `pose_id`, `station` if the data name stations,
+/// `payload` if any configuration carried one,
 /// `q<i>_deg` (or `_mm`), `target`, `x_mm`,
 /// `y_mm`, `z_mm`, then `roll_deg`, `pitch_deg`, `yaw_deg` for pose rows and σ columns if
 /// any measurement has them, and `temperature_c` if any measurement recorded one. Only
@@ -597,6 +621,10 @@ pub fn write_string(data: &Dataset, model: &Model) -> Result<String, Error> {
     if stations {
         header.push("station".into());
     }
+    let payloads = data.carries_payloads();
+    if payloads {
+        header.push("payload".into());
+    }
     header.extend(model.joints.iter().map(joint_column));
     header.extend(["target", "x_mm", "y_mm", "z_mm"].map(String::from));
     if any_pose {
@@ -617,6 +645,9 @@ pub fn write_string(data: &Dataset, model: &Model) -> Result<String, Error> {
         let mut row = vec![data.config_ids[m.config].clone()];
         if stations {
             row.push(data.stations[data.station_of(m.config)].clone());
+        }
+        if payloads {
+            row.push(data.payload_of(m.config).unwrap_or("none").to_string());
         }
         for (v, j) in data.configurations[m.config].iter().zip(&model.joints) {
             row.push(f(joint_display(j, *v)));

@@ -147,6 +147,14 @@ pub struct Dataset {
     /// is.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub config_stations: Vec<usize>,
+    /// The payloads the data name (a `payload` column naming a cell's `[[payload]]`), in
+    /// order of first appearance; empty: no configuration carried one.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub payloads: Vec<String>,
+    /// The payload each configuration carried, an index into `payloads` (`None`: none);
+    /// empty when no configuration carried one.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub config_payloads: Vec<Option<usize>>,
 }
 
 impl Dataset {
@@ -163,7 +171,65 @@ impl Dataset {
         if !self.stations.is_empty() {
             self.config_stations.push(0);
         }
+        if !self.config_payloads.is_empty() {
+            self.config_payloads.push(None);
+        }
         self.configurations.len() - 1
+    }
+
+    /// The payload configuration `c` carried (a name in [`Dataset::payloads`]), if any.
+    pub fn payload_of(&self, c: usize) -> Option<&str> {
+        let k = self.config_payloads.get(c).copied().flatten()?;
+        self.payloads.get(k).map(String::as_str)
+    }
+
+    /// Records that configuration `c` carried payload `name` (`None`: none).
+    pub fn set_payload(&mut self, c: usize, name: Option<&str>) {
+        let Some(name) = name else {
+            if let Some(p) = self.config_payloads.get_mut(c) {
+                *p = None;
+            }
+            return;
+        };
+        let k = match self.payloads.iter().position(|p| p == name) {
+            Some(k) => k,
+            None => {
+                self.payloads.push(name.to_string());
+                self.payloads.len() - 1
+            }
+        };
+        if self.config_payloads.len() < self.configurations.len() {
+            self.config_payloads.resize(self.configurations.len(), None);
+        }
+        self.config_payloads[c] = Some(k);
+    }
+
+    /// Whether any configuration carried a payload.
+    pub fn carries_payloads(&self) -> bool {
+        self.config_payloads.iter().any(Option::is_some)
+    }
+
+    /// Each configuration's payload as an index into `model`'s payloads
+    /// ([`Model::payload_index`]); an error names a payload the model does not have.
+    pub fn model_payloads(
+        &self,
+        model: &crate::model::Model,
+    ) -> Result<Vec<Option<usize>>, crate::Error> {
+        let of_name: Vec<Option<usize>> = self
+            .payloads
+            .iter()
+            .map(|p| model.payload_index(p))
+            .collect::<Result<_, _>>()
+            .map_err(|e| crate::Error::Input(format!("{}: {e}", self.source)))?;
+        Ok((0..self.configurations.len())
+            .map(|c| {
+                self.config_payloads
+                    .get(c)
+                    .copied()
+                    .flatten()
+                    .and_then(|k| of_name[k])
+            })
+            .collect())
     }
 
     /// The station of configuration `c` (an index into [`Dataset::stations`]; 0 without
@@ -223,6 +289,14 @@ impl Dataset {
         self.configurations
             .extend(other.configurations.iter().cloned());
         self.config_ids.extend(other.config_ids.iter().cloned());
+        if !self.config_payloads.is_empty() {
+            self.config_payloads.resize(self.configurations.len(), None);
+        }
+        for c in 0..other.configurations.len() {
+            if let Some(p) = other.payload_of(c) {
+                self.set_payload(offset + c, Some(p));
+            }
+        }
         for m in &other.measurements {
             let mut m = m.clone();
             m.config += offset;
@@ -247,6 +321,9 @@ impl Dataset {
                 out.push_configuration(self.config_ids[c].clone(), self.configurations[c].clone());
             if let Some(s) = out.config_stations.last_mut() {
                 *s = self.station_of(c);
+            }
+            if let Some(p) = self.payload_of(c) {
+                out.set_payload(map[c], Some(p));
             }
         }
         for m in &self.measurements {

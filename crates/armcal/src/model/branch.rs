@@ -406,6 +406,7 @@ mod tests {
         Model::from_spec(&ModelSpec {
             compliance: None,
             periodic: None,
+            payloads: Vec::new(),
             name: "test".into(),
             instrument: None,
             links,

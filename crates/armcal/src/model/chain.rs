@@ -2,7 +2,7 @@
 //! one parameter registry. A [`Model`] is immutable once built and can be shared across
 //! threads; buffers for one evaluation live in [`crate::model::Data`].
 
-use crate::model::compliance::{Compliance, ComplianceSpec};
+use crate::model::compliance::{Compliance, ComplianceSpec, Payload};
 use crate::model::link::{Convention, Joint, JointKind, LinkGeometry, Motion};
 use crate::model::periodic::{CompiledPeriodic, PeriodicSpec};
 use crate::model::registry::{Registry, Segment, Status, Unit};
@@ -82,6 +82,10 @@ pub struct ModelSpec {
     /// Periodic joint errors ([`crate::model::periodic`]); `None`: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub periodic: Option<PeriodicSpec>,
+    /// Payloads the robot may carry (a cell's `[[payload]]`): what a measurement's
+    /// `payload` names; with compliance, their gravity torque deflects the joints.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub payloads: Vec<Payload>,
 }
 
 /// A compiled link: its spec plus where its parameters live in the registry.
@@ -155,6 +159,9 @@ pub struct Model {
     pub compliance: Option<Compliance>,
     /// Periodic joint errors, compiled; their amplitudes are the registry's last parameters.
     pub periodic: Vec<CompiledPeriodic>,
+    /// Payloads the robot may carry ([`ModelSpec::payloads`], checked); a measurement's
+    /// payload is an index into them ([`crate::model::Data::payload`]).
+    pub payloads: Vec<Payload>,
     pub(crate) instrument_steps: Vec<Step>,
     /// The instrument steps of each station (empty without stations).
     pub(crate) station_steps: Vec<Vec<Step>>,
@@ -383,9 +390,15 @@ impl Model {
             targets.push(l);
             target_steps.push(s);
         }
+        for (k, p) in spec.payloads.iter().enumerate() {
+            p.check().map_err(Error::Model)?;
+            if spec.payloads[..k].iter().any(|o| o.name == p.name) {
+                return Err(Error::Model(format!("payload `{}` is named twice", p.name)));
+            }
+        }
         let link_params = registry.len();
         let mut compliance = match &spec.compliance {
-            Some(c) => Some(c.compile(&joints, link_params, &mut registry)?),
+            Some(c) => Some(c.compile(&joints, &spec.payloads, link_params, &mut registry)?),
             None => None,
         };
         let periodic = match &spec.periodic {
@@ -405,6 +418,7 @@ impl Model {
             targets,
             compliance,
             periodic,
+            payloads: spec.payloads.clone(),
             instrument_steps,
             station_steps,
             chain_steps,
@@ -446,6 +460,30 @@ impl Model {
                     })
                     .collect(),
             }),
+            payloads: self.payloads.clone(),
+        }
+    }
+
+    /// The index of payload `name` in [`Model::payloads`]; `None` (no payload) for `none`
+    /// or an empty name; an unknown name is an error that lists the model's payloads.
+    pub fn payload_index(&self, name: &str) -> Result<Option<usize>, String> {
+        if name.is_empty() || name == "none" {
+            return Ok(None);
+        }
+        match self.payloads.iter().position(|p| p.name == name) {
+            Some(k) => Ok(Some(k)),
+            None if self.payloads.is_empty() => Err(format!(
+                "payload `{name}`: the cell declares no payload (add a [[payload]] with its \
+                 name, mass_kg and com_mm)"
+            )),
+            None => Err(format!(
+                "payload `{name}` is not one of the cell's payloads ({}; or `none`)",
+                self.payloads
+                    .iter()
+                    .map(|p| p.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )),
         }
     }
 

@@ -49,6 +49,21 @@
 //! `j2 × elbow`, `j2 × wrist`, `j3 × wrist` (`j3 × elbow` has no torque: the elbow lies on
 //! the axis of `j3`). The terms are named `<joint>.compliance.<mass>`.
 //!
+//! # A known payload
+//! A payload of known mass `m_p` with its centre of mass at `x_p` (in the tool frame, the
+//! chain's end; [`Payload`]) adds `c_i m_p g ℓ_i(x_p, q)` to `Δq_i`. Here the joint's
+//! compliance `c_i` itself appears, not a product with an unknown mass: a model whose robot
+//! may carry payloads (a cell's `[[payload]]`) has one more term per compliant joint,
+//! `<joint>.compliance.payload` = `c_i` in **µrad/(N·m)** (stored in rad per N·mm), whose
+//! basis is the payload's torque `m_p g ℓ_i(x_p)` (N·mm) for a measurement that carried one
+//! ([`crate::model::Data::payload`]) and 0 for one that did not. Over measurements with and
+//! without the payload (or with two payloads) `c_i` is separate from the lumped `κ` and the
+//! geometry, so the deflection can be predicted at any payload; over measurements that all
+//! carried the same payload its torque is nearly the wrist mass's lever and the gate finds it
+//! inseparable (the same point mass seen twice). With no measurement carrying a payload its
+//! column is zero and identification leaves it out, saying so. Joints whose levers are zero
+//! at the payload (a vertical first joint) get no payload term.
+//!
 //! # Units
 //! `κ` is stored in rad per mm of lever and shown in **µrad/m** (`1 rad/mm = 10⁹ µrad/m`): a
 //! deflection of `κ` µrad for every metre of horizontal lever arm. For `c = 10⁻⁶ rad/(N·m)`
@@ -59,7 +74,7 @@ use crate::model::chain::Model;
 use crate::model::joint_correction::revolute_joints;
 use crate::model::kinematics::{forward_kinematics, Data};
 use crate::model::link::{Joint, JointKind};
-use crate::model::pose::Twist;
+use crate::model::pose::{Pose, Twist};
 use crate::model::registry::{Registry, Segment, Unit};
 use crate::Error;
 use nalgebra::{convert, RealField, Vector3};
@@ -67,6 +82,18 @@ use serde::{Deserialize, Serialize};
 
 /// Largest |κ| a model holds (rad/mm; 10⁶ µrad/m).
 pub const MAX_COMPLIANCE: f64 = 1e-3;
+
+/// Largest |c| of a payload term (rad per N·mm; 10⁶ µrad/(N·m) = 1 rad/(N·m)).
+pub const MAX_JOINT_COMPLIANCE: f64 = 1e-3;
+
+/// Standard gravity (m/s²): a payload's weight is `m_p g` newtons.
+pub const STANDARD_GRAVITY: f64 = 9.80665;
+
+/// Largest payload mass a model holds (kg).
+pub const MAX_PAYLOAD_KG: f64 = 1e5;
+
+/// The mass label of a payload term (`j2.compliance.payload`).
+pub const PAYLOAD_TERM: &str = "payload";
 
 /// Configurations the lever tests of [`ComplianceSpec::lumped`] sample.
 const LEVER_SAMPLES: usize = 200;
@@ -82,10 +109,68 @@ pub struct ComplianceTerm {
     pub joint: String,
     /// The mass's label in the parameter name (`elbow`, `wrist`).
     pub mass: String,
-    /// The joint on whose axis the point mass sits (where the chain reaches that axis).
-    pub at: String,
-    /// κ in rad per mm of lever (shown in µrad/m).
+    /// The joint on whose axis the point mass sits (where the chain reaches that axis);
+    /// `None` for a payload term (mass [`PAYLOAD_TERM`]), whose point is the carried
+    /// payload's centre of mass.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub at: Option<String>,
+    /// κ in rad per mm of lever (shown in µrad/m); a payload term's `c` in rad per N·mm
+    /// (shown in µrad/(N·m)).
     pub value: f64,
+}
+
+impl ComplianceTerm {
+    /// Whether this is a payload term (`c_i`, loaded by the known payload).
+    pub fn is_payload(&self) -> bool {
+        self.at.is_none()
+    }
+
+    /// The unit of the term's value: µrad/m for a lumped κ, µrad/(N·m) for a payload term.
+    pub fn unit(&self) -> Unit {
+        if self.is_payload() {
+            Unit::RadPerNmm
+        } else {
+            Unit::RadPerMm
+        }
+    }
+}
+
+/// A payload the robot may carry: a cell's `[[payload]]` (`name`, `mass_kg`, `com_mm`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Payload {
+    /// The name a data file's `payload` column and `--payload` give.
+    pub name: String,
+    /// Mass in kg (> 0).
+    pub mass_kg: f64,
+    /// Centre of mass in the tool frame (the chain's end frame), mm.
+    pub com_mm: [f64; 3],
+}
+
+impl Payload {
+    /// Checks the name (as a station name: it becomes part of file rows and records), the
+    /// mass (0 < m ≤ [`MAX_PAYLOAD_KG`]) and the centre of mass (finite, within the model's
+    /// length range); the error says which and why.
+    pub fn check(&self) -> Result<(), String> {
+        crate::model::station::check_name(&self.name)
+            .map_err(|e| e.replace("station", "payload"))?;
+        if self.name == "none" {
+            return Err("`none` means no payload in a data file; choose another name".into());
+        }
+        if !(self.mass_kg > 0.0 && self.mass_kg <= MAX_PAYLOAD_KG) {
+            return Err(format!(
+                "payload `{}`: mass_kg = {} must be > 0 and ≤ {MAX_PAYLOAD_KG} kg",
+                self.name, self.mass_kg
+            ));
+        }
+        if let Some(x) = self.com_mm.iter().find(|x| !Unit::Mm.holds(**x)) {
+            return Err(format!(
+                "payload `{}`: com_mm has {x}, outside {}",
+                self.name,
+                Unit::Mm.range_text()
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// Joint compliance of a model: gravity, the lever geometry and the lumped terms.
@@ -96,7 +181,7 @@ pub struct ComplianceSpec {
     /// The link parameter values (registry order, mm and rad) the levers are computed with:
     /// the nominal geometry, kept so that a model rebuilt from an estimate deflects alike.
     pub levers: Vec<f64>,
-    /// The lumped terms.
+    /// The lumped terms (then, with payloads, one payload term per compliant joint).
     pub terms: Vec<ComplianceTerm>,
 }
 
@@ -105,8 +190,8 @@ pub struct ComplianceSpec {
 pub struct CompiledTerm {
     /// Index of the compliant joint in `q`.
     pub joint: usize,
-    /// Index of the joint whose axis point carries the mass.
-    pub at: usize,
+    /// Index of the joint whose axis point carries the mass; `None`: a payload term.
+    pub at: Option<usize>,
     /// Index of κ in the registry.
     pub param: usize,
     /// The term as specified (its value is the nominal).
@@ -122,6 +207,9 @@ pub struct Compliance {
     pub levers: Vec<f64>,
     /// The terms, in registry order.
     pub terms: Vec<CompiledTerm>,
+    /// Per model payload ([`crate::model::Model::payloads`]): its weight `m_p g` (N) and
+    /// centre of mass in the tool frame (mm).
+    pub payloads: Vec<(f64, Vector3<f64>)>,
     /// Number of link parameters (the registry before the κ).
     link_params: usize,
 }
@@ -155,31 +243,53 @@ impl<T: RealField + Copy> ComplianceData<T> {
     /// for `k ≤ i` joint k turns axis i and the point rigidly, `ċ = ω_k × c`; for `k > i`
     /// the axis stays and the point moves if joint k comes before it in the chain,
     /// `ċ = ω_i × (ω_k × x + v_k)`, else nothing moves. `ℓ̇ = ĝ · ċ` (ĝ fixed in the world).
+    /// A payload term's basis is the torque `m_p g ℓ_i(x_p)` of `payload` (an index into
+    /// [`Compliance::payloads`]; its point is beyond every joint), and 0 without one.
     pub(crate) fn evaluate(
         &mut self,
         model: &Model,
         c: &Compliance,
         q: &[T],
+        payload: Option<usize>,
         lever: &mut [T],
         lever_rate: &mut [T],
     ) {
         forward_kinematics(model, &mut self.levers, &c.levers, q);
         let dof = model.dof();
         let g: Vector3<T> = self.levers.frames[0].rot * c.gravity.map(convert::<f64, T>);
+        let carried = payload
+            .and_then(|p| c.payloads.get(p))
+            .map(|(weight, com)| {
+                let x = self
+                    .levers
+                    .tool()
+                    .transform_point(&com.map(convert::<f64, T>));
+                (convert::<f64, T>(*weight), x)
+            });
         for (t, term) in c.terms.iter().enumerate() {
+            let rates = &mut lever_rate[t * dof..(t + 1) * dof];
+            let (scale, x, at) = match (term.at, carried) {
+                (Some(at), _) => (T::one(), self.levers.joint_points[at], at),
+                (None, Some((weight, x))) => (weight, x, dof),
+                (None, None) => {
+                    lever[t] = T::zero();
+                    rates.fill(T::zero());
+                    continue;
+                }
+            };
             let twists = &self.levers.joint_twists;
-            let x = self.levers.joint_points[term.at];
             let axis = twists[term.joint];
             let vel = axis.point_velocity(&x);
-            lever[t] = g.dot(&vel);
+            lever[t] = g.dot(&vel) * scale;
             for (k, tw) in twists.iter().enumerate() {
-                lever_rate[t * dof + k] = if k <= term.joint {
-                    g.dot(&tw.w.cross(&vel))
-                } else if k < term.at {
-                    g.dot(&axis.w.cross(&tw.point_velocity(&x)))
-                } else {
-                    T::zero()
-                };
+                rates[k] = scale
+                    * if k <= term.joint {
+                        g.dot(&tw.w.cross(&vel))
+                    } else if k < at {
+                        g.dot(&axis.w.cross(&tw.point_velocity(&x)))
+                    } else {
+                        T::zero()
+                    };
             }
         }
     }
@@ -233,7 +343,7 @@ impl ComplianceSpec {
                 terms.push(ComplianceTerm {
                     joint: names[i].to_string(),
                     mass: label.to_string(),
-                    at: names[at].to_string(),
+                    at: Some(names[at].to_string()),
                     value: 0.0,
                 });
             }
@@ -244,6 +354,23 @@ impl ComplianceSpec {
                      it); remove it from the list",
                     names[i]
                 ));
+            }
+        }
+        // one payload term per compliant joint that a payload's weight turns
+        for &i in &index {
+            let turns = model.payloads.iter().any(|p| {
+                let com = Vector3::from(p.com_mm);
+                samples
+                    .iter()
+                    .any(|s| s.payload_lever(i, &com).abs() > 1e-9)
+            });
+            if turns {
+                terms.push(ComplianceTerm {
+                    joint: names[i].to_string(),
+                    mass: PAYLOAD_TERM.to_string(),
+                    at: None,
+                    value: 0.0,
+                });
             }
         }
         Ok(ComplianceSpec {
@@ -258,6 +385,7 @@ impl ComplianceSpec {
     pub(crate) fn compile(
         &self,
         joints: &[Joint],
+        payloads: &[Payload],
         link_params: usize,
         registry: &mut Registry,
     ) -> Result<Compliance, Error> {
@@ -278,30 +406,35 @@ impl ComplianceSpec {
         };
         let mut terms = Vec::new();
         for t in &c.terms {
-            let (i, at) = (joint(&t.joint)?, joint(&t.at)?);
-            if joints[i].kind != JointKind::Revolute || at <= i {
+            let i = joint(&t.joint)?;
+            let at = t.at.as_deref().map(joint).transpose()?;
+            if joints[i].kind != JointKind::Revolute || at.is_some_and(|at| at <= i) {
                 return Err(Error::Model(format!(
                     "compliance term `{}`: joint `{}` must be revolute and the mass joint `{}` \
                      beyond it",
                     Self::parameter_name(t),
                     t.joint,
-                    t.at
+                    t.at.as_deref().unwrap_or(PAYLOAD_TERM)
                 )));
             }
-            if !Unit::RadPerMm.holds(t.value) {
+            if t.is_payload() != (t.mass == PAYLOAD_TERM) {
                 return Err(Error::Model(format!(
-                    "compliance term `{}` = {:e} µrad/m is outside |x| ≤ {:e} µrad/m",
-                    Self::parameter_name(t),
-                    t.value * Unit::RadPerMm.display_factor(),
-                    MAX_COMPLIANCE * Unit::RadPerMm.display_factor()
+                    "compliance term `{}`: a term without a mass joint is the payload term \
+                     `{PAYLOAD_TERM}`, and only it",
+                    Self::parameter_name(t)
                 )));
             }
-            let param = registry.add(
-                Self::parameter_name(t),
-                Unit::RadPerMm,
-                t.value,
-                Segment::Chain,
-            )?;
+            let unit = t.unit();
+            if !unit.holds(t.value) {
+                return Err(Error::Model(format!(
+                    "compliance term `{}` = {:e} {} is outside {}",
+                    Self::parameter_name(t),
+                    t.value * unit.display_factor(),
+                    unit.display_name(),
+                    unit.range_text()
+                )));
+            }
+            let param = registry.add(Self::parameter_name(t), unit, t.value, Segment::Chain)?;
             terms.push(CompiledTerm {
                 joint: i,
                 at,
@@ -314,6 +447,10 @@ impl ComplianceSpec {
             gravity: g,
             levers: c.levers.clone(),
             terms,
+            payloads: payloads
+                .iter()
+                .map(|p| (p.mass_kg * STANDARD_GRAVITY, Vector3::from(p.com_mm)))
+                .collect(),
             link_params,
         })
     }
@@ -341,6 +478,7 @@ pub fn gravity_direction(gravity: [f64; 3]) -> Result<Vector3<f64>, String> {
 struct LeverSample {
     twists: Vec<Twist<f64>>,
     points: Vec<Vector3<f64>>,
+    tool: Pose<f64>,
     gravity: Vector3<f64>,
 }
 
@@ -348,6 +486,12 @@ impl LeverSample {
     fn lever(&self, i: usize, at: usize) -> f64 {
         self.gravity
             .dot(&self.twists[i].point_velocity(&self.points[at]))
+    }
+
+    /// The lever of a payload with centre of mass `com` (tool frame) about joint `i`.
+    fn payload_lever(&self, i: usize, com: &Vector3<f64>) -> f64 {
+        let x = self.tool.transform_point(com);
+        self.gravity.dot(&self.twists[i].point_velocity(&x))
     }
 }
 
@@ -360,6 +504,7 @@ fn lever_samples(model: &Model, levers: &[f64], g: Vector3<f64>) -> Vec<LeverSam
             LeverSample {
                 twists: data.joint_twists.clone(),
                 points: data.joint_points.clone(),
+                tool: *data.tool(),
                 gravity: data.frames[0].rot * g,
             }
         })

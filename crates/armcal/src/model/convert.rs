@@ -120,6 +120,7 @@ pub fn dh_to_mdh(spec: &ModelSpec) -> Result<ModelSpec, Error> {
     Ok(ModelSpec {
         compliance: None,
         periodic: None,
+        payloads: Vec::new(),
         links,
         ..spec.clone()
     })
@@ -191,6 +192,7 @@ pub fn mdh_to_dh(spec: &ModelSpec) -> Result<ModelSpec, Error> {
     Ok(ModelSpec {
         compliance: None,
         periodic: None,
+        payloads: Vec::new(),
         links,
         ..spec.clone()
     })
@@ -288,6 +290,7 @@ pub fn to_zrp(model: &Model, params: &[f64]) -> ModelSpec {
     ModelSpec {
         compliance: None,
         periodic: None,
+        payloads: Vec::new(),
         name: spec.name,
         instrument: spec.instrument,
         links,
@@ -430,6 +433,7 @@ pub(crate) fn link_pose(g: &LinkGeometry, kind: Option<JointKind>) -> Result<Pos
     let spec = ModelSpec {
         compliance: None,
         periodic: None,
+        payloads: Vec::new(),
         name: String::new(),
         instrument: None,
         links: vec![LinkSpec {
@@ -566,6 +570,7 @@ pub fn zrp_to_dh(spec: &ModelSpec, nominal: Option<&ModelSpec>) -> Result<ModelS
     Ok(ModelSpec {
         compliance: None,
         periodic: None,
+        payloads: Vec::new(),
         name: spec.name.clone(),
         instrument: spec.instrument.clone(),
         links,

@@ -22,6 +22,7 @@ pub(crate) fn suffix(u: Unit) -> &'static str {
         Unit::Rad => "_deg",
         Unit::Unitless => "",
         Unit::RadPerMm => "_urad_per_m",
+        Unit::RadPerNmm => "_urad_per_Nm",
         Unit::Arcsec => "_arcsec",
     }
 }
@@ -167,6 +168,15 @@ pub fn to_cell_toml_with(spec: &ModelSpec, sections: &CellSections) -> Result<St
     out.push_str(sections.parameters.as_deref().unwrap_or("free = \"all\"\n"));
     out.push_str(&joint_corrections_toml(spec)?);
     out.push_str(&sections.tail);
+    for p in &spec.payloads {
+        let _ = writeln!(
+            out,
+            "\n[[payload]]\nname = {}\nmass_kg = {:?}\ncom_mm = {:?}",
+            toml_text::string(&p.name),
+            p.mass_kg,
+            p.com_mm
+        );
+    }
     Ok(out)
 }
 
@@ -211,7 +221,7 @@ fn joint_corrections_toml(spec: &ModelSpec) -> Result<String, Error> {
         }
         let _ = writeln!(out, "compliance = [{}]", quoted(joints));
         for t in &c.terms {
-            values.push((ComplianceSpec::parameter_name(t), Unit::RadPerMm, t.value));
+            values.push((ComplianceSpec::parameter_name(t), t.unit(), t.value));
         }
     }
     if let Some(p) = &spec.periodic {
@@ -325,6 +335,7 @@ pub fn export_form(spec: &ModelSpec, form: LinkForm) -> Result<ModelSpec, Error>
         });
     }
     out.periodic = spec.periodic.clone();
+    out.payloads = spec.payloads.clone();
     Ok(out)
 }
 

@@ -76,6 +76,11 @@ pub struct IdentifiabilitySettings {
     /// [`Model::stations`]); empty: the configurations are spread over the model's stations
     /// in turn (as [`analyze`]'s random ones always are).
     pub stations: Vec<usize>,
+    /// The payload each configuration of [`analyze_at`] carried (an index into
+    /// [`Model::payloads`], `None`: none); `None`: the configurations carry, in turn, no
+    /// payload and each of the model's payloads (as [`analyze`]'s random ones always do: a
+    /// payload term is generically identifiable from measurements with and without it).
+    pub payloads: Option<Vec<Option<usize>>>,
 }
 
 impl Default for IdentifiabilitySettings {
@@ -86,6 +91,7 @@ impl Default for IdentifiabilitySettings {
             seed: 1,
             tolerance: 1e-8,
             stations: Vec::new(),
+            payloads: None,
         }
     }
 }
@@ -236,15 +242,16 @@ pub fn stacked_jacobian(
     m: Measurement,
     columns: &[usize],
 ) -> DMatrix<f64> {
-    stacked_jacobian_at(model, params, qs, &|_| 0, m, columns)
+    stacked_jacobian_at(model, params, qs, &|_| (0, None), m, columns)
 }
 
-/// As [`stacked_jacobian`], configuration `i` measured from station `station(i)`.
+/// As [`stacked_jacobian`], configuration `i` measured from station `at(i).0` carrying
+/// payload `at(i).1`.
 fn stacked_jacobian_at(
     model: &Model,
     params: &[f64],
     qs: &[Vec<f64>],
-    station: &dyn Fn(usize) -> usize,
+    at: &dyn Fn(usize) -> (usize, Option<usize>),
     m: Measurement,
     columns: &[usize],
 ) -> DMatrix<f64> {
@@ -253,7 +260,7 @@ fn stacked_jacobian_at(
     let mut data = Data::new(model);
     let mut full = DMatrix::zeros(per_pose * qs.len(), columns.len());
     for (i, q) in qs.iter().enumerate() {
-        data.station = station(i);
+        (data.station, data.payload) = at(i);
         forward_kinematics(model, &mut data, params, q);
         let mut row = i * per_pose;
         for &(o, r) in &obs {
@@ -267,7 +274,7 @@ fn stacked_jacobian_at(
     // Distance between the point at pose i and at pose i+1: row = d̂ᵀ (J_i − J_{i+1}).
     let mut positions = Vec::with_capacity(qs.len());
     for (i, q) in qs.iter().enumerate() {
-        data.station = station(i);
+        (data.station, data.payload) = at(i);
         forward_kinematics(model, &mut data, params, q);
         positions.push(
             obs.iter()
@@ -317,13 +324,19 @@ fn stacked_factor(
     let mut factor = RowCompressor::new(columns.len());
     let mut start = 0;
     let stations = model.stations.len().max(1);
+    let payload_states = model.payloads.len() + 1;
     while start + overlap < qs.len() {
         let end = (start + FACTOR_BLOCK + overlap).min(qs.len());
-        let station = |i: usize| {
+        let at = |i: usize| {
             let i = start + i;
-            opts.stations.get(i).copied().unwrap_or(i % stations)
+            let station = opts.stations.get(i).copied().unwrap_or(i % stations);
+            let payload = match &opts.payloads {
+                Some(given) => given.get(i).copied().flatten(),
+                None => (i % payload_states).checked_sub(1),
+            };
+            (station, payload)
         };
-        let block = stacked_jacobian_at(model, params, &qs[start..end], &station, m, columns);
+        let block = stacked_jacobian_at(model, params, &qs[start..end], &at, m, columns);
         factor.add_rows(block.as_view());
         start = end - overlap;
     }

@@ -49,8 +49,15 @@ impl<T: RealField + Copy> CorrectionData<T> {
         })
     }
 
-    /// Every term's basis, its q-derivatives and value at `q`, and the corrected joints.
-    pub(crate) fn evaluate(&mut self, model: &Model, params: &[f64], q: &[T]) {
+    /// Every term's basis, its q-derivatives and value at `q` with `payload` carried (an
+    /// index into [`Model::payloads`]), and the corrected joints.
+    pub(crate) fn evaluate(
+        &mut self,
+        model: &Model,
+        params: &[f64],
+        q: &[T],
+        payload: Option<usize>,
+    ) {
         let dof = model.dof();
         let mut t = 0;
         if let (Some(c), Some(state)) = (&model.compliance, &mut self.compliance) {
@@ -59,6 +66,7 @@ impl<T: RealField + Copy> CorrectionData<T> {
                 model,
                 c,
                 q,
+                payload,
                 &mut self.basis[..n],
                 &mut self.basis_rate[..n * dof],
             );

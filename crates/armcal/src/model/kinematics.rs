@@ -16,6 +16,10 @@ pub struct Data<T: RealField + Copy> {
     /// The station whose instrument pose [`forward_kinematics`] takes (an index into
     /// [`Model::stations`]; 0 by default, and the only one without stations).
     pub station: usize,
+    /// The payload the robot carries (an index into [`Model::payloads`]; `None` by default):
+    /// with compliance, its gravity torque deflects the joints
+    /// ([`crate::model::compliance`]).
+    pub payload: Option<usize>,
     /// Pose of the instrument frame in the world (at `station`).
     pub instrument: Pose<T>,
     /// World pose at the end of each chain link (base, links, tool).
@@ -53,6 +57,7 @@ impl<T: RealField + Copy> Data<T> {
     pub(crate) fn without_corrections(model: &Model) -> Self {
         Data {
             station: 0,
+            payload: None,
             instrument: Pose::identity(),
             frames: vec![Pose::identity(); model.links.len()],
             targets: vec![Pose::identity(); model.targets.len()],
@@ -85,7 +90,7 @@ pub fn forward_kinematics<T: RealField + Copy>(
     debug_assert_eq!(q.len(), model.dof());
     match data.corrections.take() {
         Some(mut state) => {
-            state.evaluate(model, params, q);
+            state.evaluate(model, params, q, data.payload);
             chain_pass(model, data, params, &state.q);
             state.set_twists(
                 model,

@@ -22,6 +22,10 @@ pub enum Unit {
     /// mm of lever, shown in µrad/m.
     #[serde(rename = "urad_per_m")]
     RadPerMm,
+    /// A joint's own compliance `c` (the payload term of [`crate::model::compliance`]),
+    /// stored in rad per N·mm of gravity torque, shown in µrad/(N·m).
+    #[serde(rename = "urad_per_Nm")]
+    RadPerNmm,
     /// A small joint angle: a periodic joint error's amplitude
     /// ([`crate::model::periodic`]), stored in radians, shown in arcseconds.
     Arcsec,
@@ -32,14 +36,14 @@ impl Unit {
     pub fn display_factor(self) -> f64 {
         match self {
             Unit::Rad => 180.0 / std::f64::consts::PI,
-            Unit::RadPerMm => 1e9,
+            Unit::RadPerMm | Unit::RadPerNmm => 1e9,
             Unit::Arcsec => 648_000.0 / std::f64::consts::PI,
             _ => 1.0,
         }
     }
 
     /// The largest magnitude a model value of this unit may have, in internal units: lengths
-    /// 10⁶ mm (1 km), angles 3600° (ten turns, 20π rad), dimensionless 10⁶, compliance 10⁶ µrad/m, periodic amplitudes 0.1 rad. Beyond these the
+    /// 10⁶ mm (1 km), angles 3600° (ten turns, 20π rad), dimensionless 10⁶, compliance 10⁶ µrad/m and 10⁶ µrad/(N·m), periodic amplitudes 0.1 rad. Beyond these the
     /// kinematics and the conversions between conventions lose every digit (and overflow), so
     /// a model refuses them ([`crate::model::LinkSpec::check_values`]).
     pub fn max_abs(self) -> f64 {
@@ -47,6 +51,7 @@ impl Unit {
             Unit::Mm | Unit::Unitless => 1e6,
             Unit::Rad => 20.0 * std::f64::consts::PI,
             Unit::RadPerMm => crate::model::compliance::MAX_COMPLIANCE,
+            Unit::RadPerNmm => crate::model::compliance::MAX_JOINT_COMPLIANCE,
             Unit::Arcsec => crate::model::periodic::MAX_AMPLITUDE,
         }
     }
@@ -72,6 +77,7 @@ impl Unit {
             Unit::Rad => "deg",
             Unit::Unitless => "1",
             Unit::RadPerMm => "µrad/m",
+            Unit::RadPerNmm => "µrad/(N·m)",
             Unit::Arcsec => "arcsec",
         }
     }

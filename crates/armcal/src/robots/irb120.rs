@@ -75,6 +75,7 @@ pub fn irb120() -> Robot {
         spec: ModelSpec {
             compliance: None,
             periodic: None,
+            payloads: Vec::new(),
             name: "irb120".into(),
             instrument: None,
             links,

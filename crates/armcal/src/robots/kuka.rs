@@ -90,6 +90,7 @@ fn build(k: Kr) -> Robot {
         spec: ModelSpec {
             compliance: None,
             periodic: None,
+            payloads: Vec::new(),
             name: k.name.into(),
             instrument: None,
             links,

@@ -99,6 +99,7 @@ pub fn motoman(arm: Arm) -> Robot {
         spec: ModelSpec {
             compliance: None,
             periodic: None,
+            payloads: Vec::new(),
             name,
             instrument: None,
             links,

@@ -89,6 +89,7 @@ pub fn notional(lambda: f64, mu: f64) -> Robot {
         spec: ModelSpec {
             compliance: None,
             periodic: None,
+            payloads: Vec::new(),
             name: format!("paper-{lambda}-{mu}"),
             instrument: None,
             links,

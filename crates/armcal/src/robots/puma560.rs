@@ -261,6 +261,7 @@ fn dh_spec(name: &str, rows: &[BookRow]) -> Result<ModelSpec, Error> {
     Ok(ModelSpec {
         compliance: None,
         periodic: None,
+        payloads: Vec::new(),
         name: name.into(),
         instrument: None,
         links,
@@ -303,6 +304,7 @@ fn zrp_spec(name: &str, rows: &[ZrpRow], t0: &[[f64; 4]; 3], mm: f64) -> Result<
     Ok(ModelSpec {
         compliance: None,
         periodic: None,
+        payloads: Vec::new(),
         name: name.into(),
         instrument: None,
         links,

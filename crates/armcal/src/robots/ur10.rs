@@ -65,6 +65,7 @@ pub fn ur10() -> Robot {
         spec: ModelSpec {
             compliance: None,
             periodic: None,
+            payloads: Vec::new(),
             name: "ur10".into(),
             instrument: None,
             links,

@@ -30,6 +30,11 @@ pub struct Perturbation {
     /// `nominal + σ z`. Default 20 arcsec (9.7·10⁻⁵ rad), a gear's transmission error.
     #[serde(default = "default_periodic")]
     pub periodic: f64,
+    /// A joint's own compliance `c` (the payload term of [`crate::model::compliance`], rad
+    /// per N·mm): the truth draws `c = nominal + σ |z|`. Default 5·10⁻⁹ rad/(N·mm) =
+    /// 5 µrad/(N·m) (a joint stiffness of 2·10⁵ N·m/rad).
+    #[serde(default = "default_joint_compliance")]
+    pub joint_compliance: f64,
     /// Perturb every parameter (`true`) or only the free ones (`false`, the default: the
     /// truth then lies in the identifiable set and identification can recover it exactly).
     pub all: bool,
@@ -43,6 +48,7 @@ impl Default for Perturbation {
             unitless: 1e-3,
             compliance: default_compliance(),
             periodic: default_periodic(),
+            joint_compliance: default_joint_compliance(),
             all: false,
         }
     }
@@ -50,6 +56,10 @@ impl Default for Perturbation {
 
 fn default_compliance() -> f64 {
     2e-7
+}
+
+fn default_joint_compliance() -> f64 {
+    5e-9
 }
 
 fn default_periodic() -> f64 {
@@ -74,6 +84,7 @@ pub fn perturbed_truth(model: &Model, p: &Perturbation, seed: u64) -> Vec<f64> {
                 Unit::Rad => p.angle,
                 Unit::Unitless => p.unitless,
                 Unit::RadPerMm => return par.nominal + p.compliance * z.abs(),
+                Unit::RadPerNmm => return par.nominal + p.joint_compliance * z.abs(),
                 Unit::Arcsec => p.periodic,
             };
             par.nominal + s * z
@@ -89,6 +100,19 @@ pub fn simulate(
     model: &Model,
     truth: &[f64],
     configurations: &[Vec<f64>],
+    noise: Option<&NoiseModel>,
+    seed: u64,
+) -> Result<Dataset, Error> {
+    simulate_carrying(model, truth, configurations, &[], noise, seed)
+}
+
+/// As [`simulate`], configuration `c` carrying payload `payloads[c]` (an index into
+/// [`Model::payloads`]; a missing entry or `None`: none), which the data record.
+pub fn simulate_carrying(
+    model: &Model,
+    truth: &[f64],
+    configurations: &[Vec<f64>],
+    payloads: &[Option<usize>],
     noise: Option<&NoiseModel>,
     seed: u64,
 ) -> Result<Dataset, Error> {
@@ -108,8 +132,10 @@ pub fn simulate(
         model
             .check_joints(q)
             .map_err(|e| Error::Input(format!("configuration {}: {e}", c + 1)))?;
+        fk.payload = payloads.get(c).copied().flatten();
         forward_kinematics(model, &mut fk, truth, q);
         let config = data.push_configuration(format!("{}", c + 1), q.clone());
+        data.set_payload(config, fk.payload.map(|k| model.payloads[k].name.as_str()));
         for &obs in &observed {
             let is_frame = matches!(obs, Observed::Target(k) if model.target_is_frame(k));
             let pose = observed_pose(&fk, obs);
@@ -221,17 +247,26 @@ pub struct Simulation {
 
 /// Measures the poses `(id, q)` on a robot perturbed from `model` ([`perturbed_truth`] with
 /// `seed`), with the instrument's `noise` (seed `seed + 0x5eed`; noise-free if `None`);
-/// configurations keep their ids. `cell` names the model in the truth record.
+/// configurations keep their ids, and every one carries `payload` (an index into
+/// [`Model::payloads`]; `None`: none). `cell` names the model in the truth record.
 pub fn simulate_poses(
     cell: &str,
     model: &Model,
     poses: &[(String, Vec<f64>)],
+    payload: Option<usize>,
     perturbation: &Perturbation,
     noise: Option<&NoiseModel>,
     seed: u64,
 ) -> Result<Simulation, Error> {
     let truth = perturbed_truth(model, perturbation, seed);
-    let data = simulate_with_ids(model, &truth, poses, noise, seed.wrapping_add(0x5eed))?;
+    let data = simulate_with_ids(
+        model,
+        &truth,
+        poses,
+        payload,
+        noise,
+        seed.wrapping_add(0x5eed),
+    )?;
     Ok(Simulation {
         data,
         truth: TruthRecord::new(cell, model, &truth, seed),
@@ -239,27 +274,32 @@ pub fn simulate_poses(
 }
 
 /// What the instrument measures at the poses `(id, q)` according to the model with
-/// parameters `params`, without noise; the data's source is "prediction".
+/// parameters `params` with the robot carrying `payload` (an index into [`Model::payloads`];
+/// `None`: none), without noise; the data's source is "prediction".
 pub fn predict(
     model: &Model,
     params: &[f64],
     poses: &[(String, Vec<f64>)],
+    payload: Option<usize>,
 ) -> Result<Dataset, Error> {
-    let mut data = simulate_with_ids(model, params, poses, None, 0)?;
+    let mut data = simulate_with_ids(model, params, poses, payload, None, 0)?;
     data.source = "prediction".into();
     Ok(data)
 }
 
-/// [`simulate`] at the configurations of `poses`, which keep their ids.
+/// [`simulate_carrying`] at the configurations of `poses`, which keep their ids, each
+/// carrying `payload`.
 fn simulate_with_ids(
     model: &Model,
     params: &[f64],
     poses: &[(String, Vec<f64>)],
+    payload: Option<usize>,
     noise: Option<&NoiseModel>,
     seed: u64,
 ) -> Result<Dataset, Error> {
     let qs: Vec<Vec<f64>> = poses.iter().map(|(_, q)| q.clone()).collect();
-    let mut data = simulate(model, params, &qs, noise, seed)?;
+    let payloads = vec![payload; qs.len()];
+    let mut data = simulate_carrying(model, params, &qs, &payloads, noise, seed)?;
     for (k, (id, _)) in poses.iter().enumerate() {
         data.config_ids[k] = id.clone();
     }

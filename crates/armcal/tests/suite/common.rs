@@ -21,7 +21,7 @@ pub fn random_geometry(c: Convention, kind: Option<JointKind>, r: &mut ChaCha8Rn
             Unit::Mm => r.random_range(-400.0..400.0),
             Unit::Rad => r.random_range(-3.0..3.0),
             Unit::Unitless => r.random_range(-1.5..1.5),
-            Unit::RadPerMm => r.random_range(0.0..1e-6),
+            Unit::RadPerMm | Unit::RadPerNmm => r.random_range(0.0..1e-6),
             Unit::Arcsec => r.random_range(-1e-3..1e-3),
         })
         .collect();
@@ -85,6 +85,7 @@ pub fn every_convention_model(seed: u64) -> Model {
     let spec = ModelSpec {
         compliance: None,
         periodic: None,
+        payloads: Vec::new(),
         name: "every-convention".into(),
         instrument: Some(LinkSpec {
             name: "tracker".into(),
@@ -118,7 +119,7 @@ pub fn compliant_model(seed: u64) -> Model {
     let term = |joint: &str, at: &str, value: f64| armcal::model::compliance::ComplianceTerm {
         joint: joint.into(),
         mass: format!("at_{at}"),
-        at: at.into(),
+        at: Some(at.into()),
         value,
     };
     let mut k = || r.random_range(0.2e-5..1.5e-5);

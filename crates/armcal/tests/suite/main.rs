@@ -22,6 +22,7 @@ mod identify {
     mod identification_input;
     mod identification_validation;
     mod mixed_measurements;
+    mod payload;
     mod periodic;
     mod priors_and_noise;
     mod stations;

@@ -17,6 +17,7 @@ pub(super) fn find_with_unit<'t>(
         Unit::Rad => &[("_deg", std::f64::consts::PI / 180.0), ("_rad", 1.0)],
         Unit::Unitless => &[("", 1.0)],
         Unit::RadPerMm => &[("_urad_per_m", 1e-9)],
+        Unit::RadPerNmm => &[("_urad_per_Nm", 1e-9)],
         Unit::Arcsec => &[("_arcsec", std::f64::consts::PI / 648_000.0)],
     };
     let mut found = None;
@@ -132,6 +133,7 @@ pub(super) fn unit_spellings(field: &str, unit: Unit) -> String {
         Unit::Rad => format!("{field}_deg|{field}_rad"),
         Unit::Unitless => field.to_string(),
         Unit::RadPerMm => format!("{field}_urad_per_m"),
+        Unit::RadPerNmm => format!("{field}_urad_per_Nm"),
         Unit::Arcsec => format!("{field}_arcsec"),
     }
 }

@@ -1,7 +1,7 @@
 //! The TOML layer of the cell file: raw structures with spans, unit suffixes, and errors
 //! that give file, line and field. [`parse`] reads the file section by section, one module
 //! per section: [`robot`] (`[robot]`, `[[tool_capsules]]`), [`instrument`], [`frames`]
-//! (`[base]`, `[tool]`, `[[targets]]`), [`parameters`], [`working`], [`obstacles`],
+//! (`[base]`, `[tool]`, `[[targets]]`), [`payloads`], [`parameters`], [`working`], [`obstacles`],
 //! [`design`] and [`data`]; [`fields`] holds the field readers they share.
 
 use super::*;
@@ -19,6 +19,7 @@ mod frames;
 mod instrument;
 mod obstacles;
 mod parameters;
+mod payloads;
 mod robot;
 mod working;
 
@@ -41,6 +42,8 @@ struct RawCell {
     obstacles: Vec<Spanned<toml::Table>>,
     #[serde(default)]
     tool_capsules: Vec<Spanned<toml::Table>>,
+    #[serde(default)]
+    payload: Vec<Spanned<toml::Table>>,
     design: Option<Spanned<toml::Table>>,
     data: Option<Spanned<data::RawData>>,
 }
@@ -160,7 +163,9 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
     let given = Model::from_spec(&spec).map_err(model_error)?;
     let shaped = shape_robot(&mut robot, &given, spec, form, &mut tool_capsules)
         .map_err(|e| ctx.err(rspan.clone(), "robot.convention", e))?;
-    let mut model = Model::from_spec(&shaped.spec).map_err(model_error)?;
+    let mut spec = shaped.spec;
+    spec.payloads = payloads::payloads(&ctx, &raw.payload)?;
+    let mut model = Model::from_spec(&spec).map_err(model_error)?;
     parameters::joint_corrections(&ctx, raw.parameters.as_ref(), rr.gravity, &mut model)?;
 
     let (measurement, auto_free) =

@@ -175,7 +175,7 @@ fn term_value<'a>(spec: &'a mut ModelSpec, name: &str) -> Option<(Unit, &'a mut 
     let periodic = spec.periodic.iter_mut().flat_map(|p| p.terms.iter_mut());
     compliance
         .filter(|t| ComplianceSpec::parameter_name(t) == name)
-        .map(|t| (Unit::RadPerMm, &mut t.value))
+        .map(|t| (t.unit(), &mut t.value))
         .chain(
             periodic
                 .filter(|t| PeriodicSpec::parameter_name(t) == name)

@@ -72,6 +72,7 @@ pub(super) fn robot(
             spec: ModelSpec {
                 compliance: None,
                 periodic: None,
+                payloads: Vec::new(),
                 name,
                 instrument: None,
                 links,
@@ -226,6 +227,7 @@ fn inline_link(t: &toml::Table, index: usize) -> Result<LinkSpec, String> {
                     Unit::Rad => "_deg",
                     Unit::Unitless => "",
                     Unit::RadPerMm => "_urad_per_m",
+                    Unit::RadPerNmm => "_urad_per_Nm",
                     Unit::Arcsec => "_arcsec",
                 };
                 return Err(format!(

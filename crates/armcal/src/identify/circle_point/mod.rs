@@ -456,6 +456,7 @@ pub fn axes_to_zrp(axes: &AxesResult, tool_pose_at_zero: &Pose<f64>) -> Result<M
     let spec = ModelSpec {
         compliance: None,
         periodic: None,
+        payloads: Vec::new(),
         name: format!("{}-cpa", axes.model),
         instrument: None,
         links,
@@ -543,6 +544,7 @@ pub fn axes_to_s_model(
     let spec = ModelSpec {
         compliance: None,
         periodic: None,
+        payloads: Vec::new(),
         name: format!("{}-cpa-s", axes.model),
         instrument: None,
         links,

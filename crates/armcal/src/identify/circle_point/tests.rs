@@ -275,6 +275,7 @@ fn prismatic_axis_and_zero_reference_check() {
     let spec = ModelSpec {
         compliance: None,
         periodic: None,
+        payloads: Vec::new(),
         name: "rp".into(),
         instrument: None,
         links: vec![

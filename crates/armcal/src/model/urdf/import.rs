@@ -176,6 +176,7 @@ pub fn from_urdf_robot(robot: &urdf_rs::Robot, tip: Option<&str>) -> Result<Mode
     Ok(ModelSpec {
         compliance: None,
         periodic: None,
+        payloads: Vec::new(),
         name: robot.name.clone(),
         instrument: None,
         links: out,

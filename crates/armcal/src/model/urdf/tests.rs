@@ -203,7 +203,9 @@ fn every_convention_spec(seed: u64) -> ModelSpec {
                 crate::model::Unit::Mm => r.random_range(-400.0..400.0),
                 crate::model::Unit::Rad => r.random_range(-3.0..3.0),
                 crate::model::Unit::Unitless => r.random_range(0.2..1.5),
-                crate::model::Unit::RadPerMm | crate::model::Unit::Arcsec => {
+                crate::model::Unit::RadPerMm
+                | crate::model::Unit::RadPerNmm
+                | crate::model::Unit::Arcsec => {
                     unreachable!("no link field is a joint correction")
                 }
             })
@@ -273,6 +275,7 @@ fn every_convention_spec(seed: u64) -> ModelSpec {
     ModelSpec {
         compliance: None,
         periodic: None,
+        payloads: Vec::new(),
         name: "every".into(),
         instrument: None,
         links,

@@ -97,6 +97,7 @@ fn random_chain(c: Convention, n: usize, seed: u64) -> ModelSpec {
     ModelSpec {
         compliance: None,
         periodic: None,
+        payloads: Vec::new(),
         name: format!("random-{c}"),
         instrument: None,
         links,

@@ -179,7 +179,10 @@ fn mixed_derivative_matches_finite_differences_of_jacobian() {
                         // difference rounds at eps·|column|/h, so compare it on its column's
                         // scale (the dual-number test below checks it exactly).
                         let c = idx / m;
-                        let scale = if model.registry.get(c).unit == Unit::RadPerMm {
+                        let scale = if matches!(
+                            model.registry.get(c).unit,
+                            Unit::RadPerMm | Unit::RadPerNmm
+                        ) {
                             j0.column(c).abs().max().max(1.0)
                         } else {
                             1.0

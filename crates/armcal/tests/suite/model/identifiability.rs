@@ -82,6 +82,7 @@ fn random_chain(kinds: &str, seed: u64) -> Model {
     Model::from_spec(&ModelSpec {
         compliance: None,
         periodic: None,
+        payloads: Vec::new(),
         name: kinds.into(),
         instrument: None,
         links,
