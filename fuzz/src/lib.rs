@@ -72,8 +72,8 @@ pub fn cell(text: &str) {
 
 /// The built-in cells a fuzzed data file is read for: the paper cell (armcal's own columns)
 /// and the UR10 cell (a vendor's `;`-separated, decimal-comma file through a `[data]` mapping).
-fn data_cells() -> &'static [Cell; 2] {
-    static CELLS: OnceLock<[Cell; 2]> = OnceLock::new();
+fn data_cells() -> &'static [Cell; 3] {
+    static CELLS: OnceLock<[Cell; 3]> = OnceLock::new();
     CELLS.get_or_init(|| {
         let read = |text: &str, name: &str| {
             Cell::from_toml(text, name, Path::new(".")).expect("a built-in example cell")
@@ -84,13 +84,18 @@ fn data_cells() -> &'static [Cell; 2] {
                 include_str!("../../examples/ur10-leica-cell.toml"),
                 "ur10-leica-cell.toml",
             ),
+            read(
+                include_str!("../../examples/paper-payload-cell.toml"),
+                "paper-payload-cell.toml",
+            ),
         ]
     })
 }
 
-/// A CSV file through one of armcal's CSV readers; the first byte chooses the cell (bit 0)
-/// and the reader (bits 1–2): a data file (0), a pose list or pose pool (1), a program of
-/// Cartesian targets (2).
+/// A CSV file through one of armcal's CSV readers; the first byte chooses the cell (bit 0:
+/// paper or UR10; bit 3 set: the paper cell with compliance and payloads, for the `payload`
+/// column) and the reader (bits 1–2): a data file (0), a pose list or pose pool (1), a
+/// program of Cartesian targets (2).
 pub fn data_csv(bytes: &[u8]) {
     let Some((&choice, rest)) = bytes.split_first() else {
         return;
@@ -98,7 +103,11 @@ pub fn data_csv(bytes: &[u8]) {
     let Ok(text) = std::str::from_utf8(rest) else {
         return;
     };
-    let cell = &data_cells()[usize::from(choice & 1)];
+    let cell = &data_cells()[if choice & 8 != 0 {
+        2
+    } else {
+        usize::from(choice & 1)
+    }];
     match (choice >> 1) & 3 {
         1 => configurations(cell, text),
         2 => {

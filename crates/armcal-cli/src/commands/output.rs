@@ -281,7 +281,13 @@ pub fn load_estimate(
     Ok((est, usable.overridden))
 }
 
-/// As [`load_params`], with the payload the robot carries: `name` checked against the
+/// The payload a prediction is made at (an index into the model's payloads) and, unless the
+/// model has no payloads and none was asked for, the sentence saying how.
+pub type PayloadChoice = (Option<usize>, Option<String>);
+
+/// The parameters of the estimate at `path` for `model` ([`load_estimate`]), or the nominal
+/// ones without an estimate, with the line every output made with them must carry, and the
+/// payload the robot carries: `name` checked against the
 /// estimate ([`armcal::identify::Estimate::payload_for`]) — the payload index and the
 /// sentence saying how it is predicted (`None` for a model without payloads and no
 /// `--payload`). Without an estimate, the nominal model at payload `name`.
@@ -290,7 +296,7 @@ pub fn load_params_at_payload(
     accept: &AcceptUnconverged,
     model: &armcal::model::Model,
     name: Option<&str>,
-) -> anyhow::Result<(Vec<f64>, Option<String>, (Option<usize>, Option<String>))> {
+) -> anyhow::Result<(Vec<f64>, Option<String>, PayloadChoice)> {
     let quiet = name.is_none() && model.payloads.is_empty();
     match path {
         Some(p) => {
