@@ -464,29 +464,6 @@ impl Model {
         }
     }
 
-    /// The index of payload `name` in [`Model::payloads`]; `None` (no payload) for `none`
-    /// or an empty name; an unknown name is an error that lists the model's payloads.
-    pub fn payload_index(&self, name: &str) -> Result<Option<usize>, String> {
-        if name.is_empty() || name == "none" {
-            return Ok(None);
-        }
-        match self.payloads.iter().position(|p| p.name == name) {
-            Some(k) => Ok(Some(k)),
-            None if self.payloads.is_empty() => Err(format!(
-                "payload `{name}`: the cell declares no payload (add a [[payload]] with its \
-                 name, mass_kg and com_mm)"
-            )),
-            None => Err(format!(
-                "payload `{name}` is not one of the cell's payloads ({}; or `none`)",
-                self.payloads
-                    .iter()
-                    .map(|p| p.name.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            )),
-        }
-    }
-
     /// The joint-space correction terms ([`crate::model::joint_correction`]) in registry
     /// order, each as (registry index, index of the joint it turns): the compliance terms,
     /// then the periodic terms.
