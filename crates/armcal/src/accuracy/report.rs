@@ -172,12 +172,14 @@ pub fn accuracy_report(
     for m in &data.measurements {
         by_config[m.config].push(m);
     }
+    let payloads = data.model_payloads(model)?;
     let mut fk = Data::new(model);
     let (mut errors, mut angle_errors) = (Vec::new(), Vec::new());
     let mut figures = Vec::new();
     for group in &poses.groups {
         let mut samples: Vec<(Observed, Samples)> = Vec::new();
         for &c in group {
+            fk.payload = payloads[c];
             forward_kinematics(model, &mut fk, params, &data.configurations[c]);
             for m in &by_config[c] {
                 let (value, rot) = match &m.kind {

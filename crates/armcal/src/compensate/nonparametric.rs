@@ -287,6 +287,7 @@ impl ResidualCorrection {
                 model.dof()
             )));
         }
+        let payloads = data.model_payloads(model)?;
         let mut fk = Data::new(model);
         let (mut xs, mut es) = (Vec::new(), Vec::new());
         for m in &data.measurements {
@@ -296,6 +297,7 @@ impl ResidualCorrection {
                 _ => continue,
             };
             let q = &data.configurations[m.config];
+            fk.payload = payloads[m.config];
             forward_kinematics(model, &mut fk, calibrated, q);
             let predicted = observed_position(&fk, m.observed);
             let world = fk.instrument.transform_point(&predicted);

@@ -597,7 +597,7 @@ pub fn import(path: &Path, model: &Model, format: &DataFormat) -> Result<Import,
 }
 
 /// Writes a dataset in armcal's format: `pose_id`, `station` if the data name stations,
-/// `payload` if any configuration carried one,
+/// `payload` if any configuration carried one or the model has payloads,
 /// `q<i>_deg` (or `_mm`), `target`, `x_mm`,
 /// `y_mm`, `z_mm`, then `roll_deg`, `pitch_deg`, `yaw_deg` for pose rows and σ columns if
 /// any measurement has them, and `temperature_c` if any measurement recorded one. Only
@@ -621,7 +621,8 @@ pub fn write_string(data: &Dataset, model: &Model) -> Result<String, Error> {
     if stations {
         header.push("station".into());
     }
-    let payloads = data.carries_payloads();
+    // a cell with payloads writes the column always, so that its files share one header
+    let payloads = data.carries_payloads() || !model.payloads.is_empty();
     if payloads {
         header.push("payload".into());
     }

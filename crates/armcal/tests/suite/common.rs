@@ -331,11 +331,16 @@ pub fn paper_cell_with(extra: &str, tag: &str) -> Result<Cell, armcal::Error> {
         "measurement = \"position\"",
         &format!("measurement = \"position\"\n{extra}"),
     );
+    cell_from_text(&text, tag)
+}
+
+/// The cell file `text` read through a temporary file (tagged `tag`), as a user's file is.
+pub fn cell_from_text(text: &str, tag: &str) -> Result<Cell, armcal::Error> {
     // one file per call: tests run in parallel and share tags
     static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let path = std::env::temp_dir().join(format!(
-        "armcal-compliance-{tag}-{}-{call}.toml",
+        "armcal-cell-{tag}-{}-{call}.toml",
         std::process::id()
     ));
     std::fs::write(&path, text).unwrap();

@@ -27,17 +27,7 @@ fn cell_with(payloads: &str, tag: &str) -> Result<Cell, armcal::Error> {
         "measurement = \"position\"",
         "measurement = \"position\"\ncompliance = [\"q2\", \"q3\"]",
     ) + payloads;
-    // one file per call: tests run in parallel
-    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let path = std::env::temp_dir().join(format!(
-        "armcal-payload-{tag}-{}-{call}.toml",
-        std::process::id()
-    ));
-    std::fs::write(&path, text).unwrap();
-    let cell = Cell::from_file(&path);
-    std::fs::remove_file(&path).unwrap();
-    cell
+    crate::common::cell_from_text(&text, &format!("payload-{tag}"))
 }
 
 fn payload_cell() -> Cell {
@@ -166,17 +156,19 @@ fn payload_columns_match_finite_differences() {
     let n = model.param_count();
     let columns: Vec<usize> = (0..n).collect();
     let obs = Observed::Target(0);
-    let position = |p: &[f64], q: &[f64], payload: Option<usize>| {
+    // the kinematics at (p, q) carrying `payload`
+    let at = |p: &[f64], q: &[f64], payload: Option<usize>| {
         let mut d = Data::new(model);
         d.payload = payload;
         forward_kinematics(model, &mut d, p, q);
-        observed_position(&d, obs)
+        d
     };
+    // the target in the instrument frame (identification rows) and the world (joint rows)
+    let position = |p: &[f64], q: &[f64], payload| observed_position(&at(p, q, payload), obs);
+    let world = |q: &[f64], payload| at(&params, q, payload).targets[0].trans;
     for (k, q) in random_configurations(model, 5, 4).iter().enumerate() {
         let payload = [None, Some(0), Some(1)][k % 3];
-        let mut data = Data::new(model);
-        data.payload = payload;
-        forward_kinematics(model, &mut data, &params, q);
+        let data = at(&params, q, payload);
         let mut jac = DMatrix::zeros(3, n);
         identification_jacobian(model, &data, obs, Rows::Position, &columns, &mut jac, 0);
         for j in 0..n {
@@ -207,13 +199,7 @@ fn payload_columns_match_finite_differences() {
             let (mut a, mut b) = (q.clone(), q.clone());
             a[i] += 1e-6;
             b[i] -= 1e-6;
-            let world = |q: &[f64]| {
-                let mut d = Data::new(model);
-                d.payload = payload;
-                forward_kinematics(model, &mut d, &params, q);
-                d.targets[0].trans
-            };
-            let fd = (world(&a) - world(&b)) / 2e-6;
+            let fd = (world(&a, payload) - world(&b, payload)) / 2e-6;
             for r in 0..3 {
                 assert!(
                     (commanded[(r, i)] - fd[r]).abs() <= 1e-5 * fd.norm().max(1.0),
@@ -314,4 +300,42 @@ fn the_calibrated_ik_at_a_payload_reaches_the_target_on_the_loaded_truth() {
         worst_rigid > 0.1,
         "the payload's deflection is visible: {worst_rigid} mm"
     );
+}
+
+#[test]
+fn accuracy_and_the_nonparametric_fit_see_each_rows_payload() {
+    use armcal::accuracy::report::{accuracy_report, Orientation};
+    use armcal::accuracy::same_pose::{commanded_poses, SamePose};
+    use armcal::compensate::nonparametric::{CorrectionInputs, ResidualCorrection};
+    let cell = payload_cell();
+    let model = &cell.model;
+    let p = Perturbation {
+        joint_compliance: 2e-8,
+        ..Perturbation::default()
+    };
+    let truth = perturbed_truth(model, &p, 12);
+    let data = measured(model, &truth, 30, &[None, Some(0)]);
+    // the robot that measured them predicts every row, loaded or not
+    let poses = commanded_poses(
+        model,
+        &data.configurations,
+        &data.config_ids,
+        &SamePose::default(),
+    );
+    let report = accuracy_report(model, &truth, &data, &poses, Orientation::IfMeasured).unwrap();
+    assert!(
+        report.errors.max < 1e-9,
+        "max error {} mm",
+        report.errors.max
+    );
+    let c = ResidualCorrection::fit(model, &truth, &data, CorrectionInputs::ArmJoints, 2).unwrap();
+    assert!(
+        c.polynomial.training_rms_before < 1e-9,
+        "{}",
+        c.polynomial.training_rms_before
+    );
+    // a data file of a cell with payloads has the payload column even without a loaded row
+    let bare = measured(model, &truth, 3, &[None]);
+    let text = csv::write_string(&bare, model).unwrap();
+    assert!(text.lines().next().unwrap().contains(",payload,"), "{text}");
 }
