@@ -131,6 +131,10 @@ pub struct CriterionValue {
     pub value: f64,
     /// `Φ = ∂φ/∂M` (symmetric).
     pub gradient: DMatrix<f64>,
+    /// `F` with `Φ = −F Fᵀ`, when the criterion has that form with fewer columns than
+    /// parameters (KPI: `F = C Hᵀ`, 3 columns per working configuration): the design
+    /// gradient `∂φ/∂q = −2 ⟨J F, (∂J/∂q) F⟩` then costs O(rows · n_p · columns).
+    pub factor: Option<DMatrix<f64>>,
 }
 
 /// Evaluates `criterion` for the information matrix `M = RᵀR`, given its triangular
@@ -163,12 +167,14 @@ pub fn evaluate(
                 Criterion::A => CriterionValue {
                     value: c.trace() / nf,
                     gradient: -(&c * &c) / nf,
+                    factor: None,
                 },
                 Criterion::D => {
                     let logdet: f64 = 2.0 * r.diagonal().iter().map(|x| x.abs().ln()).sum::<f64>();
                     CriterionValue {
                         value: -logdet / nf,
                         gradient: -c / nf,
+                        factor: None,
                     }
                 }
                 Criterion::KpiMax => kpi_max(&c, d)?,
@@ -178,6 +184,7 @@ pub fn evaluate(
                     CriterionValue {
                         value: (&h * &ch).trace(),
                         gradient: -(&ch * ch.transpose()),
+                        factor: (ch.ncols() < n).then_some(ch),
                     }
                 }
             })
@@ -243,7 +250,11 @@ pub fn evaluate(
                     gradient.ger(*g, &vi, &vi, 1.0);
                 }
             }
-            Ok(CriterionValue { value, gradient })
+            Ok(CriterionValue {
+                value,
+                gradient,
+                factor: None,
+            })
         }
     }
 }
@@ -283,6 +294,7 @@ fn kpi_max(c: &DMatrix<f64>, d: &DesignModel) -> Result<CriterionValue, Error> {
     Ok(CriterionValue {
         value,
         gradient: -(&weighted * weighted.transpose()),
+        factor: (weighted.ncols() < c.nrows()).then_some(weighted),
     })
 }
 

@@ -2,9 +2,12 @@
 //! N×k joint values: `∂φ/∂q_ij = 2 ⟨W^{1/2}J_i Φ, W^{1/2} ∂J_i/∂q_j⟩_F`, O(N·n_p²) with the
 //! mixed derivatives of the foundation — no finite differences, no Hessian.
 //!
-//! Solvers such as PANOC ask for φ and then for ∇φ at the same point; the workspace keeps
-//! the last point with its whitened Jacobians `W^{1/2}J_i` and `Φ = ∂φ/∂M`, so the gradient
-//! call there only adds the mixed derivatives ∂J_i/∂q_j (no second factorisation of M).
+//! When the criterion's `Φ = −F Fᵀ` has few columns (KPI: `F = C Hᵀ`), the gradient is
+//! `∂φ/∂q_ij = −2 ⟨W^{1/2}J_i F, W^{1/2}(∂J_i/∂q_j) F⟩_F`, O(N·k·rows·n_p·cols(F)).
+//!
+//! A solver may ask for φ and then for ∇φ at the same point; the workspace keeps the last
+//! point with its whitened Jacobians `W^{1/2}J_i` and `Φ = ∂φ/∂M`, so the gradient call there
+//! only adds the mixed derivatives ∂J_i/∂q_j (no second factorisation of M).
 
 use crate::design::criteria::{evaluate, Criterion};
 use crate::design::information::{DesignModel, InformationWorkspace};
@@ -35,15 +38,18 @@ pub struct ObjectiveWorkspace {
     info: InformationWorkspace,
     jacs: Vec<DMatrix<f64>>,
     jacs_dq: Vec<Vec<DMatrix<f64>>>,
-    /// `W^{1/2}J_i Φ` of one configuration.
+    /// `W^{1/2}J_i Φ` of one configuration (or `−(W^{1/2}J_i F) Fᵀ`).
     j_phi: DMatrix<f64>,
     owner: u64,
     cached_q: Vec<f64>,
     /// Whether `cached_q`, `value`, `phi` and `jacs` belong together.
     cached: bool,
-    /// φ and `Φ` at `cached_q`.
+    /// φ, `Φ` and `F` (`Φ = −F Fᵀ`, when the criterion gives it) at `cached_q`.
     value: f64,
     phi: DMatrix<f64>,
+    factor: Option<DMatrix<f64>>,
+    /// `W^{1/2}J_i F` of one configuration (rows × cols(F)).
+    jf: Vec<f64>,
     /// Whether `jacs_dq` holds the derivatives at `cached_q`.
     cached_dq: bool,
 }
@@ -85,6 +91,8 @@ impl<'a> DesignObjective<'a> {
             cached: false,
             value: f64::NAN,
             phi: DMatrix::zeros(d.n(), d.n()),
+            factor: None,
+            jf: Vec::new(),
             cached_dq: false,
         }
     }
@@ -132,6 +140,7 @@ impl<'a> DesignObjective<'a> {
             let cv = evaluate(self.criterion, &r, self.design)?;
             ws.value = cv.value;
             ws.phi.copy_from(&cv.gradient);
+            ws.factor = cv.factor;
             ws.cached = true;
             ws.cached_dq = gradient.is_some();
         }
@@ -144,10 +153,21 @@ impl<'a> DesignObjective<'a> {
             }
             ws.cached_dq = true;
         }
-        for i in 0..nconf {
-            ws.j_phi.gemm(1.0, &ws.jacs[i], &ws.phi, 0.0);
-            for j in 0..k {
-                g[i * k + j] = 2.0 * ws.j_phi.dot(&ws.jacs_dq[i][j]);
+        if let Some(f) = &ws.factor {
+            // −J_i Φ = (J_i F) Fᵀ, then ∂φ/∂q_ij = −2 ⟨∂J_i/∂q_j, (J_i F) Fᵀ⟩.
+            ws.jf.resize(self.design.rows() * f.ncols(), 0.0);
+            for i in 0..nconf {
+                through_factor(&ws.jacs[i], f, &mut ws.jf, ws.j_phi.as_mut_slice());
+                for j in 0..k {
+                    g[i * k + j] = -2.0 * ws.j_phi.dot(&ws.jacs_dq[i][j]);
+                }
+            }
+        } else {
+            for i in 0..nconf {
+                ws.j_phi.gemm(1.0, &ws.jacs[i], &ws.phi, 0.0);
+                for j in 0..k {
+                    g[i * k + j] = 2.0 * ws.j_phi.dot(&ws.jacs_dq[i][j]);
+                }
             }
         }
         Ok(ws.value)
@@ -167,6 +187,29 @@ impl<'a> DesignObjective<'a> {
     pub fn information(&self, q: &[Vec<f64>]) -> DMatrix<f64> {
         let mut ws = InformationWorkspace::new(self.design);
         self.prior_rows.tr_mul(&self.prior_rows) + self.design.information(&mut ws, q)
+    }
+}
+
+/// `G = (A F) Fᵀ` (rows × n, column-major) for `A` (rows × n) and `F` (n × cols), through
+/// `T = A F` (rows × cols): O(rows · n · cols).
+fn through_factor(a: &DMatrix<f64>, f: &DMatrix<f64>, t: &mut [f64], g: &mut [f64]) {
+    let (rows, n) = a.shape();
+    let cols = f.ncols();
+    let (a, f) = (a.as_slice(), f.as_slice());
+    for c in 0..cols {
+        let fc = &f[c * n..(c + 1) * n];
+        for r in 0..rows {
+            t[c * rows + r] = fc
+                .iter()
+                .enumerate()
+                .map(|(p, x)| a[p * rows + r] * x)
+                .sum();
+        }
+    }
+    for p in 0..n {
+        for r in 0..rows {
+            g[p * rows + r] = (0..cols).map(|c| t[c * rows + r] * f[c * n + p]).sum();
+        }
     }
 }
 
