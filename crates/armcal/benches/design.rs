@@ -1,7 +1,8 @@
 //! Pose-design benchmarks, the README rows: one KPI design of 60 poses for the paper cell
 //! (27 parameters) without collision avoidance (`examples/paper-cell.toml`: joint limits
 //! and the incidence limit) and with it (`examples/paper-cell-obstacles.toml`, 67
-//! constraints per pose), with the planner's default settings (2 starts in parallel). The
+//! constraints per pose), with the planner's default settings (2 starts in parallel); and one
+//! campaign re-plan step: 10 new poses given 40 measured (the paper cell, no collisions). The
 //! criterion value, feasibility and bound of each design are printed once before timing.
 //! The 90-manipulator study is timed by the CLI:
 //! `time ./target/release/armcal study paper --collisions on --out DIR`.
@@ -17,18 +18,36 @@ use armcal::cell::builtin::PAPER_CELL_OBSTACLES as CELL_OBSTACLES;
 fn design(c: &mut Criterion) {
     let mut group = c.benchmark_group("plan");
     group.sample_size(10);
-    for (name, text, collisions) in [
-        ("KPI, 60 poses, no collisions", CELL, false),
-        ("KPI, 60 poses, collisions", CELL_OBSTACLES, true),
+    for (name, text, collisions, poses, measured) in [
+        ("KPI, 60 poses, no collisions", CELL, false, 60, 0),
+        ("KPI, 60 poses, collisions", CELL_OBSTACLES, true, 60, 0),
+        (
+            "KPI, 10 poses given 40 measured, no collisions",
+            CELL,
+            false,
+            10,
+            40,
+        ),
     ] {
         let cell = Cell::from_toml(text, "cell.toml", std::path::Path::new(".")).expect("cell");
         assert_eq!(cell.model.registry.free().len(), 27);
         let settings = PlanSettings {
-            poses: 60,
+            poses,
             collisions,
             ..PlanSettings::default()
         };
-        let r = plan(&cell, &settings, &[], &mut Silent).expect("plan");
+        // The measured poses: a 40-pose KPI design of another seed.
+        let measured = if measured > 0 {
+            let first = PlanSettings {
+                poses: measured,
+                seed: 2,
+                ..settings.clone()
+            };
+            plan(&cell, &first, &[], &mut Silent).expect("plan").design
+        } else {
+            Vec::new()
+        };
+        let r = plan(&cell, &settings, &measured, &mut Silent).expect("plan");
         eprintln!(
             "{name}: (1/3) tr C_s = {:.5} mm², feasible {}, efficiency {:.3}, refinement: {} ({} iterations)",
             r.value,
@@ -38,7 +57,7 @@ fn design(c: &mut Criterion) {
             r.refine_iterations
         );
         group.bench_function(name, |b| {
-            b.iter(|| plan(&cell, &settings, &[], &mut Silent).expect("plan"))
+            b.iter(|| plan(&cell, &settings, &measured, &mut Silent).expect("plan"))
         });
     }
     group.finish();

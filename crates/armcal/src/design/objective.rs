@@ -27,6 +27,9 @@ pub struct DesignObjective<'a> {
     /// Whitened Jacobian rows of configurations already measured (design augmentation),
     /// then the cell's prior rows ([`DesignModel::prior_rows`]).
     pub prior_rows: DMatrix<f64>,
+    /// The same information in at most n_p rows: `R₀` with `R₀ᵀR₀ = prior_rowsᵀ prior_rows`
+    /// (the rows themselves when there are fewer), stacked above each design's rows.
+    prior_factor: DMatrix<f64>,
     /// Identity of this objective (see [`ObjectiveWorkspace`]).
     id: u64,
 }
@@ -67,12 +70,21 @@ impl<'a> DesignObjective<'a> {
             design.jacobian(&mut ws, q);
             prior_rows.rows_mut(i * rows, rows).copy_from(&ws.jac);
         }
+<<<<<<< HEAD
         prior_rows
             .rows_mut(rows * measured.len(), cell_prior)
             .copy_from(&design.prior_rows);
+=======
+        let prior_factor = if prior_rows.nrows() > design.n() {
+            triangular_factor(prior_rows.clone())
+        } else {
+            prior_rows.clone()
+        };
+>>>>>>> dc62fc7 (Planner figures (issue 16 item 4): bench case for one campaign re-plan step (10 poses given 40 measured); the prior information enters each evaluation as its n_p-row triangular factor, not the measured rows; README: the study's KPI designs with collisions 0.333-0.337 (were 0.336-0.406) and why the worst robots ended high (PANOC stalled on the incidence/joint-limit boundary), measured-figures rows at the shared machine's load with the distance to the physical limit; DESIGN and docs name the projected L-BFGS)
         DesignObjective {
             design,
             criterion,
+            prior_factor,
             prior_rows,
             id: NEXT_OBJECTIVE_ID.fetch_add(1, Ordering::Relaxed),
         }
@@ -123,9 +135,9 @@ impl<'a> DesignObjective<'a> {
             ws.cached_q.clear();
             ws.cached_q.extend_from_slice(q);
             let rows = self.design.rows();
-            let np = self.prior_rows.nrows();
+            let np = self.prior_factor.nrows();
             let mut stacked = DMatrix::zeros(np + rows * nconf, self.design.n());
-            stacked.rows_mut(0, np).copy_from(&self.prior_rows);
+            stacked.rows_mut(0, np).copy_from(&self.prior_factor);
             for i in 0..nconf {
                 let qi = &q[i * k..(i + 1) * k];
                 if gradient.is_some() {

@@ -20,12 +20,12 @@ const REANCHOR_DISTANCE: f64 = 0.2;
 
 /// The feasible set of the design: a product over configurations of each configuration's
 /// joint box (the joint limits, or a smaller box around a pose of the user's pool) and
-/// `{q : g(q) ≥ 0}`. Its projection (the proximal step of PANOC) clamps each configuration
+/// `{q : g(q) ≥ 0}`. Its projection (of every trial point of the descent) clamps each configuration
 /// into the box and then applies minimum-norm Gauss–Newton corrections on the violated
 /// constraints `v`, `Δq = J_vᵀ (J_v J_vᵀ)⁻¹ (−g_v)` — the Euclidean projection to first
 /// order — until none is violated. Allocates nothing per call.
 ///
-/// PANOC projects every line-search trial, mostly after small moves, so each configuration
+/// The descent projects every line-search trial, mostly after small moves, so each configuration
 /// keeps an anchor `a` where all its constraints were last evaluated. By the mean-value
 /// theorem `g_c(q) ≥ g_c(a) − L_c ‖q − a‖₁` with `L_c = sup ‖∇g_c‖_∞`; only the constraints
 /// for which this bound does not prove `g_c(q) ≥ 0` are evaluated (none at all for a
