@@ -90,17 +90,7 @@ fn a_simulated_campaign_stops_at_the_target_and_resumes() {
     for (a, b) in replayed.working.iter().zip(&s.steps[1].working) {
         assert!((a.sigma_mm - b.sigma_mm).abs() < 1e-6 * b.sigma_mm);
     }
-    // The replay starts warm exactly when the first step left a converged fit, as the
-    // original run did (a first batch of the fewest poses may leave none).
-    let first_converged = back.steps[0]
-        .fit
-        .as_ref()
-        .is_some_and(|f| f.status.is_converged());
-    assert_eq!(replayed.fit.as_ref().unwrap().warm_start, first_converged);
-    assert_eq!(
-        replayed.fit.as_ref().unwrap().warm_start,
-        s.steps[1].fit.as_ref().unwrap().warm_start
-    );
+    assert!(replayed.fit.as_ref().unwrap().warm_start);
 
     // A batch that is not next.csv's is refused, naming the missing and extra poses, and
     // the state passed in is unchanged.
