@@ -305,6 +305,26 @@ impl ConfigurationConstraints for CellConstraints<'_> {
     }
 }
 
+/// Smallest singular-value ratio of the column-normalised Jacobian a refined design must
+/// keep: a hundred times the rank tolerance of identify's identifiability analysis
+/// ([`crate::model::identifiability`], 1e-8), so that a design the refinement drove towards
+/// a direction the criterion barely sees (the tracker frame for the KPI, with the fewest
+/// poses) stays fittable.
+const MIN_SINGULAR_RATIO: f64 = 1e-6;
+
+/// Whether the information matrix `M` (= JᵀJ) has, column-normalised, every singular value of
+/// J above [`MIN_SINGULAR_RATIO`] times the largest.
+fn well_conditioned(m: &nalgebra::DMatrix<f64>) -> bool {
+    let n = m.nrows();
+    let d: Vec<f64> = (0..n).map(|i| m[(i, i)].max(1e-300).sqrt()).collect();
+    let s = nalgebra::DMatrix::from_fn(n, n, |i, j| m[(i, j)] / (d[i] * d[j]));
+    let eig = s.symmetric_eigenvalues();
+    let (lo, hi) = eig
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(a, b), &x| (a.min(x), b.max(x)));
+    lo > MIN_SINGULAR_RATIO * MIN_SINGULAR_RATIO * hi
+}
+
 /// The constraint set of a cell for planning, with the cell's `[design]` clearance and
 /// joint margin.
 pub fn constraint_set(cell: &Cell, collisions: bool) -> Result<ConstraintSet, Error> {
@@ -458,8 +478,10 @@ pub fn design_from_pool(
                 &mut observer,
             )?;
             observer.step();
-            // Only a design that violates nothing counts; otherwise keep the exchange design.
-            let ok = r.q.iter().all(|q| cons.feasible(q));
+            // Only a design that violates nothing and that identify can fit counts; otherwise
+            // keep the exchange design.
+            let ok =
+                r.q.iter().all(|q| cons.feasible(q)) && well_conditioned(&obj.information(&r.q));
             if ok && r.value <= ex.value {
                 Ok(PoolDesign {
                     refine: Some((r.describe(), r.iterations)),
@@ -478,7 +500,11 @@ pub fn design_from_pool(
                         format!(
                             "{} (refined design rejected: {})",
                             r.describe(),
-                            if ok { "no better" } else { "infeasible" }
+                            if ok {
+                                "no better"
+                            } else {
+                                "infeasible or near rank deficient"
+                            }
                         ),
                         r.iterations,
                     )),
