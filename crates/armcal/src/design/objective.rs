@@ -70,17 +70,14 @@ impl<'a> DesignObjective<'a> {
             design.jacobian(&mut ws, q);
             prior_rows.rows_mut(i * rows, rows).copy_from(&ws.jac);
         }
-<<<<<<< HEAD
         prior_rows
             .rows_mut(rows * measured.len(), cell_prior)
             .copy_from(&design.prior_rows);
-=======
         let prior_factor = if prior_rows.nrows() > design.n() {
             triangular_factor(prior_rows.clone())
         } else {
             prior_rows.clone()
         };
->>>>>>> dc62fc7 (Planner figures (issue 16 item 4): bench case for one campaign re-plan step (10 poses given 40 measured); the prior information enters each evaluation as its n_p-row triangular factor, not the measured rows; README: the study's KPI designs with collisions 0.333-0.337 (were 0.336-0.406) and why the worst robots ended high (PANOC stalled on the incidence/joint-limit boundary), measured-figures rows at the shared machine's load with the distance to the physical limit; DESIGN and docs name the projected L-BFGS)
         DesignObjective {
             design,
             criterion,
