@@ -216,7 +216,10 @@ pub fn records(text: &str) {
                         .enumerate()
                         .map(|(i, q)| (format!("p{i}"), q))
                         .collect();
-                    let _ = armcal::sim::predict(&model, &params, &poses);
+                    for payload in std::iter::once(None).chain((0..model.payloads.len()).map(Some))
+                    {
+                        let _ = armcal::sim::predict(&model, &params, &poses, payload);
+                    }
                 }
             }
             drift_check(e);
