@@ -206,9 +206,21 @@ pub fn exchange(
     let mut scores: Vec<(f64, usize)> = Vec::with_capacity(pool.len());
     observer.start("exchange", Some(settings.max_sweeps));
     let mut status = Status::IterationLimit;
+    // The information of the design (prior included), formed anew each sweep and kept up to
+    // date by rank-`rows` updates as points are exchanged.
+    let information_of = |set: &[usize]| {
+        let mut m = prior.tr_mul(prior);
+        for &i in set {
+            let ji = jp.rows(i * rows, rows);
+            m.gemm_tr(1.0, &ji, &ji, 1.0);
+        }
+        m
+    };
+    let mut m_design = DMatrix::zeros(n, n);
     while sweeps < settings.max_sweeps {
         sweeps += 1;
         let start_value = value;
+        m_design.copy_from(&information_of(&chosen));
         for slot in 0..n_points {
             // Covariance without the point in `slot`.
             let mut others: Vec<usize> = chosen.clone();
@@ -217,12 +229,10 @@ pub fn exchange(
             for &i in &others {
                 in_design[i] = true;
             }
-            let mut m = prior.tr_mul(prior);
-            for &i in &others {
-                let ji = jp.rows(i * rows, rows);
-                m.gemm_tr(1.0, &ji, &ji, 1.0);
-            }
-            let c = match m.cholesky() {
+            let mut m = m_design.clone();
+            let js = jp.rows(chosen[slot] * rows, rows);
+            m.gemm_tr(-1.0, &js, &js, 1.0);
+            let c = match m.clone().cholesky() {
                 Some(ch) => ch.inverse(),
                 None => continue, // this point is essential; keep it
             };
@@ -298,6 +308,9 @@ pub fn exchange(
                             chosen = trial;
                             value = v;
                             exchanges += 1;
+                            let jx = jp.rows(x * rows, rows);
+                            m.gemm_tr(1.0, &jx, &jx, 1.0);
+                            m_design.copy_from(&m);
                         }
                     }
                 }

@@ -172,9 +172,15 @@ impl DesignModel {
                 &mut ws.value,
                 &mut ws.dq,
             );
-            ws.jac.rows_mut(3 * k, 3).copy_from(&ws.value);
-            for (d, s) in ws.jac_dq.iter_mut().zip(&ws.dq) {
-                d.rows_mut(3 * k, 3).copy_from(s);
+            if self.observed.len() == 1 {
+                // One target: its rows are the whole Jacobian; exchange, do not copy.
+                std::mem::swap(&mut ws.jac, &mut ws.value);
+                std::mem::swap(&mut ws.jac_dq, &mut ws.dq);
+            } else {
+                ws.jac.rows_mut(3 * k, 3).copy_from(&ws.value);
+                for (d, s) in ws.jac_dq.iter_mut().zip(&ws.dq) {
+                    d.rows_mut(3 * k, 3).copy_from(s);
+                }
             }
         }
         let mut jac = std::mem::take(&mut ws.jac);
@@ -187,9 +193,15 @@ impl DesignModel {
         }
     }
 
+    /// Divides each row by its axis's σ (rows x, y, z of one target after another), by
+    /// multiplying with 1/σ down each column (the matrix is column-major).
     fn whiten(&self, m: &mut DMatrix<f64>) {
-        for r in 0..m.nrows() {
-            m.row_mut(r).unscale_mut(self.sigma[r % 3]);
+        let rows = m.nrows();
+        let inverse = self.sigma.map(|s| 1.0 / s);
+        for column in m.as_mut_slice().chunks_mut(rows) {
+            for (r, x) in column.iter_mut().enumerate() {
+                *x *= inverse[r % 3];
+            }
         }
     }
 

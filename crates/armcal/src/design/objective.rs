@@ -141,7 +141,7 @@ impl<'a> DesignObjective<'a> {
                     self.jacobian_and_derivatives(ws, i, qi);
                 } else {
                     self.design.jacobian(&mut ws.info, qi);
-                    ws.jacs[i].copy_from(&ws.info.jac);
+                    std::mem::swap(&mut ws.jacs[i], &mut ws.info.jac);
                 }
                 stacked.rows_mut(np + rows * i, rows).copy_from(&ws.jacs[i]);
             }
@@ -184,12 +184,11 @@ impl<'a> DesignObjective<'a> {
 
     /// `W^{1/2}J_i` and `W^{1/2}∂J_i/∂q_j` of configuration `i` into `ws.jacs[i]`,
     /// `ws.jacs_dq[i]`.
+    /// (The buffers are exchanged, not copied: the next call overwrites the workspace's.)
     fn jacobian_and_derivatives(&self, ws: &mut ObjectiveWorkspace, i: usize, qi: &[f64]) {
         self.design.jacobian_dq(&mut ws.info, qi);
-        ws.jacs[i].copy_from(&ws.info.jac);
-        for (dst, src) in ws.jacs_dq[i].iter_mut().zip(&ws.info.jac_dq) {
-            dst.copy_from(src);
-        }
+        std::mem::swap(&mut ws.jacs[i], &mut ws.info.jac);
+        std::mem::swap(&mut ws.jacs_dq[i], &mut ws.info.jac_dq);
     }
 
     /// Information matrix of configurations (prior included).
