@@ -121,6 +121,19 @@ pub fn singular_values_of_factor(r: &DMatrix<f64>, m: usize) -> Vec<f64> {
     s
 }
 
+/// `D⁻¹ M D⁻¹` with `D = diag(√M_ii)`: a symmetric positive semi-definite `M` (an
+/// information matrix) scaled to unit diagonal, so that a test of its conditioning does not
+/// depend on the parameters' units; with the scales `√M_ii`. `Err(i)`: the first `i` with
+/// `M_ii ≤ 0` (or not a number), a parameter without effect.
+pub fn unit_diagonal(m: &DMatrix<f64>) -> Result<(DMatrix<f64>, Vec<f64>), usize> {
+    let n = m.nrows();
+    if let Some(i) = (0..n).find(|&i| m[(i, i)].is_nan() || m[(i, i)] <= 0.0) {
+        return Err(i);
+    }
+    let d: Vec<f64> = (0..n).map(|i| m[(i, i)].sqrt()).collect();
+    Ok((DMatrix::from_fn(n, n, |a, b| m[(a, b)] / (d[a] * d[b])), d))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -189,5 +202,16 @@ mod tests {
         let r = c.finish();
         let g = a.tr_mul(&a);
         assert!((r.tr_mul(&r) - &g).abs().max() <= 1e-12 * g.abs().max());
+    }
+
+    /// Unit diagonal, the correlations kept, the scales returned; a zero diagonal named.
+    #[test]
+    fn unit_diagonal_scales_to_correlations() {
+        let m = DMatrix::from_row_slice(2, 2, &[4.0, 3.0, 3.0, 9.0]);
+        let (s, d) = unit_diagonal(&m).unwrap();
+        assert_eq!(d, vec![2.0, 3.0]);
+        assert_eq!(s, DMatrix::from_row_slice(2, 2, &[1.0, 0.5, 0.5, 1.0]));
+        let z = DMatrix::from_row_slice(2, 2, &[1.0, 0.0, 0.0, 0.0]);
+        assert_eq!(unit_diagonal(&z).unwrap_err(), 1);
     }
 }

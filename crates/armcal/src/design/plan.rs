@@ -12,6 +12,7 @@ use crate::design::objective::DesignObjective;
 use crate::design::order::order_for_travel;
 use crate::design::refine::{refine, ConfigurationConstraints, RefineSettings};
 use crate::design::Criterion;
+use crate::linalg::unit_diagonal;
 use crate::progress::{Observer, Shared};
 use crate::Error;
 use rayon::prelude::*;
@@ -318,9 +319,9 @@ const MIN_SINGULAR_RATIO: f64 = 1e-4;
 /// Whether the information matrix `M` (= JᵀJ) has, column-normalised, every singular value of
 /// J above [`MIN_SINGULAR_RATIO`] times the largest.
 fn well_conditioned(m: &nalgebra::DMatrix<f64>) -> bool {
-    let n = m.nrows();
-    let d: Vec<f64> = (0..n).map(|i| m[(i, i)].max(1e-300).sqrt()).collect();
-    let s = nalgebra::DMatrix::from_fn(n, n, |i, j| m[(i, j)] / (d[i] * d[j]));
+    let Ok((s, _)) = unit_diagonal(m) else {
+        return false;
+    };
     let eig = s.symmetric_eigenvalues();
     let (lo, hi) = eig
         .iter()

@@ -2,6 +2,7 @@
 //! variance factor with its χ² test, and the TCP covariance C_s at working configurations —
 //! by the constrained formulation (paper eq. 19) and by `C_s = G C_p Gᵀ` (paper appendix).
 
+use crate::linalg::unit_diagonal;
 use crate::model::{
     forward_kinematics, identification_jacobian, Data, Model, Observed, Rows, Segment,
 };
@@ -129,14 +130,12 @@ pub fn parameter_uncertainty(
 pub fn information_inverse(info: &DMatrix<f64>, names: &[String]) -> Result<DMatrix<f64>, Error> {
     let n = info.nrows();
     // Scale to unit diagonal so the test for singularity is unit-free.
-    let d: Vec<f64> = (0..n).map(|k| info[(k, k)].max(0.0).sqrt()).collect();
-    if let Some(k) = d.iter().position(|&x| x == 0.0) {
-        return Err(Error::Input(format!(
+    let (scaled, d) = unit_diagonal(info).map_err(|k| {
+        Error::Input(format!(
             "parameter `{}` has no effect on the measurements: it cannot be identified (fix it)",
             names[k]
-        )));
-    }
-    let scaled = DMatrix::from_fn(n, n, |a, b| info[(a, b)] / (d[a] * d[b]));
+        ))
+    })?;
     let eig = scaled.clone().symmetric_eigen();
     let min = eig.eigenvalues.min();
     let max = eig.eigenvalues.max();
