@@ -2,13 +2,17 @@
 //! (27 parameters) without collision avoidance (`examples/paper-cell.toml`: joint limits
 //! and the incidence limit) and with it (`examples/paper-cell-obstacles.toml`, 67
 //! constraints per pose), with the planner's default settings (2 starts in parallel); and one
-//! campaign re-plan step: 10 new poses given 40 measured (the paper cell, no collisions). The
+//! campaign re-plan step: 10 new poses given 40 measured (the paper cell, no collisions); and
+//! one evaluation of the design objective and its gradient (60 poses). The
 //! criterion value, feasibility and bound of each design are printed once before timing.
 //! The 90-manipulator study is timed by the CLI:
 //! `time ./target/release/armcal study paper --collisions on --out DIR`.
 
 use armcal::cell::Cell;
+use armcal::design::information::DesignModel;
+use armcal::design::objective::DesignObjective;
 use armcal::design::plan::{plan, PlanSettings};
+use armcal::design::Criterion as KpiCriterion;
 use armcal::progress::Silent;
 use criterion::{criterion_group, criterion_main, Criterion};
 
@@ -60,6 +64,29 @@ fn design(c: &mut Criterion) {
             b.iter(|| plan(&cell, &settings, &measured, &mut Silent).expect("plan"))
         });
     }
+    // One evaluation of φ and ∇φ of the 60-pose KPI design (no collisions), at nearby
+    // points so that the objective's cache never answers: the refinement's unit of work.
+    let cell = Cell::from_toml(CELL, "cell.toml", std::path::Path::new(".")).expect("cell");
+    let settings = PlanSettings {
+        collisions: false,
+        ..PlanSettings::default()
+    };
+    let design = plan(&cell, &settings, &[], &mut Silent)
+        .expect("plan")
+        .design;
+    let d = DesignModel::from_cell(&cell).expect("design model");
+    let objective = DesignObjective::new(&d, KpiCriterion::Kpi, &[]);
+    let mut ws = objective.workspace(design.len());
+    let mut u = design.concat();
+    let mut g = vec![0.0; u.len()];
+    group.bench_function("KPI value and gradient, 60 poses", |b| {
+        b.iter(|| {
+            u[0] += 1e-12;
+            objective
+                .value_and_gradient(&mut ws, &u, Some(&mut g))
+                .expect("value")
+        })
+    });
     group.finish();
 }
 
