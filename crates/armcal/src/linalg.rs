@@ -80,6 +80,28 @@ impl RowCompressor {
 /// Rows per block of [`gram`].
 const GRAM_BLOCK: usize = 512;
 
+/// `Σ aᵢ bᵢ` over the common length, in four interleaved sums that the compiler turns into
+/// vector instructions (a single running sum is one long dependency chain: the planner's
+/// exchange computes millions of these 27-term products, about 3× faster this way).
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut acc = [0.0; 4];
+    let (ac, bc) = (a.chunks_exact(4), b.chunks_exact(4));
+    let tail: f64 = ac
+        .remainder()
+        .iter()
+        .zip(bc.remainder())
+        .map(|(x, y)| x * y)
+        .sum();
+    for (x, y) in ac.zip(bc) {
+        for k in 0..4 {
+            acc[k] += x[k] * y[k];
+        }
+    }
+    (acc[0] + acc[2]) + (acc[1] + acc[3]) + tail
+}
+
 /// `AᵀA`, accumulated over blocks of rows so that each block's columns stay in cache (the
 /// columns of a 10⁶-row Jacobian are 24 MB each; entry-by-entry dot products would stream
 /// them from memory n² times).

@@ -11,7 +11,6 @@
 use crate::design::criteria::{evaluate, kpi_matrix, Criterion};
 use crate::design::information::{DesignModel, InformationWorkspace};
 use crate::design::objective::triangular_factor;
-use crate::design::small_cholesky;
 use crate::progress::Observer;
 use crate::solve::Status;
 use crate::Error;
@@ -19,7 +18,10 @@ use nalgebra::DMatrix;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use rank_updates::SweepState;
 use std::time::{Duration, Instant};
+
+mod rank_updates;
 
 /// Settings of [`exchange`].
 #[derive(Clone, Debug)]
@@ -197,85 +199,34 @@ pub fn exchange(
     let mut history = vec![value];
     let mut sweeps = 0;
     let mut exchanges = 0;
-    // Buffers: U = J_pool C, V = J_pool (L C)ᵀ, a candidate's S (rows × rows), one column.
-    let mut u = DMatrix::zeros(jp.nrows(), n);
-    let mut vl = DMatrix::zeros(jp.nrows(), l.as_ref().map_or(0, |l| l.nrows()));
-    let mut s_buf = vec![0.0; rows * rows];
-    let mut t_buf = vec![0.0; rows];
+    let mut state = SweepState::new(&jp, rows, l.as_ref().map_or(0, |l| l.nrows()));
     let mut in_design = vec![false; pool.len()];
     let mut scores: Vec<(f64, usize)> = Vec::with_capacity(pool.len());
     observer.start("exchange", Some(settings.max_sweeps));
     let mut status = Status::IterationLimit;
-    // The information of the design (prior included), formed anew each sweep and kept up to
-    // date by rank-`rows` updates as points are exchanged.
-    let information_of = |set: &[usize]| {
-        let mut m = prior.tr_mul(prior);
-        for &i in set {
-            let ji = jp.rows(i * rows, rows);
-            m.gemm_tr(1.0, &ji, &ji, 1.0);
-        }
-        m
-    };
-    let mut m_design = DMatrix::zeros(n, n);
     while sweeps < settings.max_sweeps {
         sweeps += 1;
         let start_value = value;
-        m_design.copy_from(&information_of(&chosen));
+        // C, U, V and the Q blocks anew from the design (the rank updates below drift).
+        if !state.refresh(prior, l.as_ref(), &chosen) {
+            break;
+        }
         for slot in 0..n_points {
-            // Covariance without the point in `slot`.
-            let mut others: Vec<usize> = chosen.clone();
-            others.remove(slot);
+            let removed = chosen[slot];
             in_design.fill(false);
-            for &i in &others {
+            for &i in &chosen {
                 in_design[i] = true;
             }
-            let mut m = m_design.clone();
-            let js = jp.rows(chosen[slot] * rows, rows);
-            m.gemm_tr(-1.0, &js, &js, 1.0);
-            let c = match m.clone().cholesky() {
-                Some(ch) => ch.inverse(),
-                None => continue, // this point is essential; keep it
-            };
-            // Score every candidate by the rank-`rows` update: S = I + J_x C J_xᵀ and, for
-            // A-type criteria, tr(S⁻¹ J_x C LᵀL C J_xᵀ) = tr(S⁻¹ V_x V_xᵀ).
-            u.gemm(1.0, &jp, &c, 0.0);
-            if let Some(l) = &l {
-                let lc = l * &c;
-                vl.gemm(1.0, &jp, &lc.transpose(), 0.0);
+            in_design[removed] = false;
+            // Covariance without the point in `slot`, by the rank-`rows` downdate.
+            if !state.remove(removed) {
+                continue; // this point is essential; keep it
             }
             scores.clear();
-            for (x, _) in in_design.iter().enumerate().filter(|(_, used)| !**used) {
-                let r0 = x * rows;
-                for a in 0..rows {
-                    for b in 0..=a {
-                        let mut sab = if a == b { 1.0 } else { 0.0 };
-                        for p in 0..n {
-                            sab += u[(r0 + a, p)] * jp[(r0 + b, p)];
-                        }
-                        s_buf[a * rows + b] = sab;
-                        s_buf[b * rows + a] = sab;
-                    }
+            for x in (0..pool.len()).filter(|&x| !in_design[x]) {
+                if let Some(score) = state.score(x, l.is_some()) {
+                    scores.push((score, x));
                 }
-                if !small_cholesky::factor(&mut s_buf, rows) {
-                    continue;
-                }
-                let score = if l.is_some() {
-                    // tr(S⁻¹ V_x V_xᵀ) = Σ_c v_cᵀ S⁻¹ v_c over the columns of V_x.
-                    let mut tr = 0.0;
-                    for col in 0..vl.ncols() {
-                        for a in 0..rows {
-                            t_buf[a] = vl[(r0 + a, col)];
-                        }
-                        small_cholesky::solve(&s_buf, &mut t_buf, rows);
-                        for a in 0..rows {
-                            tr += t_buf[a] * vl[(r0 + a, col)];
-                        }
-                    }
-                    -tr
-                } else {
-                    -2.0 * (0..rows).map(|a| s_buf[a * rows + a].ln()).sum::<f64>()
-                };
-                scores.push((score, x));
             }
             let best = if l.is_some() || criterion == Criterion::D {
                 scores
@@ -288,8 +239,8 @@ pub fn exchange(
                 let mut best = None;
                 let mut best_v = f64::INFINITY;
                 for &(_, x) in scores.iter().take(settings.exact_shortlist) {
-                    let mut trial = others.clone();
-                    trial.insert(slot, x);
+                    let mut trial = chosen.clone();
+                    trial[slot] = x;
                     if let Ok(v) = value_of(d, criterion, &jp, prior, &trial) {
                         if v < best_v {
                             best_v = v;
@@ -299,20 +250,16 @@ pub fn exchange(
                 }
                 best
             };
-            if let Some(x) = best {
-                if x != chosen[slot] {
-                    let mut trial = others.clone();
-                    trial.insert(slot, x);
-                    if let Ok(v) = value_of(d, criterion, &jp, prior, &trial) {
-                        if v < value - 1e-15 * value.abs() {
-                            chosen = trial;
-                            value = v;
-                            exchanges += 1;
-                            let jx = jp.rows(x * rows, rows);
-                            m.gemm_tr(1.0, &jx, &jx, 1.0);
-                            m_design.copy_from(&m);
-                        }
-                    }
+            let Some(x) = best.filter(|&x| x != removed) else {
+                continue;
+            };
+            let mut trial = chosen.clone();
+            trial[slot] = x;
+            if let Ok(v) = value_of(d, criterion, &jp, prior, &trial) {
+                if v < value - 1e-15 * value.abs() && state.replace(x) {
+                    chosen = trial;
+                    value = v;
+                    exchanges += 1;
                 }
             }
         }

@@ -199,8 +199,10 @@ impl DesignModel {
         let rows = m.nrows();
         let inverse = self.sigma.map(|s| 1.0 / s);
         for column in m.as_mut_slice().chunks_mut(rows) {
-            for (r, x) in column.iter_mut().enumerate() {
-                *x *= inverse[r % 3];
+            for axes in column.chunks_exact_mut(3) {
+                for (x, s) in axes.iter_mut().zip(&inverse) {
+                    *x *= s;
+                }
             }
         }
     }

@@ -145,7 +145,7 @@ impl<'a> DesignObjective<'a> {
                 }
                 stacked.rows_mut(np + rows * i, rows).copy_from(&ws.jacs[i]);
             }
-            let r = triangular_factor(stacked);
+            let r = information_factor(self.criterion, stacked);
             let cv = evaluate(self.criterion, &r, self.design)?;
             ws.value = cv.value;
             ws.phi.copy_from(&cv.gradient);
@@ -219,6 +219,28 @@ fn through_factor(a: &DMatrix<f64>, f: &DMatrix<f64>, t: &mut [f64], g: &mut [f6
             g[p * rows + r] = (0..cols).map(|c| t[c * rows + r] * f[c * n + p]).sum();
         }
     }
+}
+
+/// `R` (n × n, upper triangular) with `RᵀR = AᵀA` for the criterion `c`: for A, D, KPI and
+/// KPI-max (whose values and gradients go through C = M⁻¹) the transposed Cholesky factor of
+/// `M = AᵀA`, for the eigenvalue criteria (E, O1–O5) and for an M that Cholesky finds not
+/// positive definite the QR factor ([`triangular_factor`]), which keeps the accuracy of A.
+/// In the refinement's loop Cholesky costs about a third of Householder QR (one product
+/// `AᵀA` by blocks, then n³/3); its relative error in C, about cond(M)·ε, stays below 1e-8
+/// for every design the planner accepts (column-normalised singular-value ratio ≥ 1e-4).
+fn information_factor(c: Criterion, a: DMatrix<f64>) -> DMatrix<f64> {
+    if matches!(
+        c,
+        Criterion::A | Criterion::D | Criterion::Kpi | Criterion::KpiMax
+    ) && a.nrows() >= a.ncols()
+    {
+        // `Aᵀ · A` through the general product (blocked, vectorised), not `tr_mul`'s column
+        // dot products.
+        if let Some(ch) = (a.transpose() * &a).cholesky() {
+            return ch.l().transpose();
+        }
+    }
+    triangular_factor(a)
 }
 
 /// `R` (n × n, upper triangular) with `RᵀR = AᵀA`, by Householder QR of `A` (rows ≥ n);

@@ -28,6 +28,18 @@ pub fn factor(a: &mut [f64], n: usize) -> bool {
 
 /// Solves `L Lᵀ x = b` in place (`l` from [`factor`]).
 pub fn solve(l: &[f64], b: &mut [f64], n: usize) {
+    forward(l, b, n);
+    for i in (0..n).rev() {
+        let mut v = b[i];
+        for p in i + 1..n {
+            v -= l[p * n + i] * b[p];
+        }
+        b[i] = v / l[i * n + i];
+    }
+}
+
+/// Solves `L y = b` in place (forward substitution; `l` from [`factor`]): `‖y‖² = bᵀA⁻¹b`.
+pub fn forward(l: &[f64], b: &mut [f64], n: usize) {
     for i in 0..n {
         let mut v = b[i];
         for p in 0..i {
@@ -35,12 +47,25 @@ pub fn solve(l: &[f64], b: &mut [f64], n: usize) {
         }
         b[i] = v / l[i * n + i];
     }
-    for i in (0..n).rev() {
-        let mut v = b[i];
-        for p in i + 1..n {
-            v -= l[p * n + i] * b[p];
+}
+
+/// `A⁻¹` (row-major `n × n`) into `inv`, from `l` of [`factor`], column by column.
+pub fn inverse(l: &[f64], inv: &mut [f64], n: usize) {
+    let mut e = [0.0; 16];
+    let mut heap;
+    let col: &mut [f64] = if n <= e.len() {
+        &mut e[..n]
+    } else {
+        heap = vec![0.0; n];
+        &mut heap
+    };
+    for c in 0..n {
+        col.fill(0.0);
+        col[c] = 1.0;
+        solve(l, col, n);
+        for (r, v) in col.iter().enumerate() {
+            inv[r * n + c] = *v;
         }
-        b[i] = v / l[i * n + i];
     }
 }
 
@@ -72,6 +97,21 @@ mod tests {
         for (bi, xi) in b.iter().zip(x) {
             assert!((bi - xi).abs() < 1e-12);
         }
+        // A⁻¹ A = I, and ‖L⁻¹b‖² = bᵀA⁻¹b.
+        let mut inv = vec![0.0; n * n];
+        inverse(&l, &mut inv, n);
+        for i in 0..n {
+            for j in 0..n {
+                let v: f64 = (0..n).map(|p| inv[i * n + p] * a[p * n + j]).sum();
+                assert!((v - if i == j { 1.0 } else { 0.0 }).abs() < 1e-12);
+            }
+        }
+        let mut y = x.to_vec();
+        forward(&l, &mut y, n);
+        let quad: f64 = (0..n)
+            .map(|i| (0..n).map(|j| x[i] * inv[i * n + j] * x[j]).sum::<f64>())
+            .sum();
+        assert!((y.iter().map(|v| v * v).sum::<f64>() - quad).abs() < 1e-12 * quad);
         let mut not_pd = vec![1.0, 2.0, 2.0, 1.0];
         assert!(!factor(&mut not_pd, 2));
     }

@@ -43,6 +43,11 @@ pub struct Data<T: RealField + Copy> {
     /// [`crate::model::joint_correction`]) and the corrected joints; `None` without them.
     /// `joint_twists` are then the twists of the corrected joints `q + Δq`.
     pub corrections: Option<Box<CorrectionData<T>>>,
+    /// Per parameter of a constant elementary rotation (no joint): the parameter value (its
+    /// bits) and the sine and cosine last computed for it. A model evaluated at fixed
+    /// parameters (the planner, every row of one identification iteration) then computes
+    /// the sines and cosines of its joints only; a changed value is recomputed.
+    rotation_memo: Vec<Option<(u64, T, T)>>,
 }
 
 impl<T: RealField + Copy> Data<T> {
@@ -66,6 +71,7 @@ impl<T: RealField + Copy> Data<T> {
             param_twist_rates: vec![Twist::zero(); model.param_count()],
             joint_points: vec![Vector3::zeros(); model.dof()],
             corrections: None,
+            rotation_memo: vec![None; model.param_count()],
         }
     }
 
@@ -163,7 +169,7 @@ fn lift<T: RealField + Copy>(x: f64) -> T {
 /// Multiplies `pose` by one elementary factor or screw and records the twists of the
 /// factor's parameter(s) and joint.
 #[inline]
-fn apply_step<T: RealField + Copy>(
+pub(crate) fn apply_step<T: RealField + Copy>(
     step: &Step,
     pose: &mut Pose<T>,
     params: &[f64],
@@ -202,10 +208,14 @@ fn apply_step<T: RealField + Copy>(
                 data.joint_twists[*j] = twist;
                 data.joint_points[*j] = pose.trans;
             }
+            let mut sin_cos = || match joint {
+                Some(_) => value.sin_cos(),
+                None => memoized_sin_cos(&mut data.rotation_memo[*param], params[*param], value),
+            };
             match motion {
-                Motion::Rx => rotate_columns(pose, 1, 2, value),
-                Motion::Ry => rotate_columns(pose, 2, 0, value),
-                Motion::Rz => rotate_columns(pose, 0, 1, value),
+                Motion::Rx => rotate_columns(pose, 1, 2, sin_cos()),
+                Motion::Ry => rotate_columns(pose, 2, 0, sin_cos()),
+                Motion::Rz => rotate_columns(pose, 0, 1, sin_cos()),
                 Motion::RotAxis => pose.rot *= rot_axis(&axis.map(lift::<T>), value),
                 _ => pose.trans += world_axis * value,
             }
@@ -218,11 +228,29 @@ fn apply_step<T: RealField + Copy>(
     }
 }
 
-/// Right-multiplies the rotation by an elementary rotation: columns `a`, `b` turn in their
-/// plane (`Rx`: y,z; `Ry`: z,x; `Rz`: x,y).
+/// `(sin, cos)` of the constant angle `value` (= `key` lifted), from `memo` when it holds
+/// them for `key`, else computed and kept.
 #[inline]
-fn rotate_columns<T: RealField + Copy>(pose: &mut Pose<T>, a: usize, b: usize, angle: T) {
-    let (s, c) = angle.sin_cos();
+fn memoized_sin_cos<T: RealField + Copy>(
+    memo: &mut Option<(u64, T, T)>,
+    key: f64,
+    value: T,
+) -> (T, T) {
+    let bits = key.to_bits();
+    match *memo {
+        Some((k, s, c)) if k == bits => (s, c),
+        _ => {
+            let (s, c) = value.sin_cos();
+            *memo = Some((bits, s, c));
+            (s, c)
+        }
+    }
+}
+
+/// Right-multiplies the rotation by an elementary rotation of angle θ given as
+/// `(sin θ, cos θ)`: columns `a`, `b` turn in their plane (`Rx`: y,z; `Ry`: z,x; `Rz`: x,y).
+#[inline]
+fn rotate_columns<T: RealField + Copy>(pose: &mut Pose<T>, a: usize, b: usize, (s, c): (T, T)) {
     let ca = pose.rot.column(a).into_owned();
     let cb = pose.rot.column(b).into_owned();
     pose.rot.set_column(a, &(ca * c + cb * s));

@@ -7,6 +7,7 @@ pub mod complete;
 pub mod compliance;
 pub mod convert;
 pub mod export;
+pub mod fixed_kinematics;
 pub mod frames;
 pub mod identifiability;
 pub mod jacobian;

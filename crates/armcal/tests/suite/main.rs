@@ -9,6 +9,7 @@ mod model {
     mod derivatives;
     mod export_reload;
     mod exports;
+    mod fixed_kinematics;
     mod identifiability;
     mod robots;
 }

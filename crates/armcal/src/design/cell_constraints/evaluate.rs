@@ -3,6 +3,7 @@
 //! depend on the configuration.
 
 use super::*;
+use crate::model::fixed_kinematics::fixed_forward_kinematics;
 
 /// A pose read back from a design CSV (6 decimals of a degree, ±5e-7° = 8.7e-9 rad) may sit
 /// that much inside the joint margin it was planned on; 1e-7 rad (6e-6°) covers it. It
@@ -95,9 +96,10 @@ impl ConstraintSet {
         }
     }
 
-    /// Forward kinematics and the world endpoints of every robot capsule at `q`.
+    /// Forward kinematics (frames, targets and joint twists: all the constraints read) and
+    /// the world endpoints of every robot capsule at `q`.
     fn place(&self, ws: &mut ConstraintWorkspace, params: &[f64], q: &[f64]) {
-        forward_kinematics(&self.model, &mut ws.data, params, q);
+        fixed_forward_kinematics(&self.model, &mut ws.fixed, &mut ws.data, params, q);
         for (c, ends) in self.capsules.iter().zip(ws.ends.iter_mut()) {
             *ends = c.place(&ws.data);
         }

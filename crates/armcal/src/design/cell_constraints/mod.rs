@@ -80,6 +80,7 @@
 
 use crate::cell::{half_space_unit_normal, Cell, DesignClearance, Obstacle};
 use crate::geometry::{point_segment_distance, segment_distance};
+use crate::model::fixed_kinematics::FixedKinematics;
 use crate::model::{forward_kinematics, Data, Model, Twist};
 use crate::Error;
 use nalgebra::Vector3;
@@ -296,6 +297,8 @@ pub struct ConstraintSet {
 #[derive(Clone, Debug)]
 pub struct ConstraintWorkspace {
     data: Data<f64>,
+    /// The model's chain compiled at the parameters of the last evaluation.
+    fixed: FixedKinematics,
     /// World endpoints of every robot capsule.
     ends: Vec<[Vector3<f64>; 2]>,
     /// Constraint values of the last [`ConstraintSet::feasible`] / `min_margin_at` call.
@@ -537,6 +540,7 @@ impl ConstraintWorkspace {
     pub(crate) fn new(set: &ConstraintSet) -> Self {
         ConstraintWorkspace {
             data: Data::new(&set.model),
+            fixed: FixedKinematics::new(&set.model),
             ends: vec![[Vector3::zeros(); 2]; set.capsules.len()],
             values: vec![0.0; set.len()],
         }

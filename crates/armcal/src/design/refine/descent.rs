@@ -4,6 +4,7 @@
 use super::feasible_set::FeasibleSet;
 use super::RefineSettings;
 use crate::design::objective::{DesignObjective, ObjectiveWorkspace};
+use crate::linalg::dot;
 use crate::progress::Observer;
 use crate::solve::Status;
 use crate::Error;
@@ -300,11 +301,6 @@ fn scaled(
         }
         Err(_) => f64::INFINITY,
     }
-}
-
-/// `Σ a_i b_i`.
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 /// `y += a x`.

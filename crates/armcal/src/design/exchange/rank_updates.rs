@@ -1,0 +1,409 @@
+//! The exchange's covariance bookkeeping: the design's `C = M⁻¹` seen through the pool,
+//! kept up to date by rank updates as points are removed and added (see [`SweepState`]).
+
+use crate::design::small_cholesky;
+use crate::linalg::dot;
+use nalgebra::DMatrix;
+
+/// Leverage `1 − λ_min(I − J_s C J_sᵀ)` above which a design point counts as essential: its
+/// removal leaves the information (nearly) singular, and a rank update through
+/// `(I − J_s C J_sᵀ)⁻¹` would magnify rounding.
+const ESSENTIAL_PIVOT: f64 = 1e-8;
+
+/// The covariance of the current design as the exchange needs it, kept up to date by rank
+/// updates (Woodbury) instead of a new inverse and a new `J_pool C` product for every slot:
+/// `U = J_pool C`, `V = J_pool C Lᵀ` (A-type criteria), the diagonal blocks
+/// `Q_x = J_x C J_xᵀ` of every pool point, and the removal in progress.
+///
+/// Removing point s: `C₋ = C + C J_sᵀ K⁻¹ J_s C`, `K = I − J_s C J_sᵀ`, so with
+/// `W_x = J_x C J_sᵀ` (= `U_x J_sᵀ`) every candidate's `J_x C₋ J_xᵀ = Q_x + W_x K⁻¹ W_xᵀ` and
+/// `J_x C₋ Lᵀ = V_x + W_x K⁻¹ V_s` cost O(rows² · (rows + columns of L)) each, and W costs
+/// O(pool rows · rows · n) per slot, where a new `J_pool C₋` costs O(pool rows · n²). Adding
+/// x: `C' = C₋ − C₋ J_xᵀ S⁻¹ J_x C₋`, `S = I + J_x C₋ J_xᵀ`.
+///
+/// Everything is stored transposed (one pool row per column), so that every product walks
+/// contiguous memory.
+pub(super) struct SweepState {
+    rows: usize,
+    n: usize,
+    /// `Jᵀ` of the pool (n × pool rows).
+    jt: DMatrix<f64>,
+    /// `Uᵀ` (n × pool rows), `Vᵀ` (columns of L × pool rows).
+    ut: DMatrix<f64>,
+    vt: DMatrix<f64>,
+    /// `Q_x`, rows × rows row-major per pool point.
+    q: Vec<f64>,
+    /// `Wᵀ` of the removal in progress (rows × pool rows), `(W K⁻¹)ᵀ`, `K⁻¹` (row-major),
+    /// `U_sᵀ K⁻¹` (n × rows), `V_sᵀ K⁻¹` (columns of L × rows).
+    wt: DMatrix<f64>,
+    wkt: DMatrix<f64>,
+    k_inv: Vec<f64>,
+    us_k: DMatrix<f64>,
+    vs_k: DMatrix<f64>,
+    /// A candidate's S (row-major; its Cholesky factor in place) and a column of `V'_x`.
+    s_buf: Vec<f64>,
+    v_col: Vec<f64>,
+}
+
+impl SweepState {
+    pub(super) fn new(jp: &DMatrix<f64>, rows: usize, l_rows: usize) -> Self {
+        let (pool_rows, n) = jp.shape();
+        SweepState {
+            rows,
+            n,
+            jt: jp.transpose(),
+            ut: DMatrix::zeros(n, pool_rows),
+            vt: DMatrix::zeros(l_rows, pool_rows),
+            q: vec![0.0; pool_rows * rows],
+            wt: DMatrix::zeros(rows, pool_rows),
+            wkt: DMatrix::zeros(rows, pool_rows),
+            k_inv: vec![0.0; rows * rows],
+            us_k: DMatrix::zeros(n, rows),
+            vs_k: DMatrix::zeros(l_rows, rows),
+            s_buf: vec![0.0; rows * rows],
+            v_col: vec![0.0; rows],
+        }
+    }
+
+    /// Column `i` (pool row i) of a transposed buffer.
+    fn col(m: &DMatrix<f64>, i: usize) -> &[f64] {
+        let h = m.nrows();
+        &m.as_slice()[i * h..(i + 1) * h]
+    }
+
+    /// `C = M⁻¹` of the design `chosen` (prior included) and everything derived from it;
+    /// false if M is singular.
+    pub(super) fn refresh(
+        &mut self,
+        prior: &DMatrix<f64>,
+        l: Option<&DMatrix<f64>>,
+        chosen: &[usize],
+    ) -> bool {
+        let rows = self.rows;
+        let mut m = prior.tr_mul(prior);
+        for &i in chosen {
+            let ji = self.jt.columns(i * rows, rows);
+            m.gemm_tr(1.0, &ji.transpose(), &ji.transpose(), 1.0);
+        }
+        let Some(ch) = m.cholesky() else {
+            return false;
+        };
+        let c = ch.inverse();
+        self.ut.gemm(1.0, &c, &self.jt, 0.0);
+        if let Some(l) = l {
+            self.vt.gemm(1.0, l, &self.ut, 0.0);
+        }
+        for x in 0..self.jt.ncols() / rows {
+            let r0 = x * rows;
+            for a in 0..rows {
+                for b in 0..rows {
+                    self.q[r0 * rows + a * rows + b] =
+                        dot(Self::col(&self.ut, r0 + a), Self::col(&self.jt, r0 + b));
+                }
+            }
+        }
+        true
+    }
+
+    /// Starts the removal of pool point `s` from the design: `W`, `K⁻¹` and the products
+    /// with it; false if the point is essential ([`ESSENTIAL_PIVOT`]).
+    pub(super) fn remove(&mut self, s: usize) -> bool {
+        let rows = self.rows;
+        let mut k = vec![0.0; rows * rows];
+        for a in 0..rows {
+            for b in 0..rows {
+                let qab = 0.5
+                    * (self.q[s * rows * rows + a * rows + b]
+                        + self.q[s * rows * rows + b * rows + a]);
+                k[a * rows + b] = if a == b { 1.0 } else { 0.0 } - qab;
+            }
+        }
+        if !small_cholesky::factor(&mut k, rows)
+            || (0..rows).any(|a| k[a * rows + a] * k[a * rows + a] < ESSENTIAL_PIVOT)
+        {
+            return false;
+        }
+        small_cholesky::inverse(&k, &mut self.k_inv, rows);
+        // Wᵀ column x·rows + a: J_s U_xᵀ, i.e. W_x[a][b] = U_{x,a} · J_{s,b}.
+        for i in 0..self.jt.ncols() {
+            for b in 0..rows {
+                self.wt[(b, i)] = dot(Self::col(&self.ut, i), Self::col(&self.jt, s * rows + b));
+            }
+        }
+        // (W K⁻¹)ᵀ = K⁻¹ Wᵀ (K⁻¹ symmetric).
+        for i in 0..self.wt.ncols() {
+            for a in 0..rows {
+                self.wkt[(a, i)] = (0..rows)
+                    .map(|b| self.k_inv[a * rows + b] * self.wt[(b, i)])
+                    .sum();
+            }
+        }
+        for b in 0..rows {
+            for p in 0..self.n {
+                self.us_k[(p, b)] = (0..rows)
+                    .map(|a| self.ut[(p, s * rows + a)] * self.k_inv[a * rows + b])
+                    .sum();
+            }
+            for p in 0..self.vt.nrows() {
+                self.vs_k[(p, b)] = (0..rows)
+                    .map(|a| self.vt[(p, s * rows + a)] * self.k_inv[a * rows + b])
+                    .sum();
+            }
+        }
+        true
+    }
+
+    /// `S = I + J_x C₋ J_xᵀ = I + Q_x + W_x K⁻¹ W_xᵀ` of candidate `x` into `s_buf`
+    /// (row-major) and its Cholesky factor in place; false if it is not positive definite.
+    fn factor_s(&mut self, x: usize) -> bool {
+        let rows = self.rows;
+        let r0 = x * rows;
+        for a in 0..rows {
+            for b in 0..=a {
+                let wkw = dot(Self::col(&self.wkt, r0 + a), Self::col(&self.wt, r0 + b));
+                let sab = self.q[r0 * rows + a * rows + b] + wkw + if a == b { 1.0 } else { 0.0 };
+                self.s_buf[a * rows + b] = sab;
+                self.s_buf[b * rows + a] = sab;
+            }
+        }
+        small_cholesky::factor(&mut self.s_buf, rows)
+    }
+
+    /// The score of adding candidate `x` to the design without the removed point (lower is
+    /// better): `−tr(S⁻¹ V'_x V'_xᵀ) = −‖L_S⁻¹ V'_x‖²` for A-type criteria (the change of
+    /// `tr(L C Lᵀ)`), `−log det S` otherwise (minus the change of log det M); `None` if S is
+    /// not positive definite.
+    pub(super) fn score(&mut self, x: usize, a_type: bool) -> Option<f64> {
+        let rows = self.rows;
+        let r0 = x * rows;
+        if !self.factor_s(x) {
+            return None;
+        }
+        if !a_type {
+            return Some(
+                -2.0 * (0..rows)
+                    .map(|a| self.s_buf[a * rows + a].ln())
+                    .sum::<f64>(),
+            );
+        }
+        // Column c of V'_x = V_x + W_x (K⁻¹ V_s).
+        let mut tr = 0.0;
+        for c in 0..self.vt.nrows() {
+            for a in 0..rows {
+                let w = Self::col(&self.wt, r0 + a);
+                self.v_col[a] =
+                    self.vt[(c, r0 + a)] + (0..rows).map(|b| w[b] * self.vs_k[(c, b)]).sum::<f64>();
+            }
+            small_cholesky::forward(&self.s_buf, &mut self.v_col, rows);
+            tr += self.v_col.iter().map(|v| v * v).sum::<f64>();
+        }
+        Some(-tr)
+    }
+
+    /// Completes the exchange started by [`Self::remove`] by adding pool point `x`: U, V
+    /// and the Q blocks by the removal's and the addition's rank updates. False (nothing
+    /// changed) if `S` is not positive definite.
+    pub(super) fn replace(&mut self, x: usize) -> bool {
+        let rows = self.rows;
+        let cols = self.jt.ncols();
+        // Removal: U₋ᵀ = Uᵀ + (U_sᵀ K⁻¹) Wᵀ, V₋ᵀ likewise, Q₋_x = Q_x + (W_x K⁻¹) W_xᵀ.
+        add_rank_product(&mut self.ut, &self.us_k, &self.wt, 1.0);
+        add_rank_product(&mut self.vt, &self.vs_k, &self.wt, 1.0);
+        for i in 0..cols / rows {
+            let r0 = i * rows;
+            for a in 0..rows {
+                for b in 0..rows {
+                    self.q[r0 * rows + a * rows + b] +=
+                        dot(Self::col(&self.wkt, r0 + a), Self::col(&self.wt, r0 + b));
+                }
+            }
+        }
+        // Addition: S = I + Q₋_x, Yᵀ = J_x U₋ᵀ; U'ᵀ = U₋ᵀ − (U₋_xᵀ S⁻¹) Yᵀ, V' likewise,
+        // Q'_x = Q₋_x − Y_x S⁻¹ Y_xᵀ.
+        let r0 = x * rows;
+        let mut s_factor = vec![0.0; rows * rows];
+        for a in 0..rows {
+            for b in 0..rows {
+                s_factor[a * rows + b] = if a == b { 1.0 } else { 0.0 }
+                    + 0.5 * (self.q[r0 * rows + a * rows + b] + self.q[r0 * rows + b * rows + a]);
+            }
+        }
+        if !small_cholesky::factor(&mut s_factor, rows) {
+            return false;
+        }
+        let mut s_inv = vec![0.0; rows * rows];
+        small_cholesky::inverse(&s_factor, &mut s_inv, rows);
+        // Reuse the removal's buffers: Yᵀ into wt, U₋_xᵀ S⁻¹ into us_k, V₋_xᵀ S⁻¹ into vs_k.
+        for i in 0..cols {
+            for b in 0..rows {
+                self.wt[(b, i)] = dot(Self::col(&self.ut, i), Self::col(&self.jt, r0 + b));
+            }
+        }
+        for b in 0..rows {
+            for p in 0..self.n {
+                self.us_k[(p, b)] = (0..rows)
+                    .map(|a| self.ut[(p, r0 + a)] * s_inv[a * rows + b])
+                    .sum();
+            }
+            for p in 0..self.vt.nrows() {
+                self.vs_k[(p, b)] = (0..rows)
+                    .map(|a| self.vt[(p, r0 + a)] * s_inv[a * rows + b])
+                    .sum();
+            }
+        }
+        add_rank_product(&mut self.ut, &self.us_k, &self.wt, -1.0);
+        add_rank_product(&mut self.vt, &self.vs_k, &self.wt, -1.0);
+        for i in 0..cols / rows {
+            let p0 = i * rows;
+            for a in 0..rows {
+                for b in 0..rows {
+                    let mut v = 0.0;
+                    for c in 0..rows {
+                        for d in 0..rows {
+                            v += self.wt[(c, p0 + a)] * s_inv[c * rows + d] * self.wt[(d, p0 + b)];
+                        }
+                    }
+                    self.q[p0 * rows + a * rows + b] -= v;
+                }
+            }
+        }
+        true
+    }
+}
+
+/// `Mᵀ += sign · A Bᵀ...`: every column i of `m` gains `sign · Σ_b a[:, b] b[b, i]` (`a`:
+/// height of m × rank, `b`: rank × columns of m), the rank-r update of a transposed buffer.
+fn add_rank_product(m: &mut DMatrix<f64>, a: &DMatrix<f64>, b: &DMatrix<f64>, sign: f64) {
+    let h = m.nrows();
+    if h == 0 {
+        return;
+    }
+    let (a, rank) = (a.as_slice(), b.nrows());
+    for (i, col) in m.as_mut_slice().chunks_mut(h).enumerate() {
+        for r in 0..rank {
+            let f = sign * b[(r, i)];
+            for (y, x) in col.iter_mut().zip(&a[r * h..(r + 1) * h]) {
+                *y += f * x;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cell::Cell;
+    use crate::design::criteria::{kpi_matrix, Criterion};
+    use crate::design::exchange::{minimum_poses, pool_jacobians, value_of};
+    use crate::design::DesignModel;
+    use crate::model::random_configurations;
+
+    fn paper_pool() -> (DesignModel, Vec<Vec<f64>>) {
+        let cell = Cell::from_toml(
+            crate::cell::builtin::PAPER_CELL,
+            "paper-cell.toml",
+            std::path::Path::new("."),
+        )
+        .unwrap();
+        let d = DesignModel::from_cell(&cell).unwrap();
+        let pool = random_configurations(&d.model, 80, 5);
+        (d, pool)
+    }
+
+    fn max_difference(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
+        let scale = b.amax().max(1e-300);
+        (a - b).amax() / scale
+    }
+
+    /// Each candidate's score is the exact change of the criterion (KPI: `tr(L C Lᵀ)`; D:
+    /// minus the change of log det M), and after a run of exchanges the rank-updated U, V
+    /// and Q blocks agree with the ones formed anew.
+    #[test]
+    fn rank_updates_match_exact_evaluation() {
+        let (d, pool) = paper_pool();
+        let jp = pool_jacobians(&d, &pool);
+        let l = kpi_matrix(&d).unwrap();
+        let prior = DMatrix::zeros(0, d.n());
+        let rows = d.rows();
+        let mut chosen: Vec<usize> = (0..30).collect();
+        let mut state = SweepState::new(&jp, rows, l.nrows());
+        assert!(state.refresh(&prior, Some(&l), &chosen));
+        let kpi = |set: &[usize]| value_of(&d, Criterion::Kpi, &jp, &prior, set).unwrap();
+        let log_det = |set: &[usize]| {
+            let mut m = DMatrix::zeros(d.n(), d.n());
+            for &i in set {
+                let ji = jp.rows(i * rows, rows);
+                m.gemm_tr(1.0, &ji, &ji, 1.0);
+            }
+            m.cholesky()
+                .unwrap()
+                .l()
+                .diagonal()
+                .iter()
+                .map(|x| 2.0 * x.ln())
+                .sum::<f64>()
+        };
+        for (step, slot) in [3usize, 17, 0, 29, 11, 5].into_iter().enumerate() {
+            let removed = chosen[slot];
+            assert!(state.remove(removed));
+            let mut others = chosen.clone();
+            others.remove(slot);
+            let x = 30 + 7 * step;
+            let mut with_x = others.clone();
+            with_x.push(x);
+            // tr(L C Lᵀ) = 3 · KPI (kpi_matrix carries the 1/3).
+            let exact = kpi(&with_x) - kpi(&others);
+            let score = state.score(x, true).unwrap();
+            assert!(
+                (score - exact).abs() <= 1e-8 * exact.abs(),
+                "KPI score {score} vs {exact}"
+            );
+            let exact_d = -(log_det(&with_x) - log_det(&others));
+            let score_d = state.score(x, false).unwrap();
+            assert!(
+                (score_d - exact_d).abs() <= 1e-8 * exact_d.abs().max(1.0),
+                "D score {score_d} vs {exact_d}"
+            );
+            assert!(state.replace(x));
+            chosen[slot] = x;
+        }
+        let (u, v, q) = (state.ut.clone(), state.vt.clone(), state.q.clone());
+        assert!(state.refresh(&prior, Some(&l), &chosen));
+        assert!(
+            max_difference(&u, &state.ut) < 1e-9,
+            "U drifted: {}",
+            max_difference(&u, &state.ut)
+        );
+        assert!(
+            max_difference(&v, &state.vt) < 1e-9,
+            "V drifted: {}",
+            max_difference(&v, &state.vt)
+        );
+        let qmax = state.q.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        for (a, b) in q.iter().zip(&state.q) {
+            assert!((a - b).abs() < 1e-9 * qmax, "Q drifted: {a} vs {b}");
+        }
+    }
+
+    /// A point whose removal leaves the information singular is essential: `remove` refuses it.
+    #[test]
+    fn an_essential_point_is_kept() {
+        let (d, pool) = paper_pool();
+        let jp = pool_jacobians(&d, &pool);
+        let rows = d.rows();
+        // The fewest poses: every one of them is needed.
+        let needed = minimum_poses(&d, &DMatrix::zeros(0, d.n()));
+        let chosen: Vec<usize> = (0..needed).collect();
+        let prior = DMatrix::zeros(0, d.n());
+        let mut state = SweepState::new(&jp, rows, 0);
+        assert!(
+            state.refresh(&prior, None, &chosen),
+            "{needed} random poses identify the set"
+        );
+        assert!((0..needed).all(|s| !state.remove(chosen[s])));
+        // One pose more: no single pose is essential any more.
+        let chosen: Vec<usize> = (0..needed + 1).collect();
+        assert!(state.refresh(&prior, None, &chosen));
+        assert!((0..=needed).all(|s| state.remove(chosen[s])));
+    }
+}
