@@ -7,6 +7,9 @@
 //!
 //! Each block `[R; rows]` is reduced by Householder QR, which is backward stable column by
 //! column, so columns of very different scale (mm and rad) keep their relative accuracy.
+//!
+//! Beside it, two small kernels more than one module needs: the scaling of an information
+//! matrix to unit diagonal, and a vectorisable inner product.
 
 use nalgebra::{DMatrix, DMatrixView};
 

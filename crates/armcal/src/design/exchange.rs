@@ -10,7 +10,7 @@
 
 use crate::design::criteria::{evaluate, kpi_matrix, Criterion};
 use crate::design::information::{DesignModel, InformationWorkspace};
-use crate::design::objective::triangular_factor;
+use crate::design::objective::information_factor;
 use crate::progress::Observer;
 use crate::solve::Status;
 use crate::Error;
@@ -99,7 +99,7 @@ pub(crate) fn value_of(
         a.rows_mut(prior.nrows() + k * rows, rows)
             .copy_from(&jp.rows(i * rows, rows));
     }
-    Ok(evaluate(c, &triangular_factor(a), d)?.value)
+    Ok(evaluate(c, &information_factor(c, a), d)?.value)
 }
 
 /// The fewest poses that can identify the `n` free parameters of `d`: each gives `d.rows()`

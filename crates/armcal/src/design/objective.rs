@@ -228,7 +228,7 @@ fn through_factor(a: &DMatrix<f64>, f: &DMatrix<f64>, t: &mut [f64], g: &mut [f6
 /// In the refinement's loop Cholesky costs about a third of Householder QR (one product
 /// `AᵀA` by blocks, then n³/3); its relative error in C, about cond(M)·ε, stays below 1e-8
 /// for every design the planner accepts (column-normalised singular-value ratio ≥ 1e-4).
-fn information_factor(c: Criterion, a: DMatrix<f64>) -> DMatrix<f64> {
+pub(crate) fn information_factor(c: Criterion, a: DMatrix<f64>) -> DMatrix<f64> {
     if matches!(
         c,
         Criterion::A | Criterion::D | Criterion::Kpi | Criterion::KpiMax

@@ -320,3 +320,14 @@ pub(super) fn constraint_ranges(set: &ConstraintSet, samples: usize) -> Vec<(f64
 pub(super) fn is_flat(range: (f64, f64)) -> bool {
     range.1 - range.0 < 1e-9
 }
+
+impl ConstraintWorkspace {
+    pub(crate) fn new(set: &ConstraintSet) -> Self {
+        ConstraintWorkspace {
+            data: Data::new(&set.model),
+            fixed: FixedKinematics::new(&set.model),
+            ends: vec![[Vector3::zeros(); 2]; set.capsules.len()],
+            values: vec![0.0; set.len()],
+        }
+    }
+}

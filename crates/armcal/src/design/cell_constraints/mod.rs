@@ -536,17 +536,6 @@ impl ConstraintSet {
     }
 }
 
-impl ConstraintWorkspace {
-    pub(crate) fn new(set: &ConstraintSet) -> Self {
-        ConstraintWorkspace {
-            data: Data::new(&set.model),
-            fixed: FixedKinematics::new(&set.model),
-            ends: vec![[Vector3::zeros(); 2]; set.capsules.len()],
-            values: vec![0.0; set.len()],
-        }
-    }
-}
-
 /// Robot capsules that carry the reflector (see the module documentation): at most one joint
 /// between the capsule's frame and the reflector, and the reflector within the capsule's
 /// radius plus the beam radius, at nominal parameters and any of 16 values of that joint.
