@@ -5,9 +5,10 @@ use crate::design::small_cholesky;
 use crate::linalg::dot;
 use nalgebra::DMatrix;
 
-/// Leverage `1 − λ_min(I − J_s C J_sᵀ)` above which a design point counts as essential: its
-/// removal leaves the information (nearly) singular, and a rank update through
-/// `(I − J_s C J_sᵀ)⁻¹` would magnify rounding.
+/// Smallest squared pivot of the Cholesky factor of `K = I − J_s C J_sᵀ` (of the order of
+/// its least eigenvalue, 1 − the point's largest leverage) below which a design point counts
+/// as essential: its removal leaves the information (nearly) singular, and a rank update
+/// through `K⁻¹` would magnify rounding.
 const ESSENTIAL_PIVOT: f64 = 1e-8;
 
 /// The covariance of the current design as the exchange needs it, kept up to date by rank
@@ -271,8 +272,8 @@ impl SweepState {
     }
 }
 
-/// `Mᵀ += sign · A Bᵀ...`: every column i of `m` gains `sign · Σ_b a[:, b] b[b, i]` (`a`:
-/// height of m × rank, `b`: rank × columns of m), the rank-r update of a transposed buffer.
+/// `m += sign · a b`, the rank-r update of a transposed buffer: column i of `m` gains
+/// `sign · Σ_r a[:, r] b[r, i]` (`a`: height of m × r, `b`: r × columns of m).
 fn add_rank_product(m: &mut DMatrix<f64>, a: &DMatrix<f64>, b: &DMatrix<f64>, sign: f64) {
     let h = m.nrows();
     if h == 0 {
