@@ -85,7 +85,9 @@ const GRAM_BLOCK: usize = 512;
 
 /// `Σ aᵢ bᵢ` over the common length, in four interleaved sums that the compiler turns into
 /// vector instructions (a single running sum is one long dependency chain: the planner's
-/// exchange computes millions of these 27-term products, about 3× faster this way).
+/// exchange computes millions of these 27-term products, about 3× faster this way). It takes
+/// plain slices (columns of column-major buffers), where nalgebra's `dot` needs a matrix view
+/// built around each.
 pub fn dot(a: &[f64], b: &[f64]) -> f64 {
     let n = a.len().min(b.len());
     let (a, b) = (&a[..n], &b[..n]);

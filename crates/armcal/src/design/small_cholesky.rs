@@ -49,23 +49,13 @@ pub fn forward(l: &[f64], b: &mut [f64], n: usize) {
     }
 }
 
-/// `A⁻¹` (row-major `n × n`) into `inv`, from `l` of [`factor`], column by column.
+/// `A⁻¹` (row-major `n × n`) into `inv`, from `l` of [`factor`]: row c solves `A x = e_c`
+/// (A⁻¹ is symmetric, so its rows are its columns).
 pub fn inverse(l: &[f64], inv: &mut [f64], n: usize) {
-    let mut e = [0.0; 16];
-    let mut heap;
-    let col: &mut [f64] = if n <= e.len() {
-        &mut e[..n]
-    } else {
-        heap = vec![0.0; n];
-        &mut heap
-    };
-    for c in 0..n {
-        col.fill(0.0);
-        col[c] = 1.0;
-        solve(l, col, n);
-        for (r, v) in col.iter().enumerate() {
-            inv[r * n + c] = *v;
-        }
+    inv.fill(0.0);
+    for (c, row) in inv.chunks_mut(n).enumerate() {
+        row[c] = 1.0;
+        solve(l, row, n);
     }
 }
 

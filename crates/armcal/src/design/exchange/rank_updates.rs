@@ -34,11 +34,12 @@ pub(super) struct SweepState {
     vt: DMatrix<f64>,
     /// `Q_x`, rows × rows row-major per pool point.
     q: Vec<f64>,
-    /// `Wᵀ` of the removal in progress (rows × pool rows), `(W K⁻¹)ᵀ`, `K⁻¹` (row-major),
-    /// `U_sᵀ K⁻¹` (n × rows), `V_sᵀ K⁻¹` (columns of L × rows).
+    /// Of the rank update in progress, point p with `inv` = `K⁻¹` (a removal) or `S⁻¹` (an
+    /// addition): `Wᵀ = J_p Uᵀ` (rows × pool rows), `inv · Wᵀ`, `inv` (row-major),
+    /// `U_pᵀ inv` (n × rows), `V_pᵀ inv` (columns of L × rows).
     wt: DMatrix<f64>,
     wkt: DMatrix<f64>,
-    k_inv: Vec<f64>,
+    inv: Vec<f64>,
     us_k: DMatrix<f64>,
     vs_k: DMatrix<f64>,
     /// A candidate's S (row-major; its Cholesky factor in place) and a column of `V'_x`.
@@ -58,7 +59,7 @@ impl SweepState {
             q: vec![0.0; pool_rows * rows],
             wt: DMatrix::zeros(rows, pool_rows),
             wkt: DMatrix::zeros(rows, pool_rows),
-            k_inv: vec![0.0; rows * rows],
+            inv: vec![0.0; rows * rows],
             us_k: DMatrix::zeros(n, rows),
             vs_k: DMatrix::zeros(l_rows, rows),
             s_buf: vec![0.0; rows * rows],
@@ -94,64 +95,67 @@ impl SweepState {
         if let Some(l) = l {
             self.vt.gemm(1.0, l, &self.ut, 0.0);
         }
-        for x in 0..self.jt.ncols() / rows {
-            let r0 = x * rows;
-            for a in 0..rows {
-                for b in 0..rows {
-                    self.q[r0 * rows + a * rows + b] =
-                        dot(Self::col(&self.ut, r0 + a), Self::col(&self.jt, r0 + b));
-                }
-            }
-        }
+        self.q.fill(0.0);
+        add_block_dots(&mut self.q, rows, &self.ut, &self.jt, 1.0);
         true
     }
 
     /// Starts the removal of pool point `s` from the design: `W`, `K⁻¹` and the products
     /// with it; false if the point is essential ([`ESSENTIAL_PIVOT`]).
     pub(super) fn remove(&mut self, s: usize) -> bool {
+        // K = I − Q_s (symmetrised), factored in s_buf, its inverse into inv.
         let rows = self.rows;
-        let mut k = vec![0.0; rows * rows];
+        let q = &self.q[s * rows * rows..(s + 1) * rows * rows];
         for a in 0..rows {
             for b in 0..rows {
-                let qab = 0.5
-                    * (self.q[s * rows * rows + a * rows + b]
-                        + self.q[s * rows * rows + b * rows + a]);
-                k[a * rows + b] = if a == b { 1.0 } else { 0.0 } - qab;
+                let qab = 0.5 * (q[a * rows + b] + q[b * rows + a]);
+                self.s_buf[a * rows + b] = if a == b { 1.0 } else { 0.0 } - qab;
             }
         }
-        if !small_cholesky::factor(&mut k, rows)
-            || (0..rows).any(|a| k[a * rows + a] * k[a * rows + a] < ESSENTIAL_PIVOT)
+        let l = &mut self.s_buf;
+        if !small_cholesky::factor(l, rows)
+            || (0..rows).any(|a| l[a * rows + a] * l[a * rows + a] < ESSENTIAL_PIVOT)
         {
             return false;
         }
-        small_cholesky::inverse(&k, &mut self.k_inv, rows);
-        // Wᵀ column x·rows + a: J_s U_xᵀ, i.e. W_x[a][b] = U_{x,a} · J_{s,b}.
+        small_cholesky::inverse(l, &mut self.inv, rows);
+        self.products_with(s);
+        self.through_inverse(s);
+        true
+    }
+
+    /// `Wᵀ = J_p Uᵀ` of pool point `p`: `W_x[a][b] = U_{x,a} · J_{p,b}` for every pool row.
+    fn products_with(&mut self, p: usize) {
+        let rows = self.rows;
         for i in 0..self.jt.ncols() {
             for b in 0..rows {
-                self.wt[(b, i)] = dot(Self::col(&self.ut, i), Self::col(&self.jt, s * rows + b));
+                self.wt[(b, i)] = dot(Self::col(&self.ut, i), Self::col(&self.jt, p * rows + b));
             }
         }
-        // (W K⁻¹)ᵀ = K⁻¹ Wᵀ (K⁻¹ symmetric).
+    }
+
+    /// `inv · Wᵀ`, `U_pᵀ inv` and `V_pᵀ inv` of pool point `p` (`inv` symmetric).
+    fn through_inverse(&mut self, p: usize) {
+        let rows = self.rows;
         for i in 0..self.wt.ncols() {
             for a in 0..rows {
                 self.wkt[(a, i)] = (0..rows)
-                    .map(|b| self.k_inv[a * rows + b] * self.wt[(b, i)])
+                    .map(|b| self.inv[a * rows + b] * self.wt[(b, i)])
                     .sum();
             }
         }
         for b in 0..rows {
-            for p in 0..self.n {
-                self.us_k[(p, b)] = (0..rows)
-                    .map(|a| self.ut[(p, s * rows + a)] * self.k_inv[a * rows + b])
+            for r in 0..self.n {
+                self.us_k[(r, b)] = (0..rows)
+                    .map(|a| self.ut[(r, p * rows + a)] * self.inv[a * rows + b])
                     .sum();
             }
-            for p in 0..self.vt.nrows() {
-                self.vs_k[(p, b)] = (0..rows)
-                    .map(|a| self.vt[(p, s * rows + a)] * self.k_inv[a * rows + b])
+            for r in 0..self.vt.nrows() {
+                self.vs_k[(r, b)] = (0..rows)
+                    .map(|a| self.vt[(r, p * rows + a)] * self.inv[a * rows + b])
                     .sum();
             }
         }
-        true
     }
 
     /// `S = I + J_x C₋ J_xᵀ = I + Q_x + W_x K⁻¹ W_xᵀ` of candidate `x` into `s_buf`
@@ -206,69 +210,37 @@ impl SweepState {
     /// changed) if `S` is not positive definite.
     pub(super) fn replace(&mut self, x: usize) -> bool {
         let rows = self.rows;
-        let cols = self.jt.ncols();
+        // S = I + J_x C₋ J_xᵀ: its inverse now, before anything changes.
+        if !self.factor_s(x) {
+            return false;
+        }
+        small_cholesky::inverse(&self.s_buf, &mut self.inv, rows);
         // Removal: U₋ᵀ = Uᵀ + (U_sᵀ K⁻¹) Wᵀ, V₋ᵀ likewise, Q₋_x = Q_x + (W_x K⁻¹) W_xᵀ.
         add_rank_product(&mut self.ut, &self.us_k, &self.wt, 1.0);
         add_rank_product(&mut self.vt, &self.vs_k, &self.wt, 1.0);
-        for i in 0..cols / rows {
-            let r0 = i * rows;
-            for a in 0..rows {
-                for b in 0..rows {
-                    self.q[r0 * rows + a * rows + b] +=
-                        dot(Self::col(&self.wkt, r0 + a), Self::col(&self.wt, r0 + b));
-                }
-            }
-        }
-        // Addition: S = I + Q₋_x, Yᵀ = J_x U₋ᵀ; U'ᵀ = U₋ᵀ − (U₋_xᵀ S⁻¹) Yᵀ, V' likewise,
-        // Q'_x = Q₋_x − Y_x S⁻¹ Y_xᵀ.
-        let r0 = x * rows;
-        let mut s_factor = vec![0.0; rows * rows];
-        for a in 0..rows {
-            for b in 0..rows {
-                s_factor[a * rows + b] = if a == b { 1.0 } else { 0.0 }
-                    + 0.5 * (self.q[r0 * rows + a * rows + b] + self.q[r0 * rows + b * rows + a]);
-            }
-        }
-        if !small_cholesky::factor(&mut s_factor, rows) {
-            return false;
-        }
-        let mut s_inv = vec![0.0; rows * rows];
-        small_cholesky::inverse(&s_factor, &mut s_inv, rows);
-        // Reuse the removal's buffers: Yᵀ into wt, U₋_xᵀ S⁻¹ into us_k, V₋_xᵀ S⁻¹ into vs_k.
-        for i in 0..cols {
-            for b in 0..rows {
-                self.wt[(b, i)] = dot(Self::col(&self.ut, i), Self::col(&self.jt, r0 + b));
-            }
-        }
-        for b in 0..rows {
-            for p in 0..self.n {
-                self.us_k[(p, b)] = (0..rows)
-                    .map(|a| self.ut[(p, r0 + a)] * s_inv[a * rows + b])
-                    .sum();
-            }
-            for p in 0..self.vt.nrows() {
-                self.vs_k[(p, b)] = (0..rows)
-                    .map(|a| self.vt[(p, r0 + a)] * s_inv[a * rows + b])
-                    .sum();
-            }
-        }
+        add_block_dots(&mut self.q, rows, &self.wkt, &self.wt, 1.0);
+        // Addition: Yᵀ = J_x U₋ᵀ (into wt); U'ᵀ = U₋ᵀ − (U₋_xᵀ S⁻¹) Yᵀ, V' likewise,
+        // Q'_x = Q₋_x − (Y_x S⁻¹) Y_xᵀ.
+        self.products_with(x);
+        self.through_inverse(x);
         add_rank_product(&mut self.ut, &self.us_k, &self.wt, -1.0);
         add_rank_product(&mut self.vt, &self.vs_k, &self.wt, -1.0);
-        for i in 0..cols / rows {
-            let p0 = i * rows;
-            for a in 0..rows {
-                for b in 0..rows {
-                    let mut v = 0.0;
-                    for c in 0..rows {
-                        for d in 0..rows {
-                            v += self.wt[(c, p0 + a)] * s_inv[c * rows + d] * self.wt[(d, p0 + b)];
-                        }
-                    }
-                    self.q[p0 * rows + a * rows + b] -= v;
-                }
+        add_block_dots(&mut self.q, rows, &self.wkt, &self.wt, -1.0);
+        true
+    }
+}
+
+/// `Q_x[a][b] += sign · a_{x,a} · b_{x,b}` for every pool point x, the columns `x·rows + a`
+/// of the transposed buffers `a` and `b` (rows × rows row-major blocks in `q`).
+fn add_block_dots(q: &mut [f64], rows: usize, a: &DMatrix<f64>, b: &DMatrix<f64>, sign: f64) {
+    for x in 0..a.ncols() / rows {
+        let r0 = x * rows;
+        for i in 0..rows {
+            for j in 0..rows {
+                q[r0 * rows + i * rows + j] +=
+                    sign * dot(SweepState::col(a, r0 + i), SweepState::col(b, r0 + j));
             }
         }
-        true
     }
 }
 
