@@ -187,7 +187,7 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         ),
         None => {}
     }
-    if let Some(t) = record.assessment.tcp.first() {
+    for t in &record.assessment.tcp {
         println!("(1/3) tr C_s at `{}`: {:.5} mm²", t.name, t.kpi);
     }
     print_paths(&record.assessment.paths, "");

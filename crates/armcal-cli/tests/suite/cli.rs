@@ -1,7 +1,7 @@
 //! The `armcal` binary end to end.
 
 use crate::common;
-use common::armcal;
+use common::{armcal, scratch};
 
 #[test]
 fn model_of_the_paper_cell_reports_27_identifiable_parameters_with_reasons() {
@@ -182,6 +182,40 @@ fn a_closed_stdout_is_not_a_crash() {
         assert!(
             status.success() || status.signal() == Some(libc::SIGPIPE),
             "armcal {args:?} ended with {status:?}: {err}"
+        );
+    }
+}
+
+/// A cell with two working poses: `plan` states the TCP variance at each, not at the first
+/// alone (the second, weighted double here, was once left off the screen).
+#[test]
+fn plan_prints_the_tcp_variance_at_every_working_pose() {
+    let dir = scratch("plan-two-working-poses");
+    let cell = dir.join("cell.toml");
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/paper-cell.toml"
+    ))
+    .unwrap()
+        + "\n[[working]]\nname = \"pick\"\njoints_deg = [30, -60, 70, 10, 40, 0]\nweight = 2\n";
+    std::fs::write(&cell, text).unwrap();
+    let out = dir.join("design.csv");
+    let (ok, stdout, err) = armcal(&[
+        "plan",
+        "--cell",
+        cell.to_str().unwrap(),
+        "--collisions",
+        "off",
+        "--poses",
+        "20",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    for name in ["q_work", "pick"] {
+        assert!(
+            stdout.contains(&format!("(1/3) tr C_s at `{name}`:")),
+            "{name} missing:\n{stdout}"
         );
     }
 }
