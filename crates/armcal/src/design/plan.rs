@@ -22,7 +22,7 @@ use std::time::{Duration, Instant};
 
 /// Relative gain below which an exchange sweep counts as no progress when the continuous
 /// refinement follows.
-const EXCHANGE_TOLERANCE_BEFORE_REFINEMENT: f64 = 1e-3;
+pub const EXCHANGE_TOLERANCE_BEFORE_REFINEMENT: f64 = 1e-3;
 
 /// The largest design [`plan`] computes. Planning time grows with the number of poses
 /// (paper cell, KPI, 2 starts on 2 cores: 60 poses 0.9 s, 1 000 poses 14 s, 5 000 poses
