@@ -70,20 +70,13 @@ fn sensitivity(
     x: &[f64],
     grad: Option<&mut [f64]>,
 ) -> f64 {
-    match grad {
-        Some(g) => {
-            d.jacobian_dq(ws, x);
-            let b = &ws.jac * phi;
-            for (gj, dj) in g.iter_mut().zip(&ws.jac_dq) {
-                *gj = -2.0 * b.dot(dj);
-            }
-            -b.dot(&ws.jac)
-        }
-        None => {
-            d.jacobian(ws, x);
-            -(&ws.jac * phi).dot(&ws.jac)
-        }
+    d.jacobian(ws, x);
+    let b = &ws.jac * phi;
+    if let Some(g) = grad {
+        d.jacobian_dq_along(&ws.data, &mut ws.along, &b, g);
+        g.iter_mut().for_each(|gj| *gj *= -2.0);
     }
+    -b.dot(&ws.jac)
 }
 
 /// The bound for `design` (N configurations) under `objective`, maximising the sensitivity

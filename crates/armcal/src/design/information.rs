@@ -1,13 +1,14 @@
 //! The information a measurement configuration carries: `M(q) = J(q)ᵀ W J(q)` with `J` the
 //! identification Jacobian of the measured target positions w.r.t. the free parameters and
-//! `W = Σ⁻¹` (paper §1.1: `C = (F₁ᵀF₁)⁻¹`), and its derivative w.r.t. q through the mixed
-//! derivative ∂J/∂q of the foundation.
+//! `W = Σ⁻¹` (paper §1.1: `C = (F₁ᵀF₁)⁻¹`), and the derivative w.r.t. q of a weighted sum
+//! `⟨Ω, W^{1/2}J⟩` through the foundation's mixed derivative
+//! ([`identification_jacobian_dq_along`]): every design gradient is one.
 
 use crate::cell::Cell;
 use crate::measure::NoiseModel;
 use crate::model::{
-    forward_kinematics, identification_jacobian, identification_jacobian_dq, observed_position,
-    Data, MixedWorkspace, Model, Observed, Rows,
+    forward_kinematics, identification_jacobian, identification_jacobian_dq_along,
+    observed_position, AlongWorkspace, Data, Model, Observed, Rows,
 };
 use crate::Error;
 use nalgebra::DMatrix;
@@ -114,82 +115,91 @@ impl DesignModel {
 
 /// Buffers for per-configuration information and its q-derivative.
 pub struct InformationWorkspace {
-    data: Data<f64>,
-    mixed: MixedWorkspace,
+    /// Kinematics of the last configuration of [`DesignModel::jacobian`].
+    pub data: Data<f64>,
+    /// Buffers of [`DesignModel::jacobian_dq_along`].
+    pub along: AlongBuffers,
     /// Whitened Jacobian `W^{1/2} J` of one configuration.
     pub jac: DMatrix<f64>,
-    /// Its derivatives w.r.t. each joint.
-    pub jac_dq: Vec<DMatrix<f64>>,
-    value: DMatrix<f64>,
-    dq: Vec<DMatrix<f64>>,
 }
 
 impl InformationWorkspace {
-    /// Buffers sized for `d`: one configuration's whitened Jacobian and its derivative w.r.t.
-    /// each joint.
+    /// Buffers sized for `d`: one configuration's kinematics and whitened Jacobian.
     pub fn new(d: &DesignModel) -> Self {
-        let n = d.n();
         InformationWorkspace {
             data: Data::new(&d.model),
-            mixed: MixedWorkspace::new(&d.model),
-            jac: DMatrix::zeros(d.rows(), n),
-            jac_dq: vec![DMatrix::zeros(d.rows(), n); d.dof()],
-            value: DMatrix::zeros(3, n),
-            dq: vec![DMatrix::zeros(3, n); d.dof()],
+            along: AlongBuffers::new(d),
+            jac: DMatrix::zeros(d.rows(), d.n()),
+        }
+    }
+}
+
+/// Buffers of [`DesignModel::jacobian_dq_along`].
+pub struct AlongBuffers {
+    along: AlongWorkspace,
+    /// `W^{1/2} Ω` (rows × n).
+    weight: DMatrix<f64>,
+}
+
+impl AlongBuffers {
+    /// Buffers sized for `d`.
+    pub fn new(d: &DesignModel) -> Self {
+        AlongBuffers {
+            along: AlongWorkspace::new(&d.model),
+            weight: DMatrix::zeros(d.rows(), d.n()),
         }
     }
 }
 
 impl DesignModel {
-    /// Whitened Jacobian of one configuration into `ws.jac`.
+    /// Whitened Jacobian of one configuration into `ws.jac` (its kinematics in `ws.data`).
     pub fn jacobian(&self, ws: &mut InformationWorkspace, q: &[f64]) {
-        forward_kinematics(&self.model, &mut ws.data, &self.params, q);
+        self.jacobian_into(&mut ws.data, q, &mut ws.jac);
+    }
+
+    /// Whitened Jacobian `W^{1/2} J` of the configuration `q` into `jac` (rows × n), with its
+    /// kinematics into `data` (for [`DesignModel::jacobian_dq_along`]).
+    pub fn jacobian_into(&self, data: &mut Data<f64>, q: &[f64], jac: &mut DMatrix<f64>) {
+        forward_kinematics(&self.model, data, &self.params, q);
         for (k, &obs) in self.observed.iter().enumerate() {
             identification_jacobian(
                 &self.model,
-                &ws.data,
+                data,
                 obs,
                 Rows::Position,
                 &self.free,
-                &mut ws.jac,
+                jac,
                 3 * k,
             );
         }
-        self.whiten(&mut ws.jac);
+        self.whiten(jac);
     }
 
-    /// Whitened Jacobian and its derivative w.r.t. every joint into `ws.jac`, `ws.jac_dq`.
-    pub fn jacobian_dq(&self, ws: &mut InformationWorkspace, q: &[f64]) {
+    /// `∂/∂q_k ⟨Ω, W^{1/2}J⟩` for every joint k into `out`, at the configuration whose
+    /// kinematics `data` holds ([`DesignModel::jacobian_into`]); `omega` is rows × n. Equal
+    /// to `⟨W^{1/2}Ω, ∂J/∂q_k⟩` ([`identification_jacobian_dq_along`] per target).
+    pub fn jacobian_dq_along(
+        &self,
+        data: &Data<f64>,
+        buffers: &mut AlongBuffers,
+        omega: &DMatrix<f64>,
+        out: &mut [f64],
+    ) {
+        buffers.weight.copy_from(omega);
+        self.whiten(&mut buffers.weight);
+        out.fill(0.0);
         for (k, &obs) in self.observed.iter().enumerate() {
-            identification_jacobian_dq(
+            identification_jacobian_dq_along(
                 &self.model,
-                &mut ws.mixed,
-                &self.params,
-                q,
+                &mut buffers.along,
+                data,
                 obs,
                 Rows::Position,
                 &self.free,
-                &mut ws.value,
-                &mut ws.dq,
+                &buffers.weight,
+                3 * k,
+                out,
             );
-            if self.observed.len() == 1 {
-                // One target: its rows are the whole Jacobian; exchange, do not copy.
-                std::mem::swap(&mut ws.jac, &mut ws.value);
-                std::mem::swap(&mut ws.jac_dq, &mut ws.dq);
-            } else {
-                ws.jac.rows_mut(3 * k, 3).copy_from(&ws.value);
-                for (d, s) in ws.jac_dq.iter_mut().zip(&ws.dq) {
-                    d.rows_mut(3 * k, 3).copy_from(s);
-                }
-            }
-        }
-        let mut jac = std::mem::take(&mut ws.jac);
-        self.whiten(&mut jac);
-        ws.jac = jac;
-        for j in 0..ws.jac_dq.len() {
-            let mut m = std::mem::take(&mut ws.jac_dq[j]);
-            self.whiten(&mut m);
-            ws.jac_dq[j] = m;
         }
     }
 

@@ -5,12 +5,18 @@
 //! When the criterion's `Φ = −F Fᵀ` has few columns (KPI: `F = C Hᵀ`), the gradient is
 //! `∂φ/∂q_ij = −2 ⟨W^{1/2}J_i F, W^{1/2}(∂J_i/∂q_j) F⟩_F`, O(N·k·rows·n_p·cols(F)).
 //!
+//! Both are weighted sums `⟨Ω_i, ∂(W^{1/2}J_i)/∂q_j⟩` with `Ω_i = W^{1/2}J_i Φ`, computed per
+//! configuration in one pass ([`DesignModel::jacobian_dq_along`]) from the kinematics of the
+//! value's pass, without forming the N·k matrices ∂J_i/∂q_j.
+//!
 //! A solver may ask for φ and then for ∇φ at the same point; the workspace keeps the last
-//! point with its whitened Jacobians `W^{1/2}J_i` and `Φ = ∂φ/∂M`, so the gradient call there
-//! only adds the mixed derivatives ∂J_i/∂q_j (no second factorisation of M).
+//! point with each configuration's kinematics, its whitened Jacobian `W^{1/2}J_i` and
+//! `Φ = ∂φ/∂M`, so the gradient call there only adds the weighted sums (no second
+//! forward kinematics, no second factorisation of M).
 
 use crate::design::criteria::{evaluate, Criterion};
-use crate::design::information::{DesignModel, InformationWorkspace};
+use crate::design::information::{AlongBuffers, DesignModel, InformationWorkspace};
+use crate::model::Data;
 use crate::Error;
 use nalgebra::DMatrix;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -35,17 +41,17 @@ pub struct DesignObjective<'a> {
 }
 
 /// Buffers for [`DesignObjective::value_and_gradient`], and a cache of its last evaluation:
-/// the point `q`, φ, `Φ`, the Jacobians `W^{1/2}J_i` and (if a gradient was asked for) their
-/// derivatives, of the objective `owner` at exactly (bitwise) that `q`.
+/// the point `q`, φ, `Φ`, each configuration's kinematics and Jacobian `W^{1/2}J_i`, of the
+/// objective `owner` at exactly (bitwise) that `q`.
 pub struct ObjectiveWorkspace {
-    info: InformationWorkspace,
+    kinematics: Vec<Data<f64>>,
     jacs: Vec<DMatrix<f64>>,
-    jacs_dq: Vec<Vec<DMatrix<f64>>>,
+    along: AlongBuffers,
     /// `W^{1/2}J_i Φ` of one configuration (or `−(W^{1/2}J_i F) Fᵀ`).
     j_phi: DMatrix<f64>,
     owner: u64,
     cached_q: Vec<f64>,
-    /// Whether `cached_q`, `value`, `phi` and `jacs` belong together.
+    /// Whether `cached_q`, `value`, `phi`, `kinematics` and `jacs` belong together.
     cached: bool,
     /// φ, `Φ` and `F` (`Φ = −F Fᵀ`, when the criterion gives it) at `cached_q`.
     value: f64,
@@ -53,8 +59,6 @@ pub struct ObjectiveWorkspace {
     factor: Option<DMatrix<f64>>,
     /// `W^{1/2}J_i F` of one configuration (rows × cols(F)).
     jf: Vec<f64>,
-    /// Whether `jacs_dq` holds the derivatives at `cached_q`.
-    cached_dq: bool,
 }
 
 impl<'a> DesignObjective<'a> {
@@ -91,9 +95,9 @@ impl<'a> DesignObjective<'a> {
     pub fn workspace(&self, n_configs: usize) -> ObjectiveWorkspace {
         let d = self.design;
         ObjectiveWorkspace {
-            info: InformationWorkspace::new(d),
+            kinematics: (0..n_configs).map(|_| Data::new(&d.model)).collect(),
             jacs: vec![DMatrix::zeros(d.rows(), d.n()); n_configs],
-            jacs_dq: vec![vec![DMatrix::zeros(d.rows(), d.n()); d.dof()]; n_configs],
+            along: AlongBuffers::new(d),
             j_phi: DMatrix::zeros(d.rows(), d.n()),
             owner: self.id,
             cached_q: Vec::with_capacity(n_configs * d.dof()),
@@ -102,7 +106,6 @@ impl<'a> DesignObjective<'a> {
             phi: DMatrix::zeros(d.n(), d.n()),
             factor: None,
             jf: Vec::new(),
-            cached_dq: false,
         }
     }
 
@@ -128,67 +131,53 @@ impl<'a> DesignObjective<'a> {
         if !hit {
             ws.owner = self.id;
             ws.cached = false;
-            ws.cached_dq = false;
             ws.cached_q.clear();
             ws.cached_q.extend_from_slice(q);
-            let rows = self.design.rows();
+            let d = self.design;
+            while ws.jacs.len() < nconf {
+                ws.kinematics.push(Data::new(&d.model));
+                ws.jacs.push(DMatrix::zeros(d.rows(), d.n()));
+            }
+            let rows = d.rows();
             let np = self.prior_factor.nrows();
-            let mut stacked = DMatrix::zeros(np + rows * nconf, self.design.n());
+            let mut stacked = DMatrix::zeros(np + rows * nconf, d.n());
             stacked.rows_mut(0, np).copy_from(&self.prior_factor);
             for i in 0..nconf {
-                let qi = &q[i * k..(i + 1) * k];
-                if gradient.is_some() {
-                    self.jacobian_and_derivatives(ws, i, qi);
-                } else {
-                    self.design.jacobian(&mut ws.info, qi);
-                    std::mem::swap(&mut ws.jacs[i], &mut ws.info.jac);
-                }
+                d.jacobian_into(
+                    &mut ws.kinematics[i],
+                    &q[i * k..(i + 1) * k],
+                    &mut ws.jacs[i],
+                );
                 stacked.rows_mut(np + rows * i, rows).copy_from(&ws.jacs[i]);
             }
             let r = information_factor(self.criterion, stacked);
-            let cv = evaluate(self.criterion, &r, self.design)?;
+            let cv = evaluate(self.criterion, &r, d)?;
             ws.value = cv.value;
             ws.phi.copy_from(&cv.gradient);
             ws.factor = cv.factor;
             ws.cached = true;
-            ws.cached_dq = gradient.is_some();
         }
         let Some(g) = gradient else {
             return Ok(ws.value);
         };
-        if !ws.cached_dq {
-            for i in 0..nconf {
-                self.jacobian_and_derivatives(ws, i, &q[i * k..(i + 1) * k]);
-            }
-            ws.cached_dq = true;
-        }
-        if let Some(f) = &ws.factor {
-            // −J_i Φ = (J_i F) Fᵀ, then ∂φ/∂q_ij = −2 ⟨∂J_i/∂q_j, (J_i F) Fᵀ⟩.
-            ws.jf.resize(self.design.rows() * f.ncols(), 0.0);
-            for i in 0..nconf {
-                through_factor(&ws.jacs[i], f, &mut ws.jf, ws.j_phi.as_mut_slice());
-                for j in 0..k {
-                    g[i * k + j] = -2.0 * ws.j_phi.dot(&ws.jacs_dq[i][j]);
+        for (i, gi) in g.chunks_mut(k).take(nconf).enumerate() {
+            // ∂φ/∂q_ij = 2 ⟨J_i Φ, ∂J_i/∂q_j⟩; with Φ = −F Fᵀ, J_i Φ = −(J_i F) Fᵀ.
+            let sign = match &ws.factor {
+                Some(f) => {
+                    ws.jf.resize(self.design.rows() * f.ncols(), 0.0);
+                    through_factor(&ws.jacs[i], f, &mut ws.jf, ws.j_phi.as_mut_slice());
+                    -2.0
                 }
-            }
-        } else {
-            for i in 0..nconf {
-                ws.j_phi.gemm(1.0, &ws.jacs[i], &ws.phi, 0.0);
-                for j in 0..k {
-                    g[i * k + j] = 2.0 * ws.j_phi.dot(&ws.jacs_dq[i][j]);
+                None => {
+                    ws.j_phi.gemm(1.0, &ws.jacs[i], &ws.phi, 0.0);
+                    2.0
                 }
-            }
+            };
+            self.design
+                .jacobian_dq_along(&ws.kinematics[i], &mut ws.along, &ws.j_phi, gi);
+            gi.iter_mut().for_each(|x| *x *= sign);
         }
         Ok(ws.value)
-    }
-
-    /// `W^{1/2}J_i` and `W^{1/2}∂J_i/∂q_j` of configuration `i` into `ws.jacs[i]`,
-    /// `ws.jacs_dq[i]`.
-    /// (The buffers are exchanged, not copied: the next call overwrites the workspace's.)
-    fn jacobian_and_derivatives(&self, ws: &mut ObjectiveWorkspace, i: usize, qi: &[f64]) {
-        self.design.jacobian_dq(&mut ws.info, qi);
-        std::mem::swap(&mut ws.jacs[i], &mut ws.info.jac);
-        std::mem::swap(&mut ws.jacs_dq[i], &mut ws.info.jac_dq);
     }
 
     /// Information matrix of configurations (prior included).

@@ -68,7 +68,7 @@ pub fn observed_position<T: RealField + Copy>(data: &Data<T>, obs: Observed) -> 
 
 /// Sign with which a parameter moves the observed frame (0 if it does not).
 #[inline]
-fn influence(segment: Segment, obs: Observed) -> f64 {
+pub(crate) fn influence(segment: Segment, obs: Observed) -> f64 {
     match (segment, obs) {
         (Segment::Instrument, _) => -1.0,
         (Segment::Chain, _) => 1.0,
@@ -134,35 +134,32 @@ pub fn joint_jacobian<T: RealField + Copy>(data: &Data<T>, obs: Observed) -> DMa
     j
 }
 
-/// Workspace for [`identification_jacobian_dq`]: kinematics buffers and, for every
-/// parameter and joint, the position of its factor along the chain (what can move what).
-pub struct MixedWorkspace {
-    data: Data<f64>,
-    /// Instrument factors 0, chain factor i → i + 1, target factors `usize::MAX`.
-    param_order: Vec<usize>,
-    joint_order: Vec<usize>,
-    /// Per joint, in the instrument frame: `R_Iᵀ ω_k` and the point's velocity `R_Iᵀ ṗ`.
-    joint_w: Vec<Vector3<f64>>,
-    joint_p_dot: Vec<Vector3<f64>>,
-    /// With joint corrections: per joint, its derivative matrix w.r.t. the corrected joint.
-    deflected: Vec<DMatrix<f64>>,
+/// Where every parameter and joint acts along the chain (what can move what): instrument
+/// factors 0, chain factor i → i + 1, target factors `usize::MAX`; a joint correction θ_t
+/// acts where its joint acts.
+#[derive(Clone, Debug)]
+pub struct ChainOrder {
+    /// Per parameter.
+    pub param: Vec<usize>,
+    /// Per joint.
+    pub joint: Vec<usize>,
 }
 
-impl MixedWorkspace {
-    /// Buffers sized for `model`, with every parameter's and joint's chain position.
+impl ChainOrder {
+    /// The chain positions of `model`'s parameters and joints.
     pub fn new(model: &Model) -> Self {
-        let mut param_order = vec![0; model.param_count()];
-        let mut joint_order = vec![0; model.dof()];
+        let mut param = vec![0; model.param_count()];
+        let mut joint = vec![0; model.dof()];
         let mut mark = |step: &Step, order: usize| {
-            let (params, joint) = match step {
+            let (params, j) = match step {
                 Step::Elementary { param, joint, .. } => (*param..*param + 1, *joint),
                 Step::Screw { first, joint, .. } => (*first..*first + 7, *joint),
             };
             for p in params {
-                param_order[p] = order;
+                param[p] = order;
             }
-            if let Some(j) = joint {
-                joint_order[j] = order;
+            if let Some(j) = j {
+                joint[j] = order;
             }
         };
         for step in &model.instrument_steps {
@@ -175,13 +172,46 @@ impl MixedWorkspace {
             mark(step, usize::MAX);
         }
         // θ_t turns joint i: it acts where joint i acts, with no rate of its own
-        for (param, joint) in model.joint_corrections() {
-            param_order[param] = joint_order[joint];
+        for (p, j) in model.joint_corrections() {
+            param[p] = joint[j];
         }
+        ChainOrder { param, joint }
+    }
+}
+
+/// Per joint, in the instrument frame: `R_Iᵀ ω_k` into `joint_w` and the velocity of the
+/// point `p` (world), `R_Iᵀ ṗ = R_Iᵀ (ω_k × p + v_k)`, into `joint_p_dot`.
+pub(crate) fn joint_motions(
+    data: &Data<f64>,
+    p: &Vector3<f64>,
+    joint_w: &mut [Vector3<f64>],
+    joint_p_dot: &mut [Vector3<f64>],
+) {
+    let rt: Matrix3<f64> = data.instrument.rot.transpose();
+    for ((jk, w), p_dot) in data.joint_twists.iter().zip(joint_w).zip(joint_p_dot) {
+        *w = rt * jk.w;
+        *p_dot = rt * jk.point_velocity(p);
+    }
+}
+
+/// Workspace for [`identification_jacobian_dq`]: kinematics buffers and, for every
+/// parameter and joint, the position of its factor along the chain (what can move what).
+pub struct MixedWorkspace {
+    data: Data<f64>,
+    order: ChainOrder,
+    /// Per joint, in the instrument frame: `R_Iᵀ ω_k` and the point's velocity `R_Iᵀ ṗ`.
+    joint_w: Vec<Vector3<f64>>,
+    joint_p_dot: Vec<Vector3<f64>>,
+    /// With joint corrections: per joint, its derivative matrix w.r.t. the corrected joint.
+    deflected: Vec<DMatrix<f64>>,
+}
+
+impl MixedWorkspace {
+    /// Buffers sized for `model`, with every parameter's and joint's chain position.
+    pub fn new(model: &Model) -> Self {
         MixedWorkspace {
             data: Data::new(model),
-            param_order,
-            joint_order,
+            order: ChainOrder::new(model),
             joint_w: vec![Vector3::zeros(); model.dof()],
             joint_p_dot: vec![Vector3::zeros(); model.dof()],
             deflected: Vec::new(),
@@ -229,18 +259,15 @@ pub fn identification_jacobian_dq(
     let data = &ws.data;
     let p = observed_world(data, obs).trans;
     let rt: Matrix3<f64> = data.instrument.rot.transpose();
-    for (k, jk) in data.joint_twists.iter().enumerate() {
-        ws.joint_w[k] = rt * jk.w;
-        ws.joint_p_dot[k] = rt * jk.point_velocity(&p);
-    }
+    joint_motions(data, &p, &mut ws.joint_w, &mut ws.joint_p_dot);
     for (c, &j) in columns.iter().enumerate() {
         let s = influence(model.registry.get(j).segment, obs);
-        let order_j = ws.param_order[j];
+        let order_j = ws.order.param[j];
         let w_j = rt * data.param_twists[j].w * s;
         let col = Vector3::new(value[(0, c)], value[(1, c)], value[(2, c)]);
         for (k, out) in dq.iter_mut().enumerate().take(model.dof()) {
             let (w_k, p_dot) = (&ws.joint_w[k], &ws.joint_p_dot[k]);
-            let order_k = ws.joint_order[k];
+            let order_k = ws.order.joint[k];
             let (d_pos, d_rot) = if s == 0.0 {
                 (Vector3::zeros(), Vector3::zeros())
             } else if order_j > order_k {

@@ -11,6 +11,7 @@ pub mod fixed_kinematics;
 pub mod frames;
 pub mod identifiability;
 pub mod jacobian;
+pub mod jacobian_dq_along;
 pub mod joint_correction;
 pub mod kinematics;
 pub mod link;
@@ -26,8 +27,9 @@ pub mod urdf;
 pub use chain::{LimitTolerance, Link, LinkSpec, Model, ModelSpec, MEASURED_LIMIT_TOLERANCE};
 pub use jacobian::{
     identification_jacobian, identification_jacobian_dq, joint_jacobian, observed_pose,
-    observed_position, MixedWorkspace, Observed, Rows,
+    observed_position, ChainOrder, MixedWorkspace, Observed, Rows,
 };
+pub use jacobian_dq_along::{identification_jacobian_dq_along, AlongWorkspace};
 pub use kinematics::{forward_kinematics, tool_pose, Data};
 pub use link::{Convention, Joint, JointKind, LinkGeometry, Motion};
 pub use pose::{Pose, Twist};

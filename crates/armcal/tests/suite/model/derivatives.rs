@@ -202,10 +202,14 @@ fn mixed_derivative_matches_finite_differences_of_jacobian() {
 
 /// The analytic mixed derivative against forward-mode dual numbers pushed through the
 /// generic kinematics and identification Jacobian (exact to rounding, unlike finite
-/// differences), for every observed frame, both row kinds and a column subset.
+/// differences), for every observed frame, both row kinds and a column subset: the matrices
+/// ∂J/∂q_k, and the weighted sums `∂/∂q_k ⟨Ω, J⟩` of [`identification_jacobian_dq_along`]
+/// for a random Ω read at a row offset (Ω's other rows must not count; the sums are added
+/// to what `out` holds).
 #[test]
 fn mixed_derivative_matches_dual_numbers() {
     use num_dual::Dual64;
+    use rand::Rng;
     for seed in 0..3 {
         for model in derivative_models(seed) {
             let mut r = rng(500 + seed);
@@ -214,6 +218,9 @@ fn mixed_derivative_matches_dual_numbers() {
             let columns: Vec<usize> = (0..n).filter(|c| c % 3 != 1).collect();
             let q = random_q(&model, &mut r);
             let mut ws = MixedWorkspace::new(&model);
+            let mut along_ws = AlongWorkspace::new(&model);
+            let mut data = Data::new(&model);
+            forward_kinematics(&model, &mut data, &params, &q);
             let mut dual_data = Data::<Dual64>::new(&model);
             for obs in [Observed::Target(0), Observed::Target(1), Observed::Tool] {
                 for rows in [Rows::Position, Rows::Pose] {
@@ -222,6 +229,20 @@ fn mixed_derivative_matches_dual_numbers() {
                     let mut dq = vec![DMatrix::zeros(m, columns.len()); model.dof()];
                     identification_jacobian_dq(
                         &model, &mut ws, &params, &q, obs, rows, &columns, &mut value, &mut dq,
+                    );
+                    let weight =
+                        DMatrix::from_fn(m + 3, columns.len(), |_, _| r.random_range(-1.0..1.0));
+                    let mut along = vec![0.5; model.dof()];
+                    identification_jacobian_dq_along(
+                        &model,
+                        &mut along_ws,
+                        &data,
+                        obs,
+                        rows,
+                        &columns,
+                        &weight,
+                        2,
+                        &mut along,
                     );
                     for (k, dqk) in dq.iter().enumerate() {
                         let qd: Vec<Dual64> = q
@@ -246,6 +267,17 @@ fn mixed_derivative_matches_dual_numbers() {
                                 assert!((v - b.re).abs() <= 1e-12 * scale.max(v.abs()));
                             }
                         }
+                        let (mut expected, mut size) = (0.5, 1.0f64);
+                        for (idx, x) in jac.iter().enumerate() {
+                            let term = weight[(2 + idx % m, idx / m)] * x.eps;
+                            expected += term;
+                            size = size.max(term.abs());
+                        }
+                        assert!(
+                            (along[k] - expected).abs() <= 1e-10 * size,
+                            "seed {seed} {obs:?} {rows:?} joint {k}: weighted sum {}, dual {expected}",
+                            along[k]
+                        );
                     }
                 }
             }
