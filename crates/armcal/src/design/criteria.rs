@@ -156,7 +156,22 @@ pub fn evaluate(
         return Err(singular());
     }
     match criterion {
-        Criterion::A | Criterion::D | Criterion::Kpi | Criterion::KpiMax => {
+        Criterion::Kpi => {
+            // F = C Hᵀ = R⁻¹ (R⁻ᵀ Hᵀ) by two triangular solves with one right-hand side per
+            // KPI row (3 per working configuration), without forming C; φ = tr(H C Hᵀ) =
+            // ‖R⁻ᵀ Hᵀ‖²_F.
+            let h = kpi_matrix(d)?;
+            let y = r
+                .tr_solve_upper_triangular(&h.transpose())
+                .ok_or_else(singular)?;
+            let f = r.solve_upper_triangular(&y).ok_or_else(singular)?;
+            Ok(CriterionValue {
+                value: y.norm_squared(),
+                gradient: -(&f * f.transpose()),
+                factor: (f.ncols() < n).then_some(f),
+            })
+        }
+        Criterion::A | Criterion::D | Criterion::KpiMax => {
             // C = R⁻¹ R⁻ᵀ.
             let rinv = r
                 .clone()
@@ -177,16 +192,7 @@ pub fn evaluate(
                         factor: None,
                     }
                 }
-                Criterion::KpiMax => kpi_max(&c, d)?,
-                _ => {
-                    let h = kpi_matrix(d)?;
-                    let ch = &c * h.transpose();
-                    CriterionValue {
-                        value: (&h * &ch).trace(),
-                        gradient: -(&ch * ch.transpose()),
-                        factor: (ch.ncols() < n).then_some(ch),
-                    }
-                }
+                _ => kpi_max(&c, d)?,
             })
         }
         _ => {

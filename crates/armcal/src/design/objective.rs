@@ -188,24 +188,20 @@ impl<'a> DesignObjective<'a> {
 }
 
 /// `G = (A F) Fᵀ` (rows × n, column-major) for `A` (rows × n) and `F` (n × cols), through
-/// `T = A F` (rows × cols): O(rows · n · cols).
+/// `T = A F` (rows × cols): O(rows · n · cols), along contiguous columns.
 fn through_factor(a: &DMatrix<f64>, f: &DMatrix<f64>, t: &mut [f64], g: &mut [f64]) {
-    let (rows, n) = a.shape();
-    let cols = f.ncols();
+    let rows = a.nrows();
     let (a, f) = (a.as_slice(), f.as_slice());
-    for c in 0..cols {
-        let fc = &f[c * n..(c + 1) * n];
-        for r in 0..rows {
-            t[c * rows + r] = fc
-                .iter()
-                .enumerate()
-                .map(|(p, x)| a[p * rows + r] * x)
-                .sum();
+    t.fill(0.0);
+    for (tc, fc) in t.chunks_exact_mut(rows).zip(f.chunks_exact(a.len() / rows)) {
+        for (ap, x) in a.chunks_exact(rows).zip(fc) {
+            tc.iter_mut().zip(ap).for_each(|(t, a)| *t += a * x);
         }
     }
-    for p in 0..n {
-        for r in 0..rows {
-            g[p * rows + r] = (0..cols).map(|c| t[c * rows + r] * f[c * n + p]).sum();
+    g.fill(0.0);
+    for (tc, fc) in t.chunks_exact(rows).zip(f.chunks_exact(a.len() / rows)) {
+        for (gp, y) in g.chunks_exact_mut(rows).zip(fc) {
+            gp.iter_mut().zip(tc).for_each(|(g, t)| *g += t * y);
         }
     }
 }

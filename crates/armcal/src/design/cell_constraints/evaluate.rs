@@ -97,12 +97,25 @@ impl ConstraintSet {
     }
 
     /// Forward kinematics (frames, targets and joint twists: all the constraints read) and
-    /// the world endpoints of every robot capsule at `q`.
+    /// the world endpoints of every robot capsule at `q`; nothing when `ws` already holds
+    /// them for exactly (bitwise) these `params` and `q` (a projection evaluates the values,
+    /// then the Jacobian rows of the violated constraints, at one configuration).
     fn place(&self, ws: &mut ConstraintWorkspace, params: &[f64], q: &[f64]) {
+        let same = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+        let placed = &ws.placed;
+        if placed.len() == params.len() + q.len()
+            && same(&placed[params.len()..], q)
+            && same(&placed[..params.len()], params)
+        {
+            return;
+        }
         fixed_forward_kinematics(&self.model, &mut ws.fixed, &mut ws.data, params, q);
         for (c, ends) in self.capsules.iter().zip(ws.ends.iter_mut()) {
             *ends = c.place(&ws.data);
         }
+        ws.placed.clear();
+        ws.placed.extend_from_slice(params);
+        ws.placed.extend_from_slice(q);
     }
 
     /// Value (and gradient) of constraint `row` at the configuration [`Self::place`]d in `ws`.
@@ -327,6 +340,7 @@ impl ConstraintWorkspace {
             data: Data::new(&set.model),
             fixed: FixedKinematics::new(&set.model),
             ends: vec![[Vector3::zeros(); 2]; set.capsules.len()],
+            placed: Vec::new(),
             values: vec![0.0; set.len()],
         }
     }

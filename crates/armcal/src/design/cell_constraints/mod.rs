@@ -293,7 +293,8 @@ pub struct ConstraintSet {
     joint_tolerance: f64,
 }
 
-/// Reusable buffers for [`ConstraintSet::evaluate`].
+/// Reusable buffers for [`ConstraintSet::evaluate`], of the set that made them
+/// ([`ConstraintSet::workspace`]): they remember the configuration last placed.
 #[derive(Clone, Debug)]
 pub struct ConstraintWorkspace {
     data: Data<f64>,
@@ -301,6 +302,8 @@ pub struct ConstraintWorkspace {
     fixed: FixedKinematics,
     /// World endpoints of every robot capsule.
     ends: Vec<[Vector3<f64>; 2]>,
+    /// The parameters, then the configuration, that `data` and `ends` hold (empty: none).
+    placed: Vec<f64>,
     /// Constraint values of the last [`ConstraintSet::feasible`] / `min_margin_at` call.
     pub values: Vec<f64>,
 }

@@ -160,7 +160,7 @@ impl<'a, 'b> Descent<'a, 'b> {
         let start = self.objective.value_and_gradient(ws, u, None)?;
         let scale = 1.0 / start.abs().max(1e-300);
         self.evaluations += 1;
-        let mut f = scaled(self.objective, ws, u, &mut self.g, scale);
+        let mut f = scaled(self.objective, ws, u, Some(&mut self.g), scale);
         let window = settings.check_every.max(1);
         let mut iterations = 0;
         let mut values = vec![f];
@@ -273,9 +273,17 @@ impl<'a, 'b> Descent<'a, 'b> {
                 .sum();
             if decrease > 0.0 {
                 self.evaluations += 1;
-                let ft = scaled(self.objective, ws, &self.trial, &mut self.g_trial, scale);
+                // The value first; the gradient (from the same kinematics) only for the point
+                // accepted.
+                let ft = scaled(self.objective, ws, &self.trial, None, scale);
                 if ft <= f - ARMIJO * decrease && ft < f {
-                    return Some(ft);
+                    return Some(scaled(
+                        self.objective,
+                        ws,
+                        &self.trial,
+                        Some(&mut self.g_trial),
+                        scale,
+                    ));
                 }
             }
             alpha *= 0.5;
@@ -284,17 +292,18 @@ impl<'a, 'b> Descent<'a, 'b> {
     }
 }
 
-/// φ and its gradient at `x` into `g`, both times `scale`; a singular design is +∞.
+/// φ at `x` and, if asked, its gradient into `g`, both times `scale`; a singular design is
+/// +∞.
 fn scaled(
     objective: &DesignObjective,
     ws: &mut ObjectiveWorkspace,
     x: &[f64],
-    g: &mut [f64],
+    mut g: Option<&mut [f64]>,
     scale: f64,
 ) -> f64 {
-    match objective.value_and_gradient(ws, x, Some(g)) {
+    match objective.value_and_gradient(ws, x, g.as_deref_mut()) {
         Ok(v) => {
-            for gi in g.iter_mut() {
+            for gi in g.into_iter().flatten() {
                 *gi *= scale;
             }
             v * scale

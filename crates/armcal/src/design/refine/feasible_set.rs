@@ -72,9 +72,13 @@ struct ProjectionBuffers {
     /// The candidate normal being added to a basis.
     candidate: Vec<f64>,
     /// Per configuration: the constraint values and Jacobian at the iterate
-    /// ([`FeasibleSet::active_normals`]).
+    /// ([`FeasibleSet::active_normals`]), and the configuration they were evaluated at
+    /// (`evaluated`, if `has_evaluated`): a projection's full evaluation at the point the
+    /// descent then accepts is not repeated.
     active_values: Vec<f64>,
     active_jacobian: Vec<f64>,
+    evaluated: Vec<f64>,
+    has_evaluated: Vec<bool>,
 }
 
 impl<'a> FeasibleSet<'a> {
@@ -114,6 +118,8 @@ impl<'a> FeasibleSet<'a> {
                 candidate: vec![0.0; k],
                 active_values: vec![0.0; m * nconf],
                 active_jacobian: vec![0.0; m * k * nconf],
+                evaluated: vec![0.0; nu],
+                has_evaluated: vec![false; nconf],
             }),
         }
     }
@@ -250,7 +256,14 @@ impl ProjectionBuffers {
         }
         self.violated.clear();
         if moved > REANCHOR_DISTANCE || 3 * self.near.len() > m {
-            cons.evaluate(q, &mut self.values, None);
+            // Values and Jacobian in one kinematics pass, kept for the working set
+            // (`active_normals`) should the descent accept this configuration.
+            cons.evaluate(q, &mut self.values, Some(&mut self.jacobian));
+            self.active_values[index * m..(index + 1) * m].copy_from_slice(&self.values);
+            self.active_jacobian[index * m * k..(index + 1) * m * k]
+                .copy_from_slice(&self.jacobian);
+            self.evaluated[index * k..(index + 1) * k].copy_from_slice(q);
+            self.has_evaluated[index] = true;
             self.anchors[index * k..(index + 1) * k].copy_from_slice(q);
             self.anchor_values[index * m..(index + 1) * m].copy_from_slice(&self.values);
             self.anchored[index] = true;
@@ -261,12 +274,6 @@ impl ProjectionBuffers {
                 self.has_safe[index] = true;
                 return false;
             }
-            cons.evaluate_rows(
-                q,
-                &self.violated,
-                &mut self.values,
-                Some(&mut self.jacobian),
-            );
         } else {
             // One forward kinematics for the values and gradients of the near ones.
             cons.evaluate_rows(q, &self.near, &mut self.values, Some(&mut self.jacobian));
@@ -362,8 +369,17 @@ impl FeasibleSet<'_> {
         for (index, (q, vq)) in u.chunks(k).zip(v.chunks(k)).enumerate() {
             let values = &mut b.active_values[index * m..(index + 1) * m];
             let jacobian = &mut b.active_jacobian[index * m * k..(index + 1) * m * k];
+            let evaluated = &mut b.evaluated[index * k..(index + 1) * k];
             if let (Some(cons), false) = (self.constraints, extend) {
-                cons.evaluate(q, values, Some(jacobian));
+                let same = evaluated
+                    .iter()
+                    .zip(q)
+                    .all(|(a, x)| a.to_bits() == x.to_bits());
+                if !(b.has_evaluated[index] && same) {
+                    cons.evaluate(q, values, Some(jacobian));
+                    evaluated.copy_from_slice(q);
+                    b.has_evaluated[index] = true;
+                }
             }
             let (lower, upper) = self.bounds(index);
             let basis = &mut b.basis[index * k * k..(index + 1) * k * k];
