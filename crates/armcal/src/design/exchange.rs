@@ -99,7 +99,7 @@ pub(crate) fn value_of(
         a.rows_mut(prior.nrows() + k * rows, rows)
             .copy_from(&jp.rows(i * rows, rows));
     }
-    Ok(evaluate(c, &information_factor(c, a), d)?.value)
+    Ok(evaluate(c, &information_factor(c, &a), d)?.value)
 }
 
 /// The fewest poses that can identify the `n` free parameters of `d`: each gives `d.rows()`

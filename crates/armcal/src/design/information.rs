@@ -154,12 +154,19 @@ impl AlongBuffers {
 impl DesignModel {
     /// Whitened Jacobian of one configuration into `ws.jac` (its kinematics in `ws.data`).
     pub fn jacobian(&self, ws: &mut InformationWorkspace, q: &[f64]) {
-        self.jacobian_into(&mut ws.data, q, &mut ws.jac);
+        self.jacobian_into(&mut ws.data, q, &mut ws.jac, 0);
     }
 
-    /// Whitened Jacobian `W^{1/2} J` of the configuration `q` into `jac` (rows × n), with its
-    /// kinematics into `data` (for [`DesignModel::jacobian_dq_along`]).
-    pub fn jacobian_into(&self, data: &mut Data<f64>, q: &[f64], jac: &mut DMatrix<f64>) {
+    /// Whitened Jacobian `W^{1/2} J` of the configuration `q` into rows `row..row + rows` of
+    /// `out` (n columns), with its kinematics into `data` (for
+    /// [`DesignModel::jacobian_dq_along`]).
+    pub fn jacobian_into(
+        &self,
+        data: &mut Data<f64>,
+        q: &[f64],
+        out: &mut DMatrix<f64>,
+        row: usize,
+    ) {
         forward_kinematics(&self.model, data, &self.params, q);
         for (k, &obs) in self.observed.iter().enumerate() {
             identification_jacobian(
@@ -168,11 +175,11 @@ impl DesignModel {
                 obs,
                 Rows::Position,
                 &self.free,
-                jac,
-                3 * k,
+                out,
+                row + 3 * k,
             );
         }
-        self.whiten(jac);
+        self.whiten(out, row);
     }
 
     /// `∂/∂q_k ⟨Ω, W^{1/2}J⟩` for every joint k into `out`, at the configuration whose
@@ -186,7 +193,7 @@ impl DesignModel {
         out: &mut [f64],
     ) {
         buffers.weight.copy_from(omega);
-        self.whiten(&mut buffers.weight);
+        self.whiten(&mut buffers.weight, 0);
         out.fill(0.0);
         for (k, &obs) in self.observed.iter().enumerate() {
             identification_jacobian_dq_along(
@@ -203,13 +210,13 @@ impl DesignModel {
         }
     }
 
-    /// Divides each row by its axis's σ (rows x, y, z of one target after another), by
-    /// multiplying with 1/σ down each column (the matrix is column-major).
-    fn whiten(&self, m: &mut DMatrix<f64>) {
-        let rows = m.nrows();
+    /// Divides rows `row..row + rows` (x, y, z of one target after another) by their
+    /// axis's σ, multiplying with 1/σ down each column (the matrix is column-major).
+    fn whiten(&self, m: &mut DMatrix<f64>, row: usize) {
+        let (height, rows) = (m.nrows(), self.rows());
         let inverse = self.sigma.map(|s| 1.0 / s);
-        for column in m.as_mut_slice().chunks_mut(rows) {
-            for axes in column.chunks_exact_mut(3) {
+        for column in m.as_mut_slice().chunks_mut(height) {
+            for axes in column[row..row + rows].chunks_exact_mut(3) {
                 for (x, s) in axes.iter_mut().zip(&inverse) {
                     *x *= s;
                 }

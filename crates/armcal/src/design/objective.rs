@@ -45,13 +45,14 @@ pub struct DesignObjective<'a> {
 /// objective `owner` at exactly (bitwise) that `q`.
 pub struct ObjectiveWorkspace {
     kinematics: Vec<Data<f64>>,
-    jacs: Vec<DMatrix<f64>>,
+    /// The prior factor's rows, then every configuration's `W^{1/2}J_i`.
+    stacked: DMatrix<f64>,
     along: AlongBuffers,
     /// `W^{1/2}J_i Φ` of one configuration (or `−(W^{1/2}J_i F) Fᵀ`).
     j_phi: DMatrix<f64>,
     owner: u64,
     cached_q: Vec<f64>,
-    /// Whether `cached_q`, `value`, `phi`, `kinematics` and `jacs` belong together.
+    /// Whether `cached_q`, `value`, `phi`, `kinematics` and `stacked` belong together.
     cached: bool,
     /// φ, `Φ` and `F` (`Φ = −F Fᵀ`, when the criterion gives it) at `cached_q`.
     value: f64,
@@ -96,7 +97,7 @@ impl<'a> DesignObjective<'a> {
         let d = self.design;
         ObjectiveWorkspace {
             kinematics: (0..n_configs).map(|_| Data::new(&d.model)).collect(),
-            jacs: vec![DMatrix::zeros(d.rows(), d.n()); n_configs],
+            stacked: DMatrix::zeros(0, d.n()),
             along: AlongBuffers::new(d),
             j_phi: DMatrix::zeros(d.rows(), d.n()),
             owner: self.id,
@@ -129,28 +130,28 @@ impl<'a> DesignObjective<'a> {
                 .zip(q)
                 .all(|(a, b)| a.to_bits() == b.to_bits());
         if !hit {
+            let other_prior = ws.owner != self.id;
             ws.owner = self.id;
             ws.cached = false;
             ws.cached_q.clear();
             ws.cached_q.extend_from_slice(q);
             let d = self.design;
-            while ws.jacs.len() < nconf {
+            while ws.kinematics.len() < nconf {
                 ws.kinematics.push(Data::new(&d.model));
-                ws.jacs.push(DMatrix::zeros(d.rows(), d.n()));
             }
             let rows = d.rows();
             let np = self.prior_factor.nrows();
-            let mut stacked = DMatrix::zeros(np + rows * nconf, d.n());
-            stacked.rows_mut(0, np).copy_from(&self.prior_factor);
-            for i in 0..nconf {
-                d.jacobian_into(
-                    &mut ws.kinematics[i],
-                    &q[i * k..(i + 1) * k],
-                    &mut ws.jacs[i],
-                );
-                stacked.rows_mut(np + rows * i, rows).copy_from(&ws.jacs[i]);
+            if ws.stacked.nrows() != np + rows * nconf {
+                ws.stacked = DMatrix::zeros(np + rows * nconf, d.n());
+                ws.stacked.rows_mut(0, np).copy_from(&self.prior_factor);
+            } else if other_prior {
+                ws.stacked.rows_mut(0, np).copy_from(&self.prior_factor);
             }
-            let r = information_factor(self.criterion, stacked);
+            for i in 0..nconf {
+                let qi = &q[i * k..(i + 1) * k];
+                d.jacobian_into(&mut ws.kinematics[i], qi, &mut ws.stacked, np + rows * i);
+            }
+            let r = information_factor(self.criterion, &ws.stacked);
             let cv = evaluate(self.criterion, &r, d)?;
             ws.value = cv.value;
             ws.phi.copy_from(&cv.gradient);
@@ -160,16 +161,20 @@ impl<'a> DesignObjective<'a> {
         let Some(g) = gradient else {
             return Ok(ws.value);
         };
+        let rows = self.design.rows();
+        let np = self.prior_factor.nrows();
         for (i, gi) in g.chunks_mut(k).take(nconf).enumerate() {
             // ∂φ/∂q_ij = 2 ⟨J_i Φ, ∂J_i/∂q_j⟩; with Φ = −F Fᵀ, J_i Φ = −(J_i F) Fᵀ.
+            let row = np + rows * i;
             let sign = match &ws.factor {
                 Some(f) => {
-                    ws.jf.resize(self.design.rows() * f.ncols(), 0.0);
-                    through_factor(&ws.jacs[i], f, &mut ws.jf, ws.j_phi.as_mut_slice());
+                    ws.jf.resize(rows * f.ncols(), 0.0);
+                    through_factor(&ws.stacked, row, rows, f, &mut ws.jf, &mut ws.j_phi);
                     -2.0
                 }
                 None => {
-                    ws.j_phi.gemm(1.0, &ws.jacs[i], &ws.phi, 0.0);
+                    ws.j_phi
+                        .gemm(1.0, &ws.stacked.rows(row, rows), &ws.phi, 0.0);
                     2.0
                 }
             };
@@ -187,20 +192,31 @@ impl<'a> DesignObjective<'a> {
     }
 }
 
-/// `G = (A F) Fᵀ` (rows × n, column-major) for `A` (rows × n) and `F` (n × cols), through
-/// `T = A F` (rows × cols): O(rows · n · cols), along contiguous columns.
-fn through_factor(a: &DMatrix<f64>, f: &DMatrix<f64>, t: &mut [f64], g: &mut [f64]) {
-    let rows = a.nrows();
-    let (a, f) = (a.as_slice(), f.as_slice());
+/// `G = (A F) Fᵀ` (rows × n) for `A` the rows `row..row + rows` of `stacked` (n columns)
+/// and `F` (n × cols), through `T = A F` (rows × cols, column-major in `t`):
+/// O(rows · n · cols), along contiguous columns.
+fn through_factor(
+    stacked: &DMatrix<f64>,
+    row: usize,
+    rows: usize,
+    f: &DMatrix<f64>,
+    t: &mut [f64],
+    g: &mut DMatrix<f64>,
+) {
+    let height = stacked.nrows();
+    let a = stacked.as_slice();
+    let n = stacked.ncols();
     t.fill(0.0);
-    for (tc, fc) in t.chunks_exact_mut(rows).zip(f.chunks_exact(a.len() / rows)) {
-        for (ap, x) in a.chunks_exact(rows).zip(fc) {
-            tc.iter_mut().zip(ap).for_each(|(t, a)| *t += a * x);
+    for (tc, fc) in t.chunks_exact_mut(rows).zip(f.as_slice().chunks_exact(n)) {
+        for (ap, x) in a.chunks_exact(height).zip(fc) {
+            tc.iter_mut()
+                .zip(&ap[row..row + rows])
+                .for_each(|(t, a)| *t += a * x);
         }
     }
     g.fill(0.0);
-    for (tc, fc) in t.chunks_exact(rows).zip(f.chunks_exact(a.len() / rows)) {
-        for (gp, y) in g.chunks_exact_mut(rows).zip(fc) {
+    for (tc, fc) in t.chunks_exact(rows).zip(f.as_slice().chunks_exact(n)) {
+        for (gp, y) in g.as_mut_slice().chunks_exact_mut(rows).zip(fc) {
             gp.iter_mut().zip(tc).for_each(|(g, t)| *g += t * y);
         }
     }
@@ -213,7 +229,7 @@ fn through_factor(a: &DMatrix<f64>, f: &DMatrix<f64>, t: &mut [f64], g: &mut [f6
 /// In the refinement's loop Cholesky costs about a third of Householder QR (one product
 /// `AᵀA` by blocks, then n³/3); its relative error in C, about cond(M)·ε, stays below 1e-8
 /// for every design the planner accepts (column-normalised singular-value ratio ≥ 1e-4).
-pub(crate) fn information_factor(c: Criterion, a: DMatrix<f64>) -> DMatrix<f64> {
+pub(crate) fn information_factor(c: Criterion, a: &DMatrix<f64>) -> DMatrix<f64> {
     if matches!(
         c,
         Criterion::A | Criterion::D | Criterion::Kpi | Criterion::KpiMax
@@ -221,11 +237,11 @@ pub(crate) fn information_factor(c: Criterion, a: DMatrix<f64>) -> DMatrix<f64> 
     {
         // `Aᵀ · A` through the general product (blocked, vectorised), not `tr_mul`'s column
         // dot products.
-        if let Some(ch) = (a.transpose() * &a).cholesky() {
+        if let Some(ch) = (a.transpose() * a).cholesky() {
             return ch.l().transpose();
         }
     }
-    triangular_factor(a)
+    triangular_factor(a.clone())
 }
 
 /// `R` (n × n, upper triangular) with `RᵀR = AᵀA`, by Householder QR of `A` (rows ≥ n);

@@ -66,6 +66,10 @@ pub struct RefineSettings {
     /// Iterations over which the improvement is measured.
     pub check_every: usize,
     /// Stop when the last `check_every` iterations lowered φ by less than this fraction.
+    /// The default, 10⁻⁴ (0.01 %), is far below what distinguishes two designs in
+    /// practice (a Monte-Carlo check of the predicted TCP variance resolves about 1 %), and
+    /// the descent's tail beyond it is long: on the paper cell (60 KPI poses, seeds 1–6)
+    /// 10⁻⁵ runs 300–400 iterations instead of 240–310 to end 0.003–0.05 % lower.
     pub min_relative_improvement: f64,
     /// Wall-clock limit of the whole refinement.
     pub max_duration: Duration,
@@ -79,7 +83,7 @@ impl Default for RefineSettings {
             tolerance: 1e-6,
             max_iterations: 400,
             check_every: 20,
-            min_relative_improvement: 1e-5,
+            min_relative_improvement: 1e-4,
             max_duration: Duration::from_secs(30),
             lbfgs_memory: 10,
         }

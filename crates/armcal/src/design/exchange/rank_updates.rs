@@ -2,7 +2,6 @@
 //! kept up to date by rank updates as points are removed and added (see [`SweepState`]).
 
 use crate::design::small_cholesky;
-use crate::linalg::dot;
 use nalgebra::DMatrix;
 
 /// Smallest squared pivot of the Cholesky factor of `K = I − J_s C J_sᵀ` (of the order of
@@ -22,23 +21,23 @@ const ESSENTIAL_PIVOT: f64 = 1e-8;
 /// O(pool rows · rows · n) per slot, where a new `J_pool C₋` costs O(pool rows · n²). Adding
 /// x: `C' = C₋ − C₋ J_xᵀ S⁻¹ J_x C₋`, `S = I + J_x C₋ J_xᵀ`.
 ///
-/// Everything is stored transposed (one pool row per column), so that every product walks
-/// contiguous memory.
-pub(super) struct SweepState {
+/// Every pool-sized buffer has one row per pool row (column-major), so that the products
+/// of a slot, W and the rank updates of U and V, run along whole columns of pool rows
+/// (vectorised updates `y += a x`, no dot-product reductions).
+pub(super) struct SweepState<'a> {
     rows: usize,
-    n: usize,
-    /// `Jᵀ` of the pool (n × pool rows).
-    jt: DMatrix<f64>,
-    /// `Uᵀ` (n × pool rows), `Vᵀ` (columns of L × pool rows).
-    ut: DMatrix<f64>,
-    vt: DMatrix<f64>,
+    /// `J` of the pool (pool rows × n).
+    j: &'a DMatrix<f64>,
+    /// `U` (pool rows × n), `V` (pool rows × columns of L).
+    u: DMatrix<f64>,
+    v: DMatrix<f64>,
     /// `Q_x`, rows × rows row-major per pool point.
     q: Vec<f64>,
     /// Of the rank update in progress, point p with `inv` = `K⁻¹` (a removal) or `S⁻¹` (an
-    /// addition): `Wᵀ = J_p Uᵀ` (rows × pool rows), `inv · Wᵀ`, `inv` (row-major),
+    /// addition): `W = U J_pᵀ` (pool rows × rows), `W · inv`, `inv` (row-major),
     /// `U_pᵀ inv` (n × rows), `V_pᵀ inv` (columns of L × rows).
-    wt: DMatrix<f64>,
-    wkt: DMatrix<f64>,
+    w: DMatrix<f64>,
+    wk: DMatrix<f64>,
     inv: Vec<f64>,
     us_k: DMatrix<f64>,
     vs_k: DMatrix<f64>,
@@ -47,30 +46,23 @@ pub(super) struct SweepState {
     v_col: Vec<f64>,
 }
 
-impl SweepState {
-    pub(super) fn new(jp: &DMatrix<f64>, rows: usize, l_rows: usize) -> Self {
+impl<'a> SweepState<'a> {
+    pub(super) fn new(jp: &'a DMatrix<f64>, rows: usize, l_rows: usize) -> Self {
         let (pool_rows, n) = jp.shape();
         SweepState {
             rows,
-            n,
-            jt: jp.transpose(),
-            ut: DMatrix::zeros(n, pool_rows),
-            vt: DMatrix::zeros(l_rows, pool_rows),
+            j: jp,
+            u: DMatrix::zeros(pool_rows, n),
+            v: DMatrix::zeros(pool_rows, l_rows),
             q: vec![0.0; pool_rows * rows],
-            wt: DMatrix::zeros(rows, pool_rows),
-            wkt: DMatrix::zeros(rows, pool_rows),
+            w: DMatrix::zeros(pool_rows, rows),
+            wk: DMatrix::zeros(pool_rows, rows),
             inv: vec![0.0; rows * rows],
             us_k: DMatrix::zeros(n, rows),
             vs_k: DMatrix::zeros(l_rows, rows),
             s_buf: vec![0.0; rows * rows],
             v_col: vec![0.0; rows],
         }
-    }
-
-    /// Column `i` (pool row i) of a transposed buffer.
-    fn col(m: &DMatrix<f64>, i: usize) -> &[f64] {
-        let h = m.nrows();
-        &m.as_slice()[i * h..(i + 1) * h]
     }
 
     /// `C = M⁻¹` of the design `chosen` (prior included) and everything derived from it;
@@ -84,19 +76,19 @@ impl SweepState {
         let rows = self.rows;
         let mut m = prior.tr_mul(prior);
         for &i in chosen {
-            let ji = self.jt.columns(i * rows, rows);
-            m.gemm_tr(1.0, &ji.transpose(), &ji.transpose(), 1.0);
+            let ji = self.j.rows(i * rows, rows);
+            m.gemm_tr(1.0, &ji, &ji, 1.0);
         }
         let Some(ch) = m.cholesky() else {
             return false;
         };
         let c = ch.inverse();
-        self.ut.gemm(1.0, &c, &self.jt, 0.0);
+        self.u.gemm(1.0, self.j, &c, 0.0);
         if let Some(l) = l {
-            self.vt.gemm(1.0, l, &self.ut, 0.0);
+            self.v.gemm(1.0, &self.u, &l.transpose(), 0.0);
         }
         self.q.fill(0.0);
-        add_block_dots(&mut self.q, rows, &self.ut, &self.jt, 1.0);
+        add_block_products(&mut self.q, rows, &self.u, self.j, 1.0);
         true
     }
 
@@ -124,36 +116,35 @@ impl SweepState {
         true
     }
 
-    /// `Wᵀ = J_p Uᵀ` of pool point `p`: `W_x[a][b] = U_{x,a} · J_{p,b}` for every pool row.
+    /// `W = U J_pᵀ` of pool point `p`: column b is `Σ_c U[:, c] J[p·rows + b, c]`.
     fn products_with(&mut self, p: usize) {
         let rows = self.rows;
-        for i in 0..self.jt.ncols() {
-            for b in 0..rows {
-                self.wt[(b, i)] = dot(Self::col(&self.ut, i), Self::col(&self.jt, p * rows + b));
+        let height = self.u.nrows();
+        self.w.fill(0.0);
+        for (c, uc) in self.u.as_slice().chunks_exact(height).enumerate() {
+            for (b, wb) in self.w.as_mut_slice().chunks_exact_mut(height).enumerate() {
+                axpy(self.j[(p * rows + b, c)], uc, wb);
             }
         }
     }
 
-    /// `inv · Wᵀ`, `U_pᵀ inv` and `V_pᵀ inv` of pool point `p` (`inv` symmetric).
+    /// `W · inv`, `U_pᵀ inv` and `V_pᵀ inv` of pool point `p` (`inv` symmetric).
     fn through_inverse(&mut self, p: usize) {
         let rows = self.rows;
-        for i in 0..self.wt.ncols() {
-            for a in 0..rows {
-                self.wkt[(a, i)] = (0..rows)
-                    .map(|b| self.inv[a * rows + b] * self.wt[(b, i)])
-                    .sum();
+        let height = self.w.nrows();
+        self.wk.fill(0.0);
+        for (b, wb) in self.w.as_slice().chunks_exact(height).enumerate() {
+            for (a, wka) in self.wk.as_mut_slice().chunks_exact_mut(height).enumerate() {
+                axpy(self.inv[b * rows + a], wb, wka);
             }
         }
-        for b in 0..rows {
-            for r in 0..self.n {
-                self.us_k[(r, b)] = (0..rows)
-                    .map(|a| self.ut[(r, p * rows + a)] * self.inv[a * rows + b])
-                    .sum();
-            }
-            for r in 0..self.vt.nrows() {
-                self.vs_k[(r, b)] = (0..rows)
-                    .map(|a| self.vt[(r, p * rows + a)] * self.inv[a * rows + b])
-                    .sum();
+        for (m, out) in [(&self.u, &mut self.us_k), (&self.v, &mut self.vs_k)] {
+            for b in 0..rows {
+                for r in 0..m.ncols() {
+                    out[(r, b)] = (0..rows)
+                        .map(|a| m[(p * rows + a, r)] * self.inv[a * rows + b])
+                        .sum();
+                }
             }
         }
     }
@@ -165,7 +156,9 @@ impl SweepState {
         let r0 = x * rows;
         for a in 0..rows {
             for b in 0..=a {
-                let wkw = dot(Self::col(&self.wkt, r0 + a), Self::col(&self.wt, r0 + b));
+                let wkw: f64 = (0..rows)
+                    .map(|c| self.wk[(r0 + a, c)] * self.w[(r0 + b, c)])
+                    .sum();
                 let sab = self.q[r0 * rows + a * rows + b] + wkw + if a == b { 1.0 } else { 0.0 };
                 self.s_buf[a * rows + b] = sab;
                 self.s_buf[b * rows + a] = sab;
@@ -193,11 +186,12 @@ impl SweepState {
         }
         // Column c of V'_x = V_x + W_x (K⁻¹ V_s).
         let mut tr = 0.0;
-        for c in 0..self.vt.nrows() {
+        for c in 0..self.v.ncols() {
             for a in 0..rows {
-                let w = Self::col(&self.wt, r0 + a);
-                self.v_col[a] =
-                    self.vt[(c, r0 + a)] + (0..rows).map(|b| w[b] * self.vs_k[(c, b)]).sum::<f64>();
+                self.v_col[a] = self.v[(r0 + a, c)]
+                    + (0..rows)
+                        .map(|b| self.w[(r0 + a, b)] * self.vs_k[(c, b)])
+                        .sum::<f64>();
             }
             small_cholesky::forward(&self.s_buf, &mut self.v_col, rows);
             tr += self.v_col.iter().map(|v| v * v).sum::<f64>();
@@ -215,51 +209,57 @@ impl SweepState {
             return false;
         }
         small_cholesky::inverse(&self.s_buf, &mut self.inv, rows);
-        // Removal: U₋ᵀ = Uᵀ + (U_sᵀ K⁻¹) Wᵀ, V₋ᵀ likewise, Q₋_x = Q_x + (W_x K⁻¹) W_xᵀ.
-        add_rank_product(&mut self.ut, &self.us_k, &self.wt, 1.0);
-        add_rank_product(&mut self.vt, &self.vs_k, &self.wt, 1.0);
-        add_block_dots(&mut self.q, rows, &self.wkt, &self.wt, 1.0);
-        // Addition: Yᵀ = J_x U₋ᵀ (into wt); U'ᵀ = U₋ᵀ − (U₋_xᵀ S⁻¹) Yᵀ, V' likewise,
+        // Removal: U₋ = U + W (K⁻¹ U_s), V₋ likewise, Q₋_x = Q_x + (W_x K⁻¹) W_xᵀ.
+        add_rank_product(&mut self.u, &self.w, &self.us_k, 1.0);
+        add_rank_product(&mut self.v, &self.w, &self.vs_k, 1.0);
+        add_block_products(&mut self.q, rows, &self.wk, &self.w, 1.0);
+        // Addition: Y = U₋ J_xᵀ (into w); U' = U₋ − Y (S⁻¹ U₋_x), V' likewise,
         // Q'_x = Q₋_x − (Y_x S⁻¹) Y_xᵀ.
         self.products_with(x);
         self.through_inverse(x);
-        add_rank_product(&mut self.ut, &self.us_k, &self.wt, -1.0);
-        add_rank_product(&mut self.vt, &self.vs_k, &self.wt, -1.0);
-        add_block_dots(&mut self.q, rows, &self.wkt, &self.wt, -1.0);
+        add_rank_product(&mut self.u, &self.w, &self.us_k, -1.0);
+        add_rank_product(&mut self.v, &self.w, &self.vs_k, -1.0);
+        add_block_products(&mut self.q, rows, &self.wk, &self.w, -1.0);
         true
     }
 }
 
-/// `Q_x[a][b] += sign · a_{x,a} · b_{x,b}` for every pool point x, the columns `x·rows + a`
-/// of the transposed buffers `a` and `b` (rows × rows row-major blocks in `q`).
-fn add_block_dots(q: &mut [f64], rows: usize, a: &DMatrix<f64>, b: &DMatrix<f64>, sign: f64) {
-    for x in 0..a.ncols() / rows {
-        let r0 = x * rows;
-        for i in 0..rows {
-            for j in 0..rows {
-                q[r0 * rows + i * rows + j] +=
-                    sign * dot(SweepState::col(a, r0 + i), SweepState::col(b, r0 + j));
+/// `Q_x[a][b] += sign · Σ_c a[x·rows + a, c] · b[x·rows + b, c]` for every pool point x
+/// (rows × rows row-major blocks in `q`; `a` and `b` pool rows × the same columns).
+fn add_block_products(q: &mut [f64], rows: usize, a: &DMatrix<f64>, b: &DMatrix<f64>, sign: f64) {
+    for (ac, bc) in a.column_iter().zip(b.column_iter()) {
+        let (ac, bc) = (ac.as_slice(), bc.as_slice());
+        for ((qx, ax), bx) in q
+            .chunks_exact_mut(rows * rows)
+            .zip(ac.chunks_exact(rows))
+            .zip(bc.chunks_exact(rows))
+        {
+            for (qa, ai) in qx.chunks_exact_mut(rows).zip(ax) {
+                let f = sign * ai;
+                qa.iter_mut().zip(bx).for_each(|(y, x)| *y += f * x);
             }
         }
     }
 }
 
-/// `m += sign · a b`, the rank-r update of a transposed buffer: column i of `m` gains
-/// `sign · Σ_r a[:, r] b[r, i]` (`a`: height of m × r, `b`: r × columns of m).
-fn add_rank_product(m: &mut DMatrix<f64>, a: &DMatrix<f64>, b: &DMatrix<f64>, sign: f64) {
-    let h = m.nrows();
-    if h == 0 {
+/// `m += sign · w kᵀ`, the rank-r update of a pool-sized buffer: column c of `m` gains
+/// `sign · Σ_b w[:, b] k[c, b]` (`w`: pool rows × r, `k`: columns of m × r).
+fn add_rank_product(m: &mut DMatrix<f64>, w: &DMatrix<f64>, k: &DMatrix<f64>, sign: f64) {
+    let height = m.nrows();
+    if height == 0 {
         return;
     }
-    let (a, rank) = (a.as_slice(), b.nrows());
-    for (i, col) in m.as_mut_slice().chunks_mut(h).enumerate() {
-        for r in 0..rank {
-            let f = sign * b[(r, i)];
-            for (y, x) in col.iter_mut().zip(&a[r * h..(r + 1) * h]) {
-                *y += f * x;
-            }
+    for (c, mc) in m.as_mut_slice().chunks_exact_mut(height).enumerate() {
+        for (b, wb) in w.as_slice().chunks_exact(height).enumerate() {
+            axpy(sign * k[(c, b)], wb, mc);
         }
     }
+}
+
+/// `y += a x` over slices (the compiler vectorises it; nalgebra's `axpy` on a column view
+/// goes through strides and does not).
+fn axpy(a: f64, x: &[f64], y: &mut [f64]) {
+    y.iter_mut().zip(x).for_each(|(y, x)| *y += a * x);
 }
 
 #[cfg(test)]
@@ -340,17 +340,17 @@ mod tests {
             assert!(state.replace(x));
             chosen[slot] = x;
         }
-        let (u, v, q) = (state.ut.clone(), state.vt.clone(), state.q.clone());
+        let (u, v, q) = (state.u.clone(), state.v.clone(), state.q.clone());
         assert!(state.refresh(&prior, Some(&l), &chosen));
         assert!(
-            max_difference(&u, &state.ut) < 1e-9,
+            max_difference(&u, &state.u) < 1e-9,
             "U drifted: {}",
-            max_difference(&u, &state.ut)
+            max_difference(&u, &state.u)
         );
         assert!(
-            max_difference(&v, &state.vt) < 1e-9,
+            max_difference(&v, &state.v) < 1e-9,
             "V drifted: {}",
-            max_difference(&v, &state.vt)
+            max_difference(&v, &state.v)
         );
         let qmax = state.q.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         for (a, b) in q.iter().zip(&state.q) {
