@@ -1,5 +1,6 @@
 //! Kinematics benchmarks: FK + position identification Jacobian of the paper cell (6R,
-//! 27 free parameters), the joint Jacobian, and the mixed derivative ∂J/∂q.
+//! 27 free parameters), the mixed derivative ∂J/∂q, and its weighted sum ∂/∂q ⟨Ω, J⟩ (what
+//! a design gradient needs per pose).
 
 use armcal::cell::Cell;
 use armcal::model::*;
@@ -65,6 +66,32 @@ fn kinematics(c: &mut Criterion) {
                     &mut dq,
                 );
                 black_box(&dq);
+            })
+        },
+    );
+    let mut along_ws = AlongWorkspace::new(model);
+    let weight = DMatrix::from_fn(3, columns.len(), |r, c| {
+        ((r * 31 + c * 7) % 11) as f64 - 5.0
+    });
+    forward_kinematics(model, &mut data, &params, &q);
+    let mut along = [0.0; 6];
+    c.bench_function(
+        "weighted mixed derivative d<W, J>/dq (6 joints, 3 × 27 weights, from the FK)",
+        |b| {
+            b.iter(|| {
+                along.fill(0.0);
+                identification_jacobian_dq_along(
+                    model,
+                    &mut along_ws,
+                    &data,
+                    Observed::Target(0),
+                    Rows::Position,
+                    &columns,
+                    black_box(&weight),
+                    0,
+                    &mut along,
+                );
+                black_box(&along);
             })
         },
     );

@@ -16,6 +16,7 @@ use crate::design::information::{DesignModel, InformationWorkspace};
 use crate::design::objective::{triangular_factor, DesignObjective};
 use crate::Error;
 use nalgebra::DMatrix;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// The bound and what it says about a design.
@@ -80,13 +81,14 @@ fn sensitivity(
 }
 
 /// The bound for `design` (N configurations) under `objective`, maximising the sensitivity
-/// from the `starts` best points of `pool` (plus the design's own points).
-pub fn optimality_bound(
+/// from the `starts` best points of `pool` (plus the design's own points); the ascents run
+/// in parallel, each with a feasibility test made by `make_feasible`.
+pub fn optimality_bound<F: FnMut(&[f64]) -> bool>(
     objective: &DesignObjective,
     design: &[Vec<f64>],
     pool: &[Vec<f64>],
     starts: usize,
-    mut feasible: impl FnMut(&[f64]) -> bool,
+    make_feasible: impl Fn() -> F + Sync,
 ) -> Result<OptimalityBound, Error> {
     let d = objective.design;
     if !has_bound(objective.criterion) {
@@ -120,32 +122,41 @@ pub fn optimality_bound(
     scored.sort_by(|p, q| q.0.total_cmp(&p.0));
     let (lo, hi) = d.model.joint_limits();
     let k = lo.len();
-    let mut best = scored[0].clone();
-    let mut g = vec![0.0; k];
-    for (s0, x0) in scored.into_iter().take(starts.max(1)) {
-        let (mut s, mut x) = (s0, x0);
-        let mut step = 0.05;
-        for _ in 0..200 {
-            sensitivity(d, &mut ws, phi, &x, Some(&mut g));
-            let gn = g.iter().map(|v| v * v).sum::<f64>().sqrt();
-            if gn == 0.0 {
-                break;
-            }
-            let trial: Vec<f64> = (0..k)
-                .map(|j| (x[j] + step * g[j] / gn).clamp(lo[j], hi[j]))
-                .collect();
-            let st = sensitivity(d, &mut ws, phi, &trial, None);
-            if st > s && feasible(&trial) {
-                s = st;
-                x = trial;
-                step *= 1.5;
-            } else {
-                step *= 0.3;
-                if step < 1e-7 {
-                    break;
+    let ascents: Vec<(f64, Vec<f64>)> = scored[..starts.max(1).min(scored.len())]
+        .par_iter()
+        .map_init(
+            || (InformationWorkspace::new(d), vec![0.0; k], make_feasible()),
+            |(ws, g, feasible), (s0, x0)| {
+                let (mut s, mut x) = (*s0, x0.clone());
+                let mut step = 0.05;
+                for _ in 0..200 {
+                    sensitivity(d, ws, phi, &x, Some(g));
+                    let gn = g.iter().map(|v| v * v).sum::<f64>().sqrt();
+                    if gn == 0.0 {
+                        break;
+                    }
+                    let trial: Vec<f64> = (0..k)
+                        .map(|j| (x[j] + step * g[j] / gn).clamp(lo[j], hi[j]))
+                        .collect();
+                    let st = sensitivity(d, ws, phi, &trial, None);
+                    if st > s && feasible(&trial) {
+                        s = st;
+                        x = trial;
+                        step *= 1.5;
+                    } else {
+                        step *= 0.3;
+                        if step < 1e-7 {
+                            break;
+                        }
+                    }
                 }
-            }
-        }
+                (s, x)
+            },
+        )
+        .collect();
+    // The first of the largest, in the order of the starts (as a serial run would pick).
+    let mut best = scored[0].clone();
+    for (s, x) in ascents {
         if s > best.0 {
             best = (s, x);
         }

@@ -393,8 +393,9 @@ pub fn plan(
     let feasible = design.iter().all(|q| cons.feasible(q));
     let min_margin = cons.design_margin(&design);
     let bound = if has_bound(settings.criterion) {
-        Some(optimality_bound(&objective, &design, &pool, 20, |q| {
-            cons.feasible(q)
+        Some(optimality_bound(&objective, &design, &pool, 20, || {
+            let cons = CellConstraints::new(&set, &params);
+            move |q: &[f64]| cons.feasible(q)
         })?)
     } else {
         None

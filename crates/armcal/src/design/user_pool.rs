@@ -371,7 +371,10 @@ pub fn plan_from_pool(
             &design,
             &candidates,
             20,
-            |q| cons.feasible(q),
+            || {
+                let cons = CellConstraints::new(&set, &d.params);
+                move |q: &[f64]| cons.feasible(q)
+            },
         )?)
     } else {
         None

@@ -46,7 +46,7 @@ fn bound_is_below_every_design_and_efficiency_is_high_for_optimised_designs() {
             &mut Silent,
         )
         .unwrap();
-        let b = optimality_bound(&obj, &refined.q, &pool, 20, |_| true).unwrap();
+        let b = optimality_bound(&obj, &refined.q, &pool, 20, || |_: &[f64]| true).unwrap();
         let random = strategy(&d.model, Strategy::S4, 30, 4);
         let mut ws = obj.workspace(30);
         let v_random = obj
