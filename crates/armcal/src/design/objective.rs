@@ -266,7 +266,8 @@ mod tests {
     use std::path::Path;
 
     /// The cached evaluation (value, then gradient at the same point; then other points and
-    /// another objective on the same workspace) agrees with evaluations on fresh workspaces.
+    /// other objectives, one with other prior rows, on the same workspace) agrees with
+    /// evaluations on fresh workspaces.
     #[test]
     fn cached_evaluations_match_fresh_ones() {
         let cell = Cell::from_file(
@@ -279,6 +280,10 @@ mod tests {
         q2[4] += 1e-3;
         let a = DesignObjective::new(&d, Criterion::Kpi, &[]);
         let b = DesignObjective::new(&d, Criterion::D, &[]);
+        // Other prior rows (measured poses) in a workspace that held `a`'s, then prior rows of
+        // the same shape but other values.
+        let c = DesignObjective::new(&d, Criterion::Kpi, &random_configurations(&d.model, 40, 4));
+        let e = DesignObjective::new(&d, Criterion::Kpi, &random_configurations(&d.model, 40, 5));
         let fresh = |obj: &DesignObjective, x: &[f64]| {
             let mut g = vec![0.0; x.len()];
             let v = obj
@@ -288,7 +293,15 @@ mod tests {
         };
         let mut ws = a.workspace(30);
         let mut g = vec![0.0; q.len()];
-        for (obj, x) in [(&a, &q), (&a, &q2), (&b, &q2), (&a, &q2)] {
+        for (obj, x) in [
+            (&a, &q),
+            (&a, &q2),
+            (&b, &q2),
+            (&a, &q2),
+            (&c, &q2),
+            (&e, &q2),
+            (&a, &q),
+        ] {
             let v = obj.value_and_gradient(&mut ws, x, None).unwrap();
             let w = obj.value_and_gradient(&mut ws, x, Some(&mut g)).unwrap();
             let (vf, gf) = fresh(obj, x);
