@@ -174,6 +174,12 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
             rep.constraints_per_pose
         ),
     }
+    if !rep.pairs_in_contact.is_empty() {
+        println!(
+            "not checked, in contact at every sampled configuration (shorten a capsule to check them): {}",
+            rep.pairs_in_contact.join(", ")
+        );
+    }
     print_margins(&record.margins);
     match rep.bound.as_ref().map(|b| (b, b.efficiency)) {
         Some((b, Some(e))) => println!(

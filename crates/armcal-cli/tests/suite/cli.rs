@@ -186,6 +186,45 @@ fn a_closed_stdout_is_not_a_crash() {
     }
 }
 
+/// A built-in robot whose capsules meet at every configuration (the IRB 120's upper arm and
+/// forearm at its short elbow link) is planned for with collision avoidance: the pair is left
+/// out and named, every other constraint holds.
+#[test]
+fn plan_names_the_capsule_pairs_in_contact_everywhere_and_plans_around_the_rest() {
+    let dir = scratch("plan-irb120");
+    let cell = dir.join("cell.toml");
+    std::fs::write(
+        &cell,
+        "name = \"irb120-cell\"\n[robot]\nbuiltin = \"irb120\"\n\n[instrument]\nname = \"tracker\"\n\
+         kind = \"laser-tracker\"\nxyz_mm = [2000.0, 500.0, 300.0]\nrpy_deg = [0, 0, 180]\n\
+         noise = { model = \"constant\", sigma_mm = 0.05 }\nmax_incidence_deg = 40\n\n\
+         [[targets]]\nname = \"smr1\"\nxyz_mm = [0.0, 0.0, 60.0]\n\n[parameters]\n\
+         fixed = [\"base\", \"tool\"]\nfree = \"auto\"\nmeasurement = \"position\"\n\n\
+         [[working]]\nname = \"pick\"\njoints_deg = [0, 20, 10, 0, 60, 0]\n",
+    )
+    .unwrap();
+    let out = dir.join("design.csv");
+    let (ok, stdout, err) = armcal(&[
+        "plan",
+        "--cell",
+        cell.to_str().unwrap(),
+        "--poses",
+        "30",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(stdout.contains("every pose feasible"), "{stdout}");
+    assert!(
+        stdout.contains("not checked, in contact at every sampled configuration (shorten a capsule to check them): capsule j2#0 / j4#0"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("self-collision"),
+        "the other pairs are checked:\n{stdout}"
+    );
+}
+
 /// A cell with two working poses: `plan` states the TCP variance at each, not at the first
 /// alone (the second, weighted double here, was once left off the screen).
 #[test]

@@ -102,6 +102,10 @@ pub struct PlanResult {
     pub min_margin: Option<DesignMargin>,
     /// Constraints checked at each pose.
     pub constraints_per_pose: usize,
+    /// Robot capsule pairs not checked: they overlap at every sampled configuration
+    /// ([`ConstraintSet::pairs_in_contact`]).
+    #[serde(default)]
+    pub pairs_in_contact: Vec<String>,
     /// Random draws made to fill the candidate pool.
     pub pool_draws: usize,
     /// Criterion value after the exchange, before the refinement (NaN when no feasible pool
@@ -178,6 +182,7 @@ fn infeasible_report(
         design,
         feasible: false,
         constraints_per_pose: set.len(),
+        pairs_in_contact: set.pairs_in_contact().to_vec(),
         pool_draws: draws,
         exchange_value: f64::NAN,
         exchange_sweeps: 0,
@@ -407,6 +412,7 @@ pub fn plan(
         feasible,
         min_margin,
         constraints_per_pose: set.len(),
+        pairs_in_contact: set.pairs_in_contact().to_vec(),
         pool_draws: draws,
         exchange_value,
         exchange_sweeps: sweeps,

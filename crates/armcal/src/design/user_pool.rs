@@ -386,6 +386,7 @@ pub fn plan_from_pool(
         design,
         feasible,
         constraints_per_pose: set.len(),
+        pairs_in_contact: set.pairs_in_contact().to_vec(),
         pool_draws: 0,
         exchange_value: selection_value,
         exchange_sweeps: sweeps,

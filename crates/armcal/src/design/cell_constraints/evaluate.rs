@@ -329,6 +329,46 @@ pub(super) fn constraint_ranges(set: &ConstraintSet, samples: usize) -> Vec<(f64
     range
 }
 
+/// Leaves out the robot capsule pairs that overlap at every one of `samples` spread
+/// configurations ([`constraint_ranges`]), keeping their names in `set.pairs_in_contact`
+/// (see the module documentation: bodies in contact by construction).
+pub(super) fn drop_pairs_in_contact(set: &mut ConstraintSet, samples: usize) {
+    let ranges = constraint_ranges(set, samples);
+    let touching: Vec<bool> = (0..set.len())
+        .map(|i| set.kind(i) == ConstraintKind::SelfCollision && ranges[i].1 < 0.0)
+        .collect();
+    let mut keep = touching.iter().map(|t| !t);
+    set.items.retain(|_| keep.next().unwrap_or(true));
+    let names = std::mem::take(&mut set.names);
+    for (name, touching) in names.into_iter().zip(&touching) {
+        match touching {
+            true => set.pairs_in_contact.push(name),
+            false => set.names.push(name),
+        }
+    }
+    let n = set.items.len();
+    set.required.truncate(n);
+    set.constant.truncate(n);
+}
+
+impl ConstraintSet {
+    /// Robot capsule pairs not checked because they overlap at every sampled configuration
+    /// (names as [`ConstraintSet::names`]).
+    pub fn pairs_in_contact(&self) -> &[String] {
+        &self.pairs_in_contact
+    }
+
+    /// Number of constraints of one kind.
+    pub fn count(&self, kind: ConstraintKind) -> usize {
+        self.items.iter().filter(|it| it.kind() == kind).count()
+    }
+
+    /// Buffers for [`ConstraintSet::evaluate`].
+    pub fn workspace(&self) -> ConstraintWorkspace {
+        ConstraintWorkspace::new(self)
+    }
+}
+
 /// Whether a range of [`constraint_ranges`] is constant (within 1e-9).
 pub(super) fn is_flat(range: (f64, f64)) -> bool {
     range.1 - range.0 < 1e-9

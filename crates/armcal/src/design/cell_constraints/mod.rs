@@ -40,7 +40,12 @@
 //!   "two neighboring segments do not have to be compared as the limitation of joint movement
 //!   automatically prevents their collision" (paper §2.2; with one capsule per body this is
 //!   exactly the count of eq. 22, `n(n − 1)/2 − (n − 1)`);
-//! - no joint separates them (their distance would not depend on q).
+//! - no joint separates them (their distance would not depend on q);
+//! - they overlap at every one of 256 spread configurations (nominal parameters): bodies in
+//!   contact by construction, like neighbours (a short elbow link whose capsule is shorter
+//!   than the two radii: the IRB 120's upper arm and forearm, the PUMA's shoulder and base).
+//!   No design could satisfy such a pair; it is listed in [`ConstraintSet::pairs_in_contact`]
+//!   and printed by `plan`, so a user can shorten a capsule to have it checked.
 //!
 //! "Link indices differ by ≥ 2" is the same rule when every link carries capsules. It is not
 //! when a frame carries none: in the paper robot the wrist capsule (on `j5`, wrist centre to
@@ -291,6 +296,8 @@ pub struct ConstraintSet {
     /// How far a configuration may sit inside the joint margin and still count as within
     /// the bounds ([`JOINT_MARGIN_TOLERANCE`] with a margin, 0 without).
     joint_tolerance: f64,
+    /// Robot capsule pairs left out because they overlap everywhere (`evaluate.rs`).
+    pairs_in_contact: Vec<String>,
 }
 
 /// Reusable buffers for [`ConstraintSet::evaluate`], of the set that made them
@@ -466,7 +473,9 @@ impl ConstraintSet {
             required: vec![0.0; n],
             constant: vec![false; n],
             joint_tolerance: 0.0,
+            pairs_in_contact: Vec::new(),
         };
+        drop_pairs_in_contact(&mut set, 256);
         // 16 samples: the constraints the refinement keeps no margin from (see
         // `CellConstraints` in plan.rs).
         set.constant = constraint_ranges(&set, 16)
@@ -527,16 +536,6 @@ impl ConstraintSet {
     pub fn kind(&self, i: usize) -> ConstraintKind {
         self.items[i].kind()
     }
-
-    /// Number of constraints of one kind.
-    pub fn count(&self, kind: ConstraintKind) -> usize {
-        self.items.iter().filter(|it| it.kind() == kind).count()
-    }
-
-    /// Buffers for [`ConstraintSet::evaluate`].
-    pub fn workspace(&self) -> ConstraintWorkspace {
-        ConstraintWorkspace::new(self)
-    }
 }
 
 /// Robot capsules that carry the reflector (see the module documentation): at most one joint
@@ -587,7 +586,7 @@ fn reflector_carriers(
 mod evaluate;
 mod measurable;
 pub use evaluate::JOINT_MARGIN_TOLERANCE;
-use evaluate::{constraint_ranges, is_flat};
+use evaluate::{constraint_ranges, drop_pairs_in_contact, is_flat};
 #[cfg(test)]
 mod tests;
 
