@@ -1,5 +1,6 @@
 //! `armcal identify`: calibrate the cell's free parameters from a data file.
 
+use super::digits::decimals_or_digits;
 use super::output::{
     load_cell, load_data, load_estimate, load_station_data, station_files, AcceptUnconverged,
     Outputs,
@@ -230,13 +231,13 @@ pub fn print_summary(e: &Estimate) {
     }
     for (t, c) in e.tcp.iter().zip(&e.tcp_constrained) {
         println!(
-            "TCP at `{}`: σ = ({:.4}, {:.4}, {:.4}) mm, (1/3) tr C_s = {:.5} mm² (eq. 19: {:.5})",
+            "TCP at `{}`: σ = ({}, {}, {}) mm, (1/3) tr C_s = {} mm² (eq. 19: {})",
             t.name,
-            t.covariance[(0, 0)].sqrt(),
-            t.covariance[(1, 1)].sqrt(),
-            t.covariance[(2, 2)].sqrt(),
-            t.kpi,
-            c.trace() / 3.0
+            decimals_or_digits(t.covariance[(0, 0)].sqrt(), 4),
+            decimals_or_digits(t.covariance[(1, 1)].sqrt(), 4),
+            decimals_or_digits(t.covariance[(2, 2)].sqrt(), 4),
+            decimals_or_digits(t.kpi, 5),
+            decimals_or_digits(c.trace() / 3.0, 5)
         );
     }
     let o = &e.observability;

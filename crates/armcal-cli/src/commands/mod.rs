@@ -6,6 +6,7 @@ pub mod campaign;
 pub mod check;
 pub mod compensate;
 pub mod demo;
+pub mod digits;
 pub mod export;
 pub mod fk;
 pub mod identify;

@@ -1,6 +1,7 @@
 //! `armcal plan`: optimal measurement poses for a cell; `armcal evaluate`: what any design
 //! (including a hand-made one) gives.
 
+use super::digits::decimals_or_digits;
 use super::output::{load_cell, Outputs};
 use super::progress::Progress;
 use anyhow::bail;
@@ -143,17 +144,17 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         (&report_path, &serde_json::to_string_pretty(&record)?),
     ])?;
     println!(
-        "{} poses for `{}`, criterion {}: value {:.6} ({} {:.6}; refinement {}) in {:.2} s",
+        "{} poses for `{}`, criterion {}: value {} ({} {}; refinement {}) in {:.2} s",
         rep.design.len(),
         cell.name,
         rep.criterion.words(),
-        rep.value,
+        decimals_or_digits(rep.value, 6),
         if record.pool.is_some() {
             "pool selection"
         } else {
             "exchange"
         },
-        rep.exchange_value,
+        decimals_or_digits(rep.exchange_value, 6),
         rep.refine_status.as_deref().unwrap_or("skipped"),
         rep.time.as_secs_f64()
     );
@@ -183,9 +184,9 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
     print_margins(&record.margins);
     match rep.bound.as_ref().map(|b| (b, b.efficiency)) {
         Some((b, Some(e))) => println!(
-            "optimality bound: no {}-pose design can go below {:.6}; this design's efficiency {e:.3}",
+            "optimality bound: no {}-pose design can go below {}; this design's efficiency {e:.3}",
             rep.design.len(),
-            b.lower_bound
+            decimals_or_digits(b.lower_bound, 6)
         ),
         Some(_) => println!(
             "optimality bound: none (the bound found is not positive, so it says nothing about \
@@ -194,7 +195,11 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         None => {}
     }
     for t in &record.assessment.tcp {
-        println!("(1/3) tr C_s at `{}`: {:.5} mm²", t.name, t.kpi);
+        println!(
+            "(1/3) tr C_s at `{}`: {} mm²",
+            t.name,
+            decimals_or_digits(t.kpi, 5)
+        );
     }
     print_paths(&record.assessment.paths, "");
     println!(
@@ -219,11 +224,11 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
 fn print_paths(paths: &[PathPrecision], indent: &str) {
     for p in paths {
         println!(
-            "{indent}(1/3) tr C_s along `{}` ({} configurations): mean {:.5} mm², largest {:.5} mm² at configuration {}",
+            "{indent}(1/3) tr C_s along `{}` ({} configurations): mean {} mm², largest {} mm² at configuration {}",
             p.name,
             p.kpi.len(),
-            p.mean_kpi,
-            p.max_kpi,
+            decimals_or_digits(p.mean_kpi, 5),
+            decimals_or_digits(p.max_kpi, 5),
             p.worst
         );
     }
@@ -285,11 +290,15 @@ pub fn run_evaluate(a: &EvaluateArgs) -> anyhow::Result<()> {
     }
     println!("{} poses on `{}`", ev.poses, ev.cell);
     for (c, v) in &ev.assessment.criteria {
-        println!("  {:<4} {v:.6}", c.name());
+        println!("  {:<4} {}", c.name(), decimals_or_digits(*v, 6));
     }
     println!("  φ_A(C_p) = tr(C_p)/n_p = {:.6}", ev.assessment.phi_a_cp);
     for t in &ev.assessment.tcp {
-        println!("  (1/3) tr C_s at `{}` = {:.5} mm²", t.name, t.kpi);
+        println!(
+            "  (1/3) tr C_s at `{}` = {} mm²",
+            t.name,
+            decimals_or_digits(t.kpi, 5)
+        );
     }
     print_paths(&ev.assessment.paths, "  ");
     let infeasible = &ev.infeasible_poses;

@@ -223,6 +223,14 @@ fn plan_names_the_capsule_pairs_in_contact_everywhere_and_plans_around_the_rest(
         stdout.contains("self-collision"),
         "the other pairs are checked:\n{stdout}"
     );
+    // A 0.05 mm tracker: the variance is about 1e-4 mm² and keeps 3 significant digits.
+    let kpi = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("(1/3) tr C_s at `pick`: "))
+        .and_then(|l| l.strip_suffix(" mm²"))
+        .unwrap_or_else(|| panic!("no C_s line:\n{stdout}"));
+    let digits = kpi.trim_start_matches(['0', '.']).len();
+    assert!(kpi.parse::<f64>().unwrap() < 1e-3 && digits >= 3, "{kpi}");
 }
 
 /// A cell with two working poses: `plan` states the TCP variance at each, not at the first
