@@ -317,10 +317,7 @@ pub(super) fn constraint_ranges(set: &ConstraintSet, samples: usize) -> Vec<(f64
     let mut values = vec![0.0; m];
     let mut q = vec![0.0; lower.len()];
     for k in 0..samples {
-        for (j, x) in q.iter_mut().enumerate() {
-            let t = (0.5 + k as f64 * (j as f64 + 2.0).sqrt()).fract();
-            *x = lower[j] + t * (upper[j] - lower[j]);
-        }
+        spread_configuration(&lower, &upper, k, &mut q);
         set.evaluate(&mut ws, &params, &q, &mut values, None);
         for (r, v) in range.iter_mut().zip(&values) {
             *r = (r.0.min(*v), r.1.max(*v));
@@ -329,14 +326,41 @@ pub(super) fn constraint_ranges(set: &ConstraintSet, samples: usize) -> Vec<(f64
     range
 }
 
+/// The `k`-th of the spread configurations within `lower`, `upper` (a Kronecker sequence:
+/// joint j at the fractional part of `0.5 + k √(j + 2)` of its range).
+fn spread_configuration(lower: &[f64], upper: &[f64], k: usize, q: &mut [f64]) {
+    for (j, x) in q.iter_mut().enumerate() {
+        let t = (0.5 + k as f64 * (j as f64 + 2.0).sqrt()).fract();
+        *x = lower[j] + t * (upper[j] - lower[j]);
+    }
+}
+
 /// Leaves out the robot capsule pairs that overlap at every one of `samples` spread
-/// configurations ([`constraint_ranges`]), keeping their names in `set.pairs_in_contact`
-/// (see the module documentation: bodies in contact by construction).
+/// configurations (those of [`constraint_ranges`]), keeping their names in
+/// `set.pairs_in_contact` (see the module documentation: bodies in contact by construction).
+/// Only the pairs not yet seen apart are evaluated, and the sampling stops when every pair
+/// has been: a few configurations for a robot without such a pair.
 pub(super) fn drop_pairs_in_contact(set: &mut ConstraintSet, samples: usize) {
-    let ranges = constraint_ranges(set, samples);
-    let touching: Vec<bool> = (0..set.len())
-        .map(|i| set.kind(i) == ConstraintKind::SelfCollision && ranges[i].1 < 0.0)
+    let mut touching: Vec<bool> = (0..set.len())
+        .map(|i| set.kind(i) == ConstraintKind::SelfCollision)
         .collect();
+    let (lower, upper) = set.model.joint_limits();
+    let params = set.model.nominal();
+    let mut ws = set.workspace();
+    let mut values = vec![0.0; set.len()];
+    let mut q = vec![0.0; lower.len()];
+    let mut rows: Vec<usize> = (0..set.len()).filter(|&i| touching[i]).collect();
+    for k in 0..samples {
+        if rows.is_empty() {
+            break;
+        }
+        spread_configuration(&lower, &upper, k, &mut q);
+        set.evaluate_rows(&mut ws, &params, &q, &rows, &mut values, None);
+        for &i in &rows {
+            touching[i] = values[i] < 0.0;
+        }
+        rows.retain(|&i| touching[i]);
+    }
     let mut keep = touching.iter().map(|t| !t);
     set.items.retain(|_| keep.next().unwrap_or(true));
     let names = std::mem::take(&mut set.names);
