@@ -119,25 +119,15 @@ impl<'a> SweepState<'a> {
     /// `W = U J_pᵀ` of pool point `p`: column b is `Σ_c U[:, c] J[p·rows + b, c]`.
     fn products_with(&mut self, p: usize) {
         let rows = self.rows;
-        let height = self.u.nrows();
         self.w.fill(0.0);
-        for (c, uc) in self.u.as_slice().chunks_exact(height).enumerate() {
-            for (b, wb) in self.w.as_mut_slice().chunks_exact_mut(height).enumerate() {
-                axpy(self.j[(p * rows + b, c)], uc, wb);
-            }
-        }
+        add_rank_product(&mut self.w, &self.u, |b, c| self.j[(p * rows + b, c)]);
     }
 
     /// `W · inv`, `U_pᵀ inv` and `V_pᵀ inv` of pool point `p` (`inv` symmetric).
     fn through_inverse(&mut self, p: usize) {
         let rows = self.rows;
-        let height = self.w.nrows();
         self.wk.fill(0.0);
-        for (b, wb) in self.w.as_slice().chunks_exact(height).enumerate() {
-            for (a, wka) in self.wk.as_mut_slice().chunks_exact_mut(height).enumerate() {
-                axpy(self.inv[b * rows + a], wb, wka);
-            }
-        }
+        add_rank_product(&mut self.wk, &self.w, |a, b| self.inv[b * rows + a]);
         for (m, out) in [(&self.u, &mut self.us_k), (&self.v, &mut self.vs_k)] {
             for b in 0..rows {
                 for r in 0..m.ncols() {
@@ -210,15 +200,15 @@ impl<'a> SweepState<'a> {
         }
         small_cholesky::inverse(&self.s_buf, &mut self.inv, rows);
         // Removal: U₋ = U + W (K⁻¹ U_s), V₋ likewise, Q₋_x = Q_x + (W_x K⁻¹) W_xᵀ.
-        add_rank_product(&mut self.u, &self.w, &self.us_k, 1.0);
-        add_rank_product(&mut self.v, &self.w, &self.vs_k, 1.0);
+        add_rank_product(&mut self.u, &self.w, |c, b| self.us_k[(c, b)]);
+        add_rank_product(&mut self.v, &self.w, |c, b| self.vs_k[(c, b)]);
         add_block_products(&mut self.q, rows, &self.wk, &self.w, 1.0);
         // Addition: Y = U₋ J_xᵀ (into w); U' = U₋ − Y (S⁻¹ U₋_x), V' likewise,
         // Q'_x = Q₋_x − (Y_x S⁻¹) Y_xᵀ.
         self.products_with(x);
         self.through_inverse(x);
-        add_rank_product(&mut self.u, &self.w, &self.us_k, -1.0);
-        add_rank_product(&mut self.v, &self.w, &self.vs_k, -1.0);
+        add_rank_product(&mut self.u, &self.w, |c, b| -self.us_k[(c, b)]);
+        add_rank_product(&mut self.v, &self.w, |c, b| -self.vs_k[(c, b)]);
         add_block_products(&mut self.q, rows, &self.wk, &self.w, -1.0);
         true
     }
@@ -242,16 +232,16 @@ fn add_block_products(q: &mut [f64], rows: usize, a: &DMatrix<f64>, b: &DMatrix<
     }
 }
 
-/// `m += sign · w kᵀ`, the rank-r update of a pool-sized buffer: column c of `m` gains
-/// `sign · Σ_b w[:, b] k[c, b]` (`w`: pool rows × r, `k`: columns of m × r).
-fn add_rank_product(m: &mut DMatrix<f64>, w: &DMatrix<f64>, k: &DMatrix<f64>, sign: f64) {
+/// `m[:, c] += Σ_b k(c, b) · w[:, b]` for every column c of the pool-sized buffer `m` (`w`:
+/// pool rows × r): W, `W · inv` and the rank updates of U and V, as column updates.
+fn add_rank_product(m: &mut DMatrix<f64>, w: &DMatrix<f64>, k: impl Fn(usize, usize) -> f64) {
     let height = m.nrows();
     if height == 0 {
         return;
     }
     for (c, mc) in m.as_mut_slice().chunks_exact_mut(height).enumerate() {
         for (b, wb) in w.as_slice().chunks_exact(height).enumerate() {
-            axpy(sign * k[(c, b)], wb, mc);
+            axpy(k(c, b), wb, mc);
         }
     }
 }
