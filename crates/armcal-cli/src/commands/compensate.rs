@@ -5,6 +5,7 @@
 use super::output::{
     load_cell, load_data, load_estimate, with_note, AcceptUnconverged, NoteStyle, Outputs,
 };
+use armcal::compensate::joint_change::JointChangeLimit;
 use armcal::compensate::nonparametric::{CorrectionInputs, ResidualCorrection};
 use armcal::compensate::program::{compensate_program, ProgramFile};
 use armcal::compensate::IkSettings;
@@ -25,9 +26,19 @@ pub struct Args {
     #[arg(long)]
     pub targets: PathBuf,
     /// Output: the compensated program (CSV: pose_id, the joints to command, for Cartesian
-    /// targets the pose to send, then status, position_error_mm, orientation_error_deg).
+    /// targets the pose to send, then status, position_error_mm, orientation_error_deg,
+    /// solution).
     #[arg(long)]
     pub out: PathBuf,
+    /// The largest change of a revolute joint from the uncompensated row (deg). A row whose
+    /// exact calibrated solution changes a joint by more (a branch change, or a whip near a
+    /// singularity) is solved with position priority within the limit, and gets the status
+    /// `joint-change-limit` if that misses the tolerance.
+    #[arg(long, default_value_t = 5.0, value_name = "DEG")]
+    pub max_joint_change_deg: f64,
+    /// The largest change of a prismatic joint from the uncompensated row (mm).
+    #[arg(long, default_value_t = 5.0, value_name = "MM")]
+    pub max_joint_change_mm: f64,
     /// The payload the robot carries along the program (a cell's `[[payload]]` name, or
     /// `none`): the compensation includes its deflection, and the output's first line says
     /// which payload it is for. Default: the payload the calibration data carried if they
@@ -56,6 +67,14 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
+    for (flag, v) in [
+        ("--max-joint-change-deg", a.max_joint_change_deg),
+        ("--max-joint-change-mm", a.max_joint_change_mm),
+    ] {
+        if !(v.is_finite() && v > 0.0) {
+            anyhow::bail!("{flag} {v}: the joint-change limit must be a positive number");
+        }
+    }
     let mut inputs = vec![Path::new(&a.cell), &a.estimate, &a.targets];
     inputs.extend(a.nonparametric.as_deref());
     let outputs = Outputs::plan(a.force, &inputs, &[&a.out])?;
@@ -99,6 +118,10 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         &program,
         &IkSettings {
             payload,
+            joint_change_limit: JointChangeLimit {
+                revolute: a.max_joint_change_deg.to_radians(),
+                prismatic: a.max_joint_change_mm,
+            },
             ..IkSettings::default()
         },
         correction.as_ref(),
@@ -123,6 +146,16 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         a.out.display(),
         comp.not_converged
     );
+    if comp.position_priority > 0 {
+        println!(
+            "{} rows need a joint change beyond {} deg / {} mm: solved with position priority \
+             within it, {} of them beyond the tolerance (status joint-change-limit)",
+            comp.position_priority,
+            a.max_joint_change_deg,
+            a.max_joint_change_mm,
+            comp.beyond_change_limit
+        );
+    }
     if !model.payloads.is_empty() {
         println!("payload: {payload_how}");
     }

@@ -124,3 +124,174 @@ fn compensate_reports_bad_rows_and_applies_the_nonparametric_correction() {
     let (ok, _, err) = compensate(&program, &out_file, &["--nonparametric", "missing.csv"]);
     assert!(!ok && err.contains("missing.csv"), "{err}");
 }
+
+/// A joint program through the paper robot's wrist singularity (q5 = 2° … 0 … −5°, with q4
+/// and q6 apart, as a path is taught) and two regular rows, compensated with an estimate of
+/// the paper cell. Before the joint-change limit the calibrated IK swung q4 and q6 by up to
+/// 135° near q5 = 0 and marked those rows `converged`; now every joint changes by at most
+/// the limit, every row that cannot meet the tolerance within it has the status
+/// `joint-change-limit` and is counted, and the regular rows are compensated as before.
+#[test]
+fn compensation_never_whips_the_wrist() {
+    let dir = scratch("compensate-whip");
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let (data, est) = (dir.join("data.csv"), dir.join("est.json"));
+    let (ok, _, err) = armcal(&simulate_paper_cell("3", &s(&data)));
+    assert!(ok, "{err}");
+    let (ok, _, err) = armcal(&identify_paper_cell(&s(&data), &[], &s(&est)));
+    assert!(ok, "{err}");
+    let path = [
+        2.0, 1.0, 0.5, 0.2, 0.1, 0.0, -0.1, -0.2, -0.5, -1.0, -2.0, -5.0,
+    ];
+    let mut program = "pose_id,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg\n".to_string();
+    for (i, q5) in path.iter().enumerate() {
+        program += &format!("w{i},10,-30,60,20,{q5},10\n");
+    }
+    program += "regular1,0,-30,60,0,-60,0\nregular2,-20,-45,70,30,45,-20\n";
+    let program_file = dir.join("path.csv");
+    std::fs::write(&program_file, &program).unwrap();
+    let out_file = dir.join("path-out.csv");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "compensate",
+            "--cell",
+            "examples/paper-cell.toml",
+            "--estimate",
+            est.to_str().unwrap(),
+            "--targets",
+            program_file.to_str().unwrap(),
+            "--out",
+            out_file.to_str().unwrap(),
+            "--force",
+        ];
+        args.extend_from_slice(extra);
+        let (ok, stdout, err) = armcal(&args);
+        assert!(ok, "{err}");
+        (stdout, std::fs::read_to_string(&out_file).unwrap())
+    };
+    // Each row: (id, largest joint change in deg, status, position and orientation error,
+    // solution).
+    let rows = |text: &str| -> Vec<(String, f64, String, f64, f64, String)> {
+        let nominal: Vec<Vec<f64>> = program
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').skip(1).map(|v| v.parse().unwrap()).collect())
+            .collect();
+        let mut out = Vec::new();
+        for (line, q0) in text
+            .lines()
+            .filter(|l| !l.starts_with('#'))
+            .skip(1)
+            .zip(&nominal)
+        {
+            // The status may be quoted (it holds commas): split it off first.
+            let (head, rest) = match line.split_once(",\"") {
+                Some((h, r)) => {
+                    let (status, tail) = r.split_once("\",").unwrap();
+                    (h.to_string(), (status.to_string(), tail.to_string()))
+                }
+                None => {
+                    let f: Vec<&str> = line.split(',').collect();
+                    (f[..7].join(","), (f[7].to_string(), f[8..].join(",")))
+                }
+            };
+            let f: Vec<&str> = head.split(',').collect();
+            let change = f[1..7]
+                .iter()
+                .zip(q0)
+                .map(|(v, n)| (v.parse::<f64>().unwrap() - n).abs())
+                .fold(0.0, f64::max);
+            let tail: Vec<&str> = rest.1.split(',').collect();
+            out.push((
+                f[0].to_string(),
+                change,
+                rest.0,
+                tail[0].parse().unwrap(),
+                tail[1].parse().unwrap(),
+                tail[2].to_string(),
+            ));
+        }
+        out
+    };
+
+    let (stdout, text) = run(&[]);
+    let rows_default = rows(&text);
+    let limited: Vec<_> = rows_default
+        .iter()
+        .filter(|r| r.2.starts_with("joint-change-limit: "))
+        .collect();
+    for r in &rows_default {
+        eprintln!("{r:?}");
+        assert!(r.1 <= 5.0 + 1e-6, "{r:?} changes a joint beyond 5°\n{text}");
+        if r.2 == "converged" {
+            assert!(r.3 <= 1e-6 && r.4 <= 1e-6, "{r:?}");
+        } else {
+            assert!(r.2.starts_with("joint-change-limit: "), "{r:?}");
+            // Position priority: the position is kept, the orientation gives way.
+            assert!(r.3 < 1e-3 && r.5 == "position-priority", "{r:?}");
+        }
+    }
+    // The rows near q5 = 0 cannot be compensated within 5°, and are counted.
+    assert!(limited.len() >= 8, "{text}");
+    assert!(
+        limited.iter().any(|r| r.2.contains(" near a singularity;")),
+        "{text}"
+    );
+    assert!(
+        stdout.contains(&format!("({} not converged;", limited.len())),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains(&format!(
+            "{} of them beyond the tolerance (status joint-change-limit)",
+            limited.len()
+        )),
+        "{stdout}"
+    );
+    // The regular rows are compensated exactly, by the unlimited calibrated IK.
+    for id in ["regular1", "regular2", "w11"] {
+        let r = rows_default.iter().find(|r| r.0 == id).unwrap();
+        assert!(
+            r.2 == "converged" && r.5 == "calibrated-ik" && r.1 < 5.0,
+            "{r:?}"
+        );
+    }
+
+    // With a limit of 200°, the exact solution is kept: it swings the wrist by far more
+    // than 5° near q5 = 0 (what happened before the limit), and the regular rows are the
+    // same to the digit.
+    let (_, wide) = run(&["--max-joint-change-deg", "200"]);
+    let rows_wide = rows(&wide);
+    let whip = rows_wide.iter().map(|r| r.1).fold(0.0, f64::max);
+    assert!(whip > 30.0, "{wide}");
+    for id in ["regular1", "regular2", "w11"] {
+        let line = |t: &str| {
+            t.lines()
+                .find(|l| l.starts_with(&format!("{id},")))
+                .unwrap()
+                .to_string()
+        };
+        assert_eq!(line(&wide), line(&text));
+    }
+
+    // A limit that is not a positive number is refused.
+    let (ok, _, err) = armcal(&[
+        "compensate",
+        "--cell",
+        "examples/paper-cell.toml",
+        "--estimate",
+        est.to_str().unwrap(),
+        "--targets",
+        program_file.to_str().unwrap(),
+        "--out",
+        dir.join("never.csv").to_str().unwrap(),
+        "--max-joint-change-deg",
+        "0",
+    ]);
+    assert!(
+        !ok && err
+            .contains("--max-joint-change-deg 0: the joint-change limit must be a positive number"),
+        "{err}"
+    );
+    assert!(!dir.join("never.csv").exists());
+}

@@ -139,7 +139,7 @@ fn compensate_export_and_accuracy() {
         .lines()
         .next()
         .unwrap()
-        .ends_with("status,position_error_mm,orientation_error_deg"));
+        .ends_with("status,position_error_mm,orientation_error_deg,solution"));
     assert!(text.lines().filter(|l| l.contains(",converged,")).count() >= 50);
     for fmt in ["dh", "mdh", "zrp", "json", "urdf"] {
         let out_file = dir.join(format!("model-{fmt}.out"));

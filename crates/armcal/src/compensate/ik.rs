@@ -33,6 +33,7 @@
 use crate::compensate::closed_form::{NoClosedForm, SphericalWristIk};
 pub use crate::compensate::damped_step::{damped_step, task_jacobian_columns};
 use crate::compensate::damped_step::{normal_matrix, smallest_eigenvalue, step_from};
+use crate::compensate::joint_change::{ChangeViolation, JointChangeLimit};
 use crate::model::pose::rotation_log;
 use crate::model::{forward_kinematics, Data, JointKind, Model, Pose};
 use crate::solve::Status;
@@ -68,6 +69,11 @@ pub enum IkStatus {
     /// The iteration limit was reached first.
     #[serde(rename = "max-iterations")]
     IterationLimit,
+    /// Compensation only ([`crate::compensate::joint_change`]): the exact solution changes a
+    /// joint by more than [`IkSettings::joint_change_limit`] from the uncompensated joints;
+    /// the row holds the position-priority solution within the limit
+    /// ([`IkResult::change`] names the joint).
+    JointChangeLimit,
 }
 
 impl IkStatus {
@@ -79,6 +85,7 @@ impl IkStatus {
             IkStatus::JointLimits => "joint-limits",
             IkStatus::Unreachable => "unreachable",
             IkStatus::IterationLimit => "max-iterations",
+            IkStatus::JointChangeLimit => "joint-change-limit",
         }
     }
 
@@ -99,6 +106,11 @@ impl IkStatus {
                 reason: "the target is out of reach".into(),
             },
             IkStatus::IterationLimit => Status::IterationLimit,
+            IkStatus::JointChangeLimit => Status::Infeasible {
+                reason: "the exact solution changes a joint by more than the compensation's \
+                         joint-change limit"
+                    .into(),
+            },
         }
     }
 }
@@ -123,6 +135,10 @@ pub struct IkSettings {
     /// [`Model::payloads`]; `None`: none): a compliant model deflects under its weight, and
     /// the solve includes that deflection ([`crate::identify::Estimate::payload_for`]).
     pub payload: Option<usize>,
+    /// The largest change of each joint from the uncompensated joints that compensation
+    /// accepts ([`crate::compensate::joint_change`]; not used by a bare IK solve, which has
+    /// no uncompensated joints).
+    pub joint_change_limit: JointChangeLimit,
 }
 
 impl Default for IkSettings {
@@ -136,6 +152,7 @@ impl Default for IkSettings {
             epsilon: 1.0,
             gamma_max: 1.0,
             payload: None,
+            joint_change_limit: JointChangeLimit::default(),
         }
     }
 }
@@ -172,6 +189,14 @@ pub struct IkResult {
     pub sigma_min: Option<f64>,
     /// For [`IkStatus::JointLimits`]: the joint beyond its limits.
     pub limit: Option<LimitViolation>,
+    /// For a compensation whose exact solution changes a joint by more than the limit (the
+    /// row then holds the position-priority solution within it): the joint and its change.
+    #[serde(default)]
+    pub change: Option<ChangeViolation>,
+    /// Whether the row holds the position-priority solution within the joint-change limit
+    /// ([`CalibratedIk::solve_in_box`]) instead of the unlimited solve.
+    #[serde(default)]
+    pub position_priority: bool,
 }
 
 impl IkResult {
@@ -190,6 +215,28 @@ impl IkResult {
                     if v.value > v.limit { ">" } else { "<" },
                     v.limit * f,
                     unit.display_name()
+                );
+            }
+        }
+        if let (IkStatus::JointChangeLimit, Some(c)) = (self.status, self.change) {
+            if let Some(j) = model.joints.get(c.joint) {
+                let unit = j.kind.unit();
+                let f = unit.display_factor();
+                return format!(
+                    "joint-change-limit: {} needs {:+.3} {} (limit {:.3} {}){}; within the limit \
+                     {:.6} mm, {:.4} deg",
+                    j.name,
+                    c.change * f,
+                    unit.display_name(),
+                    c.limit * f,
+                    unit.display_name(),
+                    if c.singular {
+                        " near a singularity"
+                    } else {
+                        ""
+                    },
+                    self.position_error,
+                    self.orientation_error.to_degrees()
                 );
             }
         }
@@ -220,6 +267,9 @@ pub struct IkWorkspace {
     columns: Vec<Vector6<f64>>,
     corrected: Vec<Vector6<f64>>,
     eigenvector: Vector6<f64>,
+    /// Whether [`run_dls`] holds a joint at its bound when the error's gradient pushes it
+    /// outward (an active set; [`CalibratedIk::solve_in_box`]), instead of only clamping.
+    active_set: bool,
 }
 
 impl IkWorkspace {
@@ -244,6 +294,7 @@ impl IkWorkspace {
             columns: vec![Vector6::zeros(); n],
             corrected: vec![Vector6::zeros(); n],
             eigenvector: Vector6::repeat(1.0 / 6f64.sqrt()),
+            active_set: false,
         }
     }
 }
@@ -311,6 +362,16 @@ fn run_dls<const R: usize>(
             };
         }
         task_jacobian_columns(&ws.data, length, &mut ws.columns, &mut ws.corrected);
+        if ws.active_set {
+            // A joint at a bound that the gradient JᵀQe pushes outward takes no part in the
+            // step: the damped step of the remaining joints (projected Newton).
+            for (k, c) in ws.columns.iter_mut().enumerate() {
+                let g = c.fixed_rows::<R>(0).dot(&e);
+                if (ws.q[k] <= ws.lower[k] && g < 0.0) || (ws.q[k] >= ws.upper[k] && g > 0.0) {
+                    *c = Vector6::zeros();
+                }
+            }
+        }
         let a = normal_matrix::<R>(&ws.columns);
         if iterations >= settings.max_iterations || stalls >= 5 {
             let sigma_min = smallest_eigenvalue(&a, &mut ws.eigenvector).sqrt();
@@ -506,6 +567,8 @@ fn solve_with_diagnosis(
         orientation_error: run.orientation_error,
         sigma_min: (!run.converged).then_some(run.sigma_min),
         limit,
+        change: None,
+        position_priority: false,
     };
     if run.converged {
         return result(ws, &run, IkStatus::Converged, None);
@@ -648,4 +711,111 @@ impl<'a> CalibratedIk<'a> {
             &mut self.ws,
         )
     }
+
+    /// The settings of every solve.
+    pub fn settings(&self) -> &IkSettings {
+        &self.settings
+    }
+
+    /// The joints a controller that keeps the nominal model commands for `target`: the
+    /// nominal closed-form branch nearest `reference` ([`Branches::ordered`]) where the robot
+    /// has a closed form and the target is a pose, else the nominal model's damped
+    /// least-squares solution from `reference`; `None` if that does not converge.
+    ///
+    /// [`Branches::ordered`]: crate::compensate::closed_form::Branches::ordered
+    pub fn nominal_solution(&mut self, target: &IkTarget, reference: &[f64]) -> Option<Vec<f64>> {
+        if let (IkTarget::Pose(pose), Ok(cf), 6) = (target, &self.closed_form, reference.len()) {
+            let branches = cf.solve(pose, reference).ordered(reference);
+            if let Some(b) = branches.as_slice().first() {
+                return Some(b.q.to_vec());
+            }
+        }
+        let r = calibrated_ik(
+            self.model,
+            &self.nominal,
+            target,
+            reference,
+            &self.settings,
+            &mut self.ws,
+        );
+        (r.status == IkStatus::Converged).then_some(r.q)
+    }
+
+    /// Damped least squares on the calibrated model within the joint box `[lower, upper]`
+    /// (each bound within the joint limits), from `seed`, with position priority: the
+    /// orientation rows are weighted by [`PRIORITY_LENGTH`] instead of L (and ε, γ_max
+    /// scaled alike), so that a position error δ costs as much as an orientation error
+    /// δ/[`PRIORITY_LENGTH`] rad — where the box leaves an orientation error ϑ, the position
+    /// gives way by about `PRIORITY_LENGTH² ϑ / r` only (r ≈ the arm's reach, 10⁻⁵ mm for
+    /// ϑ = 0.3°, r = 1 m). A joint at a bound that the error pushes outward is held there
+    /// (active set). Converged if both tolerances are met; otherwise
+    /// [`IkStatus::JointChangeLimit`] with what the box leaves. `sigma_min` is σ_min of
+    /// the weighted Jacobian (weight L, all joints) at the result, for a result that did
+    /// not converge: it tells a singularity apart from a limit that is simply too small.
+    pub fn solve_in_box(
+        &mut self,
+        target: &IkTarget,
+        seed: &[f64],
+        mut lower: Vec<f64>,
+        mut upper: Vec<f64>,
+    ) -> IkResult {
+        let ws = &mut self.ws;
+        std::mem::swap(&mut ws.lower, &mut lower);
+        std::mem::swap(&mut ws.upper, &mut upper);
+        for k in 0..ws.q.len() {
+            let s = seed.get(k).copied().unwrap_or(0.0);
+            ws.q[k] = s.clamp(ws.lower[k], ws.upper[k]);
+        }
+        let scale = PRIORITY_LENGTH / self.settings.length;
+        let priority = IkSettings {
+            length: PRIORITY_LENGTH,
+            epsilon: self.settings.epsilon * scale,
+            gamma_max: self.settings.gamma_max * scale,
+            ..self.settings.clone()
+        };
+        ws.active_set = true;
+        let run = run_rows(self.model, self.calibrated, target, &priority, ws, true);
+        ws.active_set = false;
+        std::mem::swap(&mut ws.lower, &mut lower);
+        std::mem::swap(&mut ws.upper, &mut upper);
+        let sigma_min = (!run.converged).then(|| {
+            let rows = match target {
+                IkTarget::Position(_) => 3,
+                IkTarget::Pose(_) => 6,
+            };
+            // `run_rows` left the kinematics of `ws.q` in `ws.data`.
+            task_jacobian_columns(
+                &ws.data,
+                self.settings.length,
+                &mut ws.columns,
+                &mut ws.corrected,
+            );
+            let s2 = if rows == 3 {
+                smallest_eigenvalue(&normal_matrix::<3>(&ws.columns), &mut ws.eigenvector)
+            } else {
+                smallest_eigenvalue(&normal_matrix::<6>(&ws.columns), &mut ws.eigenvector)
+            };
+            s2.sqrt()
+        });
+        IkResult {
+            q: ws.q.clone(),
+            status: if run.converged {
+                IkStatus::Converged
+            } else {
+                IkStatus::JointChangeLimit
+            },
+            iterations: run.iterations,
+            position_error: run.position_error,
+            orientation_error: run.orientation_error,
+            sigma_min,
+            limit: None,
+            change: None,
+            position_priority: true,
+        }
+    }
 }
+
+/// Characteristic length (mm) that weights orientation against position in
+/// [`CalibratedIk::solve_in_box`]: 1 mm, so that 1 mrad of orientation weighs as 1 µm of
+/// position (position priority), 1000× below the compensation's own L.
+pub const PRIORITY_LENGTH: f64 = 1.0;

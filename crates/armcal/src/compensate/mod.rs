@@ -5,6 +5,7 @@ pub mod closed_form;
 pub mod cmac;
 pub mod damped_step;
 pub mod ik;
+pub mod joint_change;
 pub mod lqr;
 pub mod nonparametric;
 pub mod program;

@@ -13,7 +13,8 @@
 //! targets if its header has orientation columns, a joint program otherwise, and returns the
 //! compensated program as CSV with a status per row.
 
-use crate::compensate::ik::{CalibratedIk, IkResult, IkSettings, IkTarget};
+use crate::compensate::ik::{CalibratedIk, IkResult, IkSettings, IkStatus, IkTarget};
+use crate::compensate::joint_change::{self, within_joint_change_limit};
 use crate::compensate::nonparametric::ResidualCorrection;
 use crate::measure::{csv, MeasurementKind};
 use crate::model::{forward_kinematics, Data, Model, Pose};
@@ -41,40 +42,98 @@ pub struct FilteredRow {
     pub correction: Vector3<f64>,
 }
 
-/// Applies the nonparametric correction to a solve for `pose` that gave `first`: re-solves
-/// for the target position shifted by `−ê(q)` (book §5.4), seeded with the previous
-/// solution. Returns the final result and the shift applied (zero without a correction).
-fn apply_correction(
-    ik: &mut CalibratedIk,
-    model: &Model,
-    calibrated: &[f64],
-    pose: &Pose<f64>,
-    first: IkResult,
-    correction: Option<&ResidualCorrection>,
-    data: &mut Data<f64>,
-) -> (IkResult, Vector3<f64>) {
-    let Some(corr) = correction else {
-        return (first, Vector3::zeros());
-    };
-    let mut result = first;
-    let mut shift = Vector3::zeros();
-    for _ in 0..CORRECTION_PASSES {
-        forward_kinematics(model, data, calibrated, &result.q);
-        shift = -corr.predict(&result.q, &data.tool().trans);
-        let shifted = Pose {
-            rot: pose.rot,
-            trans: pose.trans + shift,
-        };
-        let seed = std::mem::take(&mut result.q);
-        result = ik.solve_from(&IkTarget::Pose(shifted), &seed);
+/// What every row of a program shares: the calibrated IK, the nonparametric correction and
+/// the previous row's joint correction (for continuity within the joint-change limit).
+struct RowCompensator<'a> {
+    ik: CalibratedIk<'a>,
+    model: &'a Model,
+    calibrated: &'a [f64],
+    correction: Option<&'a ResidualCorrection>,
+    data: Data<f64>,
+    previous: Option<Vec<f64>>,
+}
+
+impl<'a> RowCompensator<'a> {
+    fn new(
+        model: &'a Model,
+        nominal: &[f64],
+        calibrated: &'a [f64],
+        settings: &IkSettings,
+        correction: Option<&'a ResidualCorrection>,
+    ) -> Self {
+        RowCompensator {
+            ik: CalibratedIk::new(model, nominal, calibrated, settings.clone()),
+            model,
+            calibrated,
+            correction,
+            data: Data::new(model),
+            previous: None,
+        }
     }
-    (result, shift)
+
+    /// `exact` (an unlimited solve for `target`) within the joint-change limit around the
+    /// `uncompensated` joints, if the row has them ([`within_joint_change_limit`]).
+    fn limited(
+        &mut self,
+        target: &IkTarget,
+        exact: IkResult,
+        uncompensated: Option<&[f64]>,
+    ) -> IkResult {
+        match uncompensated {
+            Some(q0) => within_joint_change_limit(
+                &mut self.ik,
+                self.model,
+                target,
+                exact,
+                q0,
+                self.previous.as_deref(),
+            ),
+            None => exact,
+        }
+    }
+
+    /// The row for `pose` whose unlimited solve gave `exact`: within the joint-change limit,
+    /// then with the nonparametric correction if any — re-solved for the target position
+    /// shifted by `−ê(q)` (book §5.4), seeded with the previous solution. Returns the final
+    /// result and the shift applied (zero without a correction), and keeps the row's joint
+    /// correction for the next row.
+    fn row(
+        &mut self,
+        pose: &Pose<f64>,
+        exact: IkResult,
+        uncompensated: Option<&[f64]>,
+    ) -> (IkResult, Vector3<f64>) {
+        let mut result = self.limited(&IkTarget::Pose(*pose), exact, uncompensated);
+        let mut shift = Vector3::zeros();
+        if let Some(corr) = self.correction {
+            for _ in 0..CORRECTION_PASSES {
+                forward_kinematics(self.model, &mut self.data, self.calibrated, &result.q);
+                shift = -corr.predict(&result.q, &self.data.tool().trans);
+                let shifted = IkTarget::Pose(Pose {
+                    rot: pose.rot,
+                    trans: pose.trans + shift,
+                });
+                let seed = std::mem::take(&mut result.q);
+                let exact = self.ik.solve_from(&shifted, &seed);
+                result = self.limited(&shifted, exact, uncompensated);
+            }
+        }
+        self.previous = match (uncompensated, result.status) {
+            (Some(q0), IkStatus::Converged | IkStatus::JointChangeLimit) => {
+                Some(joint_change::correction(self.model, q0, &result.q))
+            }
+            _ => None,
+        };
+        (result, shift)
+    }
 }
 
 /// (a) For each joint configuration of a nominal program, the joints with which the
-/// calibrated robot reaches the pose the nominal model predicts there (full tool pose).
-/// The row's own joints seed the solve: they are the exact nominal solution of that pose
-/// (the branch the program chose), so no closed form is needed.
+/// calibrated robot reaches the pose the nominal model predicts there (full tool pose),
+/// each joint changed by no more than [`IkSettings::joint_change_limit`]
+/// ([`crate::compensate::joint_change`]). The row's own joints seed the solve: they are
+/// the exact nominal solution of that pose (the branch the program chose), so no closed
+/// form is needed.
 pub fn filter_joint_program(
     model: &Model,
     nominal: &[f64],
@@ -94,17 +153,15 @@ pub fn filter_joint_program_corrected(
     settings: &IkSettings,
     correction: Option<&ResidualCorrection>,
 ) -> Vec<FilteredRow> {
+    let mut rc = RowCompensator::new(model, nominal, calibrated, settings, correction);
     let mut data = Data::new(model);
-    let mut ik = CalibratedIk::new(model, nominal, calibrated, settings.clone());
     program
         .iter()
         .map(|(id, q)| {
             forward_kinematics(model, &mut data, nominal, q);
             let target = *data.tool();
-            let first = ik.solve_from(&IkTarget::Pose(target), q);
-            let (result, applied) = apply_correction(
-                &mut ik, model, calibrated, &target, first, correction, &mut data,
-            );
+            let exact = rc.ik.solve_from(&IkTarget::Pose(target), q);
+            let (result, applied) = rc.row(&target, exact, Some(q));
             FilteredRow {
                 id: id.clone(),
                 q_nominal: q.clone(),
@@ -143,6 +200,17 @@ pub struct ProgramRecordRow {
     pub status: String,
     /// Remaining position error of the calibrated solve (mm).
     pub position_error_mm: f64,
+    /// Remaining orientation error of the calibrated solve (deg).
+    #[serde(default)]
+    pub orientation_error_deg: f64,
+    /// Whether the exact solution changes a joint by more than the joint-change limit
+    /// ([`IkStatus::JointChangeLimit`]): the row holds the position-priority solution within
+    /// the limit, which misses by the remaining errors.
+    #[serde(default)]
+    pub beyond_change_limit: bool,
+    /// Whether the row was solved with position priority within the joint-change limit.
+    #[serde(default)]
+    pub position_priority: bool,
 }
 
 impl ProgramRecord {
@@ -170,6 +238,9 @@ impl ProgramRecord {
                     converged: r.result.status.status().is_converged(),
                     status: r.result.describe(model),
                     position_error_mm: r.result.position_error,
+                    orientation_error_deg: r.result.orientation_error.to_degrees(),
+                    beyond_change_limit: r.result.status == IkStatus::JointChangeLimit,
+                    position_priority: r.result.position_priority,
                 })
                 .collect(),
         }
@@ -190,7 +261,11 @@ pub struct CorrectedTarget {
 /// (b) For each desired tool pose, the pose to send to a controller that uses the nominal
 /// model: the nominal model's pose at the calibrated solution. The solve starts from the
 /// nominal closed-form branch nearest `references[i]` (e.g. the controller's current or
-/// nominal joints) where the robot has a closed form, from `references[i]` otherwise.
+/// nominal joints) where the robot has a closed form, from `references[i]` otherwise; each
+/// joint changes by no more than [`IkSettings::joint_change_limit`] from the joints the
+/// controller would command with its nominal model
+/// ([`CalibratedIk::nominal_solution`]; no limit for a target the nominal model cannot
+/// solve).
 pub fn corrected_cartesian_targets(
     model: &Model,
     nominal: &[f64],
@@ -200,15 +275,16 @@ pub fn corrected_cartesian_targets(
     settings: &IkSettings,
     correction: Option<&ResidualCorrection>,
 ) -> Vec<CorrectedTarget> {
+    let mut rc = RowCompensator::new(model, nominal, calibrated, settings, correction);
     let mut data = Data::new(model);
-    let mut ik = CalibratedIk::new(model, nominal, calibrated, settings.clone());
     targets
         .iter()
         .zip(references)
         .map(|(t, reference)| {
-            let first = ik.solve(&IkTarget::Pose(*t), reference);
-            let (result, correction) =
-                apply_correction(&mut ik, model, calibrated, t, first, correction, &mut data);
+            let target = IkTarget::Pose(*t);
+            let exact = rc.ik.solve(&target, reference);
+            let uncompensated = rc.ik.nominal_solution(&target, reference);
+            let (result, correction) = rc.row(t, exact, uncompensated.as_deref());
             forward_kinematics(model, &mut data, nominal, &result.q);
             CorrectedTarget {
                 pose: *data.tool(),
@@ -228,9 +304,16 @@ pub struct CompensatedProgram {
     pub rows: usize,
     /// Rows whose solve did not converge (their status column says why).
     pub not_converged: usize,
+    /// Of those, rows whose exact solution changes a joint by more than the joint-change
+    /// limit ([`IkStatus::JointChangeLimit`]).
+    pub beyond_change_limit: usize,
+    /// Rows solved with position priority within the joint-change limit (converged or
+    /// not; [`crate::compensate::joint_change`]).
+    pub position_priority: usize,
     /// The output CSV: `pose_id`, the joints, for Cartesian targets the pose to send, with a
     /// correction the `correction_*_mm` shift, then `status`, `position_error_mm`,
-    /// `orientation_error_deg`.
+    /// `orientation_error_deg`, `solution` (`calibrated-ik`, or `position-priority` for a
+    /// row solved within the joint-change limit).
     pub csv: String,
 }
 
@@ -289,7 +372,15 @@ pub fn compensate_program(
         if with {
             h.extend(["correction_x_mm", "correction_y_mm", "correction_z_mm"].map(String::from));
         }
-        h.extend(["status", "position_error_mm", "orientation_error_deg"].map(String::from));
+        h.extend(
+            [
+                "status",
+                "position_error_mm",
+                "orientation_error_deg",
+                "solution",
+            ]
+            .map(String::from),
+        );
         h
     };
     // A row: its id, the solved joints, `middle` (the target), the correction and status.
@@ -308,10 +399,21 @@ pub fn compensate_program(
             r.describe(model),
             format!("{:.9}", r.position_error),
             format!("{:.9}", r.orientation_error.to_degrees()),
+            if r.position_priority {
+                "position-priority"
+            } else {
+                "calibrated-ik"
+            }
+            .to_string(),
         ]);
         fields
     };
-    let mut failed = 0;
+    let (mut failed, mut beyond, mut priority) = (0, 0, 0);
+    let mut count = |r: &IkResult| {
+        failed += usize::from(!r.status.status().is_converged());
+        beyond += usize::from(r.status == IkStatus::JointChangeLimit);
+        priority += usize::from(r.position_priority);
+    };
     let out = if cartesian {
         // Read the tool poses with a robot-only model: rows become world-frame poses.
         let mut robot_only = model.spec();
@@ -348,7 +450,7 @@ pub fn compensate_program(
         ]));
         for (i, r) in rows.iter().enumerate() {
             let (xyz, rpy) = r.pose.to_xyz_rpy();
-            failed += usize::from(!r.result.status.status().is_converged());
+            count(&r.result);
             let target = [xyz[0], xyz[1], xyz[2]]
                 .into_iter()
                 .chain(rpy.iter().map(|a| a.to_degrees()))
@@ -369,7 +471,7 @@ pub fn compensate_program(
         );
         let mut out = Table::new(header(&[]));
         for r in &rows {
-            failed += usize::from(!r.result.status.status().is_converged());
+            count(&r.result);
             out.row(row(&r.id, &r.result, Vec::new(), &r.correction));
         }
         out
@@ -378,6 +480,8 @@ pub fn compensate_program(
         cartesian,
         rows: program.rows.len(),
         not_converged: failed,
+        beyond_change_limit: beyond,
+        position_priority: priority,
         csv: out.into_string(),
     })
 }

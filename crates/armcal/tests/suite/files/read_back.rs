@@ -202,7 +202,8 @@ fn compensated_programs_read_back_in_the_program_reader() {
                         "joint-limits: ",
                         "singular: ",
                         "unreachable: ",
-                        "max-iterations: "
+                        "max-iterations: ",
+                        "joint-change-limit: "
                     ]
                     .iter()
                     .any(|p| s.starts_with(p))
