@@ -92,8 +92,8 @@ fn largest_violation(
         let change = joint_change(j.kind, *a, *b);
         let lim = limit.of(j.kind);
         let factor = change.abs() / lim;
-        // `!(factor <= 1)` also catches a non-finite change.
-        if !(factor <= 1.0) && worst.as_ref().is_none_or(|(f, _)| factor > *f) {
+        // A non-finite change is a violation too.
+        if (factor.is_nan() || factor > 1.0) && worst.as_ref().is_none_or(|(f, _)| factor > *f) {
             worst = Some((
                 factor,
                 ChangeViolation {
@@ -147,7 +147,7 @@ pub fn within_joint_change_limit(
         }
         let lim = limit.of(j.kind);
         let (a, b) = ((centre - lim).max(lo), (centre + lim).min(hi));
-        if !(a <= b) {
+        if a.is_nan() || b.is_nan() || a > b {
             return exact;
         }
         lower.push(a);

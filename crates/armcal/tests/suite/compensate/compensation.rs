@@ -424,3 +424,76 @@ fn a_filtered_program_compensates_the_sag_and_gear_errors_a_kinematic_calibratio
     assert!(with_terms <= 2.0 * predicted, "{with_terms} vs {predicted}");
     assert!(without > 3.0 * with_terms, "{without} vs {with_terms}");
 }
+
+/// The joint-change limit holds on other chains than the paper robot's (a KUKA, the PUMA
+/// 560, the UR10: each loses a wrist direction where two joint axes align): a program through
+/// that singularity, compensated with a perturbed robot, changes every joint by at most the
+/// limit; the rows that cannot meet the tolerance within it are `JointChangeLimit` with the
+/// position kept, recognised as near a singularity from the Jacobian; with no limit the same
+/// program whips the wrist.
+#[test]
+fn the_joint_change_limit_holds_through_the_wrist_singularity_of_any_chain() {
+    use armcal::compensate::joint_change::{joint_change, JointChangeLimit};
+    for name in ["kr15", "puma560", "ur10"] {
+        let model = Model::from_spec(&robots::robot(name).unwrap().spec).unwrap();
+        let nominal = model.nominal();
+        let calibrated = perturbed_truth(&model, &Perturbation::default(), 21);
+        let posture = &random_configurations(&model, 1, 22)[0];
+        let program: Vec<(String, Vec<f64>)> = [2.0, 1.0, 0.5, 0.2, 0.0, -0.2, -0.5, -1.0, -2.0]
+            .iter()
+            .map(|q5: &f64| {
+                let mut q = posture.clone();
+                q[4] = q5.to_radians();
+                (format!("{q5}"), q)
+            })
+            .collect();
+        let settings = IkSettings::default();
+        let rows = filter_joint_program(&model, &nominal, &calibrated, &program, &settings);
+        let limit = settings.joint_change_limit;
+        let mut limited = 0;
+        for row in &rows {
+            let r = &row.result;
+            for (k, j) in model.joints.iter().enumerate() {
+                let change = joint_change(j.kind, row.q_nominal[k], r.q[k]).abs();
+                assert!(change <= limit.of(j.kind) + 1e-12, "{name}: {row:?}");
+            }
+            match r.status {
+                IkStatus::Converged => {
+                    assert!(r.position_error <= 1e-6 && r.orientation_error <= 1e-9)
+                }
+                IkStatus::JointChangeLimit => {
+                    limited += 1;
+                    assert!(
+                        r.position_priority && r.position_error < 1e-3,
+                        "{name}: {r:?}"
+                    );
+                    assert!(r.change.is_some(), "{name}: {r:?}");
+                }
+                _ => panic!("{name}: {row:?}"),
+            }
+        }
+        let singular = rows
+            .iter()
+            .filter(|r| r.result.change.is_some_and(|c| c.singular))
+            .count();
+        let wide = IkSettings {
+            joint_change_limit: JointChangeLimit {
+                revolute: 4.0 * PI,
+                prismatic: 1e6,
+            },
+            ..IkSettings::default()
+        };
+        let unlimited = filter_joint_program(&model, &nominal, &calibrated, &program, &wide);
+        let whip = unlimited
+            .iter()
+            .map(|r| angle_gap(&r.result.q, &r.q_nominal).to_degrees())
+            .fold(0.0, f64::max);
+        eprintln!(
+            "{name}: {limited} of {} rows beyond the 5° limit ({singular} near a singularity); \
+             unlimited, the wrist swings by up to {whip:.1}°",
+            rows.len()
+        );
+        assert!(limited >= 2 && singular >= 1, "{name}: {rows:?}");
+        assert!(whip > 10.0, "{name}");
+    }
+}
