@@ -113,12 +113,12 @@ fn largest_violation(
 /// row), `uncompensated` the row's uncompensated joints, `previous` the previous row's
 /// correction (compensated − uncompensated joints) if it has one.
 ///
-/// `exact` is returned as it is when it changes no joint beyond the limit, and when it is
-/// [`IkStatus::JointLimits`] or [`IkStatus::Unreachable`] (the robot cannot reach the
-/// target at all: that diagnosis stands), or when the uncompensated joints lie further than
-/// the limit outside the joint limits (there is no box to solve in). Otherwise the
-/// position-priority solution within the box is returned (converged or
-/// [`IkStatus::JointChangeLimit`], with [`IkResult::change`] set).
+/// `exact` is returned as it is when it changes no joint beyond the limit, or when the
+/// uncompensated joints lie further than the limit outside the joint limits (there is no
+/// box to solve in). Otherwise the position-priority solution within the box is returned:
+/// converged, or not with [`IkResult::change`] set and the status
+/// [`IkStatus::JointChangeLimit`] — [`IkStatus::JointLimits`] or [`IkStatus::Unreachable`]
+/// if `exact` had it (the robot cannot reach the target at all: that diagnosis stands).
 pub fn within_joint_change_limit(
     ik: &mut CalibratedIk,
     model: &Model,
@@ -127,9 +127,6 @@ pub fn within_joint_change_limit(
     uncompensated: &[f64],
     previous: Option<&[f64]>,
 ) -> IkResult {
-    if matches!(exact.status, IkStatus::JointLimits | IkStatus::Unreachable) {
-        return exact;
-    }
     let limit = ik.settings().joint_change_limit;
     let Some(mut violation) = largest_violation(model, &limit, uncompensated, &exact.q) else {
         return exact;
@@ -180,6 +177,11 @@ pub fn within_joint_change_limit(
     if limited.status != IkStatus::Converged {
         violation.singular = limited.sigma_min.is_some_and(|s| s < ik.settings().epsilon);
         limited.change = Some(violation);
+        if matches!(exact.status, IkStatus::JointLimits | IkStatus::Unreachable) {
+            // The robot cannot reach the target at all: that diagnosis stands.
+            limited.status = exact.status;
+            limited.limit = exact.limit;
+        }
     }
     limited
 }

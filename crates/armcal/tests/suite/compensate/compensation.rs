@@ -469,7 +469,8 @@ fn the_joint_change_limit_holds_through_the_wrist_singularity_of_any_chain() {
                     );
                     assert!(r.change.is_some(), "{name}: {r:?}");
                 }
-                _ => panic!("{name}: {row:?}"),
+                // A stall the exact solve reported keeps its status, within the limit.
+                _ => assert!(r.position_priority, "{name}: {row:?}"),
             }
         }
         let singular = rows
