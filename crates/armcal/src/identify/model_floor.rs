@@ -57,7 +57,8 @@ pub struct TcpFloor {
     pub covariance: Matrix3<f64>,
     /// (1/3) tr C_floor (mm²), the floor's part of the KPI.
     pub kpi: f64,
-    /// Each fixed parameter's part of (1/3) tr C_floor (mm²), largest first; only non-zero.
+    /// Each fixed parameter's part of (1/3) tr C_floor (mm²), largest first; only those above
+    /// 10⁻⁹ of the total (the rest is rounding of a part the free parameters absorb).
     pub contributions: Vec<(String, f64)>,
 }
 
@@ -120,6 +121,9 @@ pub fn model_floor(
             let kw = k.rows(3 * w, 3);
             let scaled = DMatrix::from_fn(3, fixed.len(), |r, c| kw[(r, c)] * sigma[c]);
             let covariance: Matrix3<f64> = (&scaled * scaled.transpose()).fixed_view::<3, 3>(0, 0).into_owned();
+            let kpi = covariance.trace() / 3.0;
+            // A parameter the free ones absorb at the TCP leaves rounding (≈ 1e-13 of the
+            // total); what is below 1e-9 of it counts as nothing.
             let mut contributions: Vec<(String, f64)> = fixed
                 .iter()
                 .enumerate()
@@ -127,12 +131,12 @@ pub fn model_floor(
                     let part = scaled.column(c).norm_squared() / 3.0;
                     (model.registry.get(i).name.clone(), part)
                 })
-                .filter(|(_, part)| *part > 0.0)
+                .filter(|(_, part)| *part > 1e-9 * kpi)
                 .collect();
             contributions.sort_by(|a, b| b.1.total_cmp(&a.1));
             TcpFloor {
                 name: pose.name.clone(),
-                kpi: covariance.trace() / 3.0,
+                kpi,
                 covariance,
                 contributions,
             }
