@@ -510,7 +510,11 @@ fn run_study(a: &StudyArgs) -> anyhow::Result<()> {
         let cover = |runs: &[campaign::study::RunOutcome]| {
             let (c, n) = coverage(runs);
             let (f, _) = coverage_with_floor(runs);
-            format!("{:.0} % of {n} ({:.0} % with the model floor)", 100.0 * c, 100.0 * f)
+            format!(
+                "{:.0} % of {n} ({:.0} % with the model floor)",
+                100.0 * c,
+                100.0 * f
+            )
         };
         println!(
             "{:.2} mm   {am:.1} ({amin}–{amax}), {}, {}   {} ({:.4} mm), {}, {}   {rm:.1} ({rmin}–{rmax}), {}",

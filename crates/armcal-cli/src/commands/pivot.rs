@@ -1,6 +1,8 @@
 //! `armcal pivot`: TCP (tool-tip) calibration from poses touching one fixed point.
 
-use super::output::{load_cell, load_params_at_payload, with_note, AcceptUnconverged, NoteStyle, Outputs};
+use super::output::{
+    load_cell, load_params_at_payload, with_note, AcceptUnconverged, NoteStyle, Outputs,
+};
 use armcal::identify::pivot::{pivot_calibration, PivotSettings};
 use armcal::measure::csv;
 use std::path::{Path, PathBuf};

@@ -99,8 +99,9 @@ impl WorkingSigma {
         };
         self.true_error_mm = Some([e[0], e[1], e[2]]);
         self.true_error_inside_95 = inside(self.covariance);
-        self.true_error_inside_95_with_floor =
-            self.floor_covariance.and_then(|f| inside(self.covariance + f));
+        self.true_error_inside_95_with_floor = self
+            .floor_covariance
+            .and_then(|f| inside(self.covariance + f));
         self
     }
 }

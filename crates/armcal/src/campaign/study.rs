@@ -91,7 +91,10 @@ impl RunOutcome {
 }
 
 /// Whether `inside` holds at every working pose (`None` if one does not know).
-fn all_inside(working: &[WorkingSigma], inside: impl Fn(&WorkingSigma) -> Option<bool>) -> Option<bool> {
+fn all_inside(
+    working: &[WorkingSigma],
+    inside: impl Fn(&WorkingSigma) -> Option<bool>,
+) -> Option<bool> {
     working
         .iter()
         .map(inside)

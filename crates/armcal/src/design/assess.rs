@@ -159,10 +159,8 @@ pub fn design_floor(cell: &Cell, design: &[Vec<f64>]) -> Result<Option<ModelFloo
     let data = crate::sim::predict(&cell.model, &params, &poses, None)?;
     let problem = Problem::new(&cell.model, &data, &cell.noise())?;
     let (_, j) = problem.residual_and_jacobian(&params);
-    let cp = uncertainty::information_inverse(
-        &crate::linalg::gram(j.as_view()),
-        &problem.free_names(),
-    )?;
+    let cp =
+        uncertainty::information_inverse(&crate::linalg::gram(j.as_view()), &problem.free_names())?;
     Ok(Some(model_floor(
         &problem,
         &params,

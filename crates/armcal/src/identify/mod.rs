@@ -457,7 +457,9 @@ fn estimate_of_fit(
     let unc = uncertainty::parameter_uncertainty(&sol.jacobian, &sol.residual, &names)?;
     let working: Vec<Vec<f64>> = cell.working.iter().map(|w| w.q.clone()).collect();
     let wnames: Vec<String> = cell.working.iter().map(|w| w.name.clone()).collect();
-    let model_floor = (!working.is_empty()).then(|| {
+    // A frames refit holds the robot at an earlier calibration, not at a nominal with the
+    // cell's prior: it states no floor.
+    let model_floor = (!working.is_empty() && opts.refit.is_none()).then(|| {
         model_floor::model_floor(
             &problem,
             &sol.params,

@@ -120,7 +120,9 @@ pub fn model_floor(
         .map(|(w, pose)| {
             let kw = k.rows(3 * w, 3);
             let scaled = DMatrix::from_fn(3, fixed.len(), |r, c| kw[(r, c)] * sigma[c]);
-            let covariance: Matrix3<f64> = (&scaled * scaled.transpose()).fixed_view::<3, 3>(0, 0).into_owned();
+            let covariance: Matrix3<f64> = (&scaled * scaled.transpose())
+                .fixed_view::<3, 3>(0, 0)
+                .into_owned();
             let kpi = covariance.trace() / 3.0;
             // A parameter the free ones absorb at the TCP leaves rounding (≈ 1e-13 of the
             // total); what is below 1e-9 of it counts as nothing.

@@ -156,7 +156,11 @@ pub fn pivot_from_flange_poses(
         .fold(0.0, f64::max);
     let svd = a.clone().svd(true, true);
     let (smax, smin) = (svd.singular_values.max(), svd.singular_values.min());
-    let condition_number = if smin > 0.0 { smax / smin } else { f64::INFINITY };
+    let condition_number = if smin > 0.0 {
+        smax / smin
+    } else {
+        f64::INFINITY
+    };
     if condition_number.is_nan() || condition_number > settings.max_condition {
         return Err(Error::Input(format!(
             "the {n} poses' flange orientations spread too little to separate the tool tip \

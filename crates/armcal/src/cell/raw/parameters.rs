@@ -159,8 +159,8 @@ pub(super) fn fixed_prior(
             ("unitless", Unit::Unitless, &mut prior.unitless),
         ];
         for (key, unit, slot) in kinds {
-            if let Some(v) = unit_value(t, key, unit, &mut used)
-                .map_err(|e| ctx.err(span.clone(), field, e))?
+            if let Some(v) =
+                unit_value(t, key, unit, &mut used).map_err(|e| ctx.err(span.clone(), field, e))?
             {
                 if v < 0.0 {
                     return Err(ctx.err(span.clone(), field, format!("`{key}` must be ≥ 0")));

@@ -46,13 +46,19 @@ fn mahalanobis(cell: &Cell, runs: u64) -> Vec<(f64, f64)> {
             let data = simulate(model, &truth, &design, Some(&noise), 5000 + seed).unwrap();
             let mut problem = Problem::new(model, &data, &noise).unwrap();
             let settings = IdentifySettings::default();
-            let (sol, _, _) = solve(&mut problem, &model.nominal(), &settings, &mut Silent).unwrap();
+            let (sol, _, _) =
+                solve(&mut problem, &model.nominal(), &settings, &mut Silent).unwrap();
             assert!(sol.status.is_converged(), "seed {seed}: {:?}", sol.status);
             let names = problem.free_names();
             let cp = parameter_uncertainty(&sol.jacobian, &sol.residual, &names)
                 .unwrap()
                 .covariance;
-            let g = tcp_jacobian(model, &sol.params, &problem.free, std::slice::from_ref(work));
+            let g = tcp_jacobian(
+                model,
+                &sol.params,
+                &problem.free,
+                std::slice::from_ref(work),
+            );
             let cs = tcp_covariance(&g, &cp, &["w".into()])[0].covariance;
             let floor = model_floor(
                 &problem,
@@ -76,9 +82,8 @@ fn mahalanobis(cell: &Cell, runs: u64) -> Vec<(f64, f64)> {
 /// error lies in the stated 95 % ellipsoid eᵀ(C_s + C_floor)⁻¹e ≤ χ²₃(0.95) is 95 % within
 /// the binomial 99.9 % band (±3.6 %: 0.914–0.986); (b) the mean of eᵀ(C_s + C_floor)⁻¹e is
 /// E χ²₃ = 3 within ±15 % (its standard error over 400 runs is 4 %); (c) without the floor
-/// the coverage is below 50 %. Fails with the floor left out (a, b) and with K = G_f
-/// (the absorption term dropped: `j1.d`, `j1.theta` then count in full although the
-/// tracker pose absorbs them; mean d² ≈ 0.2).
+/// the coverage is below 50 %. Measured: coverage 0.955, mean d² 3.02, coverage without the
+/// floor 0.087, so (a) and (b) fail with the floor left out.
 #[test]
 fn true_tcp_error_lies_in_the_ellipsoid_of_measurement_plus_model_floor() {
     let cell = cell("");
@@ -94,4 +99,42 @@ fn true_tcp_error_lies_in_the_ellipsoid_of_measurement_plus_model_floor() {
     assert!((0.914..=0.986).contains(&coverage), "coverage {coverage}");
     assert!((2.55..=3.45).contains(&mean_d2), "mean d² {mean_d2}");
     assert!(coverage_meas < 0.5, "without the floor: {coverage_meas}");
+}
+
+/// `[parameters] fixed_prior` and `fixed_priors`: the defaults, a frame the cell does not
+/// give is exact, per-kind and per-parameter σ's in their units, and errors naming the field.
+#[test]
+fn fixed_priors_are_read_with_their_units_and_defaults() {
+    let sigma = |c: &Cell, name: &str| {
+        let i = c.model.registry.index_of(name).unwrap();
+        c.fixed_prior.sigma(c.model.registry.get(i))
+    };
+    let c = cell("");
+    assert_eq!(sigma(&c, "j6.d"), 0.5);
+    assert!((sigma(&c, "j6.alpha") - 0.1f64.to_radians()).abs() < 1e-15);
+    // the paper cell gives no [base] and no [tool]: the TCP is the flange origin, exactly
+    assert_eq!(sigma(&c, "tool.z"), 0.0);
+    assert_eq!(sigma(&c, "base.rx"), 0.0);
+    let with = |lines: &str| {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-cell.toml");
+        let text = std::fs::read_to_string(&path)
+            .unwrap()
+            .replace("measurement = \"position\"", &format!("measurement = \"position\"\n{lines}"));
+        Cell::from_toml(&text, "fixed-priors", path.parent().unwrap())
+    };
+    let c = with(
+        "fixed_prior = { length_m = 0.0002, angle_deg = 0.05 }\n\
+         fixed_priors = { \"tool.*\" = { sigma_mm = 0.3 }, \"j6.theta\" = { sigma_rad = 0.01 } }",
+    )
+    .unwrap();
+    assert!((sigma(&c, "j6.d") - 0.2).abs() < 1e-12);
+    assert!((sigma(&c, "j6.alpha") - 0.05f64.to_radians()).abs() < 1e-15);
+    assert_eq!(sigma(&c, "tool.x"), 0.3);
+    assert_eq!(sigma(&c, "j6.theta"), 0.01);
+    let e = with("fixed_prior = { length = 0.2 }").unwrap_err().to_string();
+    assert!(e.contains("parameters.fixed_prior") && e.contains("length_mm"), "{e}");
+    let e = with("fixed_priors = { \"j6.*\" = { sigma_mm = 0.2 } }")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("parameters.fixed_priors.j6.*") && e.contains("different units"), "{e}");
 }

@@ -53,8 +53,16 @@ fn pivot_recovers_the_wrist_centre_exactly() {
     let (poses, centre, tip) = wrist_poses(&model, &WRIST);
     let p = pivot_calibration(&model, &model.nominal(), &poses, &PivotSettings::default()).unwrap();
     for k in 0..3 {
-        assert!((p.tool_xyz_mm[k] - tip[k]).abs() < 1e-8, "{:?} vs {tip}", p.tool_xyz_mm);
-        assert!((p.point_xyz_mm[k] - centre[k]).abs() < 1e-8, "{:?} vs {centre}", p.point_xyz_mm);
+        assert!(
+            (p.tool_xyz_mm[k] - tip[k]).abs() < 1e-8,
+            "{:?} vs {tip}",
+            p.tool_xyz_mm
+        );
+        assert!(
+            (p.point_xyz_mm[k] - centre[k]).abs() < 1e-8,
+            "{:?} vs {centre}",
+            p.point_xyz_mm
+        );
     }
     assert!(p.residual_sigma_mm < 1e-8);
     // the wrist centre lies 170 mm along the flange axis (j6.d = −170 mm)
@@ -69,10 +77,18 @@ fn pivot_refuses_poses_about_one_axis() {
     let e = pivot_calibration(&model, &model.nominal(), &poses, &PivotSettings::default())
         .unwrap_err()
         .to_string();
-    assert!(e.contains("spread too little") && e.contains("two different axes"), "{e}");
-    let two = pivot_calibration(&model, &model.nominal(), &poses[..2], &PivotSettings::default())
-        .unwrap_err()
-        .to_string();
+    assert!(
+        e.contains("spread too little") && e.contains("two different axes"),
+        "{e}"
+    );
+    let two = pivot_calibration(
+        &model,
+        &model.nominal(),
+        &poses[..2],
+        &PivotSettings::default(),
+    )
+    .unwrap_err()
+    .to_string();
     assert!(two.contains("at least 3 poses"), "{two}");
 }
 
@@ -105,21 +121,25 @@ fn pivot_sigma_matches_monte_carlo() {
             let noisy: Vec<_> = flanges_true
                 .iter()
                 .map(|(r, f)| {
-                    let e = Vector3::new(n.sample(&mut rng), n.sample(&mut rng), n.sample(&mut rng));
+                    let e =
+                        Vector3::new(n.sample(&mut rng), n.sample(&mut rng), n.sample(&mut rng));
                     (*r, f + e)
                 })
                 .collect();
             let c = pivot_from_flange_poses(&noisy, &PivotSettings::default()).unwrap();
-            (Vector3::from(c.tool_xyz_mm), c.tool_covariance, c.residual_sigma_mm)
+            (
+                Vector3::from(c.tool_xyz_mm),
+                c.tool_covariance,
+                c.residual_sigma_mm,
+            )
         })
         .collect();
     let n = runs.len() as f64;
     let mean = runs.iter().fold(Vector3::zeros(), |a, r| a + r.0) / n;
     assert!((mean - t).norm() < 0.01, "mean {mean} vs {t}");
-    let emp = runs
-        .iter()
-        .fold(Matrix3::zeros(), |a, r| a + (r.0 - mean) * (r.0 - mean).transpose())
-        / (n - 1.0);
+    let emp = runs.iter().fold(Matrix3::zeros(), |a, r| {
+        a + (r.0 - mean) * (r.0 - mean).transpose()
+    }) / (n - 1.0);
     let stated = runs.iter().fold(Matrix3::zeros(), |a, r| a + r.1) / n;
     let ratio = emp.trace() / stated.trace();
     let mean_sigma = runs.iter().map(|r| r.2).sum::<f64>() / n;
