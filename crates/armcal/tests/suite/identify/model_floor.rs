@@ -117,9 +117,10 @@ fn fixed_priors_are_read_with_their_units_and_defaults() {
     assert_eq!(sigma(&c, "base.rx"), 0.0);
     let with = |lines: &str| {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-cell.toml");
-        let text = std::fs::read_to_string(&path)
-            .unwrap()
-            .replace("measurement = \"position\"", &format!("measurement = \"position\"\n{lines}"));
+        let text = std::fs::read_to_string(&path).unwrap().replace(
+            "measurement = \"position\"",
+            &format!("measurement = \"position\"\n{lines}"),
+        );
         Cell::from_toml(&text, "fixed-priors", path.parent().unwrap())
     };
     let c = with(
@@ -131,10 +132,18 @@ fn fixed_priors_are_read_with_their_units_and_defaults() {
     assert!((sigma(&c, "j6.alpha") - 0.05f64.to_radians()).abs() < 1e-15);
     assert_eq!(sigma(&c, "tool.x"), 0.3);
     assert_eq!(sigma(&c, "j6.theta"), 0.01);
-    let e = with("fixed_prior = { length = 0.2 }").unwrap_err().to_string();
-    assert!(e.contains("parameters.fixed_prior") && e.contains("length_mm"), "{e}");
+    let e = with("fixed_prior = { length = 0.2 }")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("parameters.fixed_prior") && e.contains("length_mm"),
+        "{e}"
+    );
     let e = with("fixed_priors = { \"j6.*\" = { sigma_mm = 0.2 } }")
         .unwrap_err()
         .to_string();
-    assert!(e.contains("parameters.fixed_priors.j6.*") && e.contains("different units"), "{e}");
+    assert!(
+        e.contains("parameters.fixed_priors.j6.*") && e.contains("different units"),
+        "{e}"
+    );
 }
