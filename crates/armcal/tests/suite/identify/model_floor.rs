@@ -125,12 +125,13 @@ fn fixed_priors_are_read_with_their_units_and_defaults() {
     };
     let c = with(
         "fixed_prior = { length_m = 0.0002, angle_deg = 0.05 }\n\
-         fixed_priors = { \"tool.*\" = { sigma_mm = 0.3 }, \"j6.theta\" = { sigma_rad = 0.01 } }",
+         fixed_priors = { \"tool.z\" = { sigma_mm = 0.3 }, \"j6.theta\" = { sigma_rad = 0.01 } }",
     )
     .unwrap();
     assert!((sigma(&c, "j6.d") - 0.2).abs() < 1e-12);
     assert!((sigma(&c, "j6.alpha") - 0.05f64.to_radians()).abs() < 1e-15);
-    assert_eq!(sigma(&c, "tool.x"), 0.3);
+    assert_eq!(sigma(&c, "tool.z"), 0.3);
+    assert_eq!(sigma(&c, "tool.x"), 0.0);
     assert_eq!(sigma(&c, "j6.theta"), 0.01);
     let e = with("fixed_prior = { length = 0.2 }")
         .unwrap_err()
