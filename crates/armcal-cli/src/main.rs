@@ -48,6 +48,9 @@ enum Command {
     Compensate(commands::compensate::Args),
     /// ISO 9283 accuracy and repeatability, and a model's errors, from a data file.
     Accuracy(commands::accuracy::Args),
+    /// TCP (tool-tip) calibration: the tool tip in the flange frame, with σ, from poses that
+    /// touch one fixed point (pivot calibration).
+    Pivot(commands::pivot::Args),
     /// Joint axes by circle point analysis from one-joint-at-a-time sweeps.
     Axes(commands::axes::Args),
     /// Export the calibrated model (cell file with DH / modified-DH / zero-reference links, JSON, URDF).
@@ -90,6 +93,7 @@ fn main() {
         Command::Compensate(a) => commands::compensate::run(&a),
         Command::Accuracy(a) => commands::accuracy::run(&a),
         Command::Axes(a) => commands::axes::run(&a),
+        Command::Pivot(a) => commands::pivot::run(&a),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

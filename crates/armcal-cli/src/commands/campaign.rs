@@ -6,7 +6,7 @@
 use super::output::{load_cell, load_data, with_note, NoteStyle, Outputs};
 use super::progress::Progress;
 use anyhow::Context;
-use armcal::campaign::study::{coverage, poses_summary, StudySettings};
+use armcal::campaign::study::{coverage, coverage_with_floor, poses_summary, StudySettings};
 use armcal::campaign::{self, CampaignSettings, CampaignState, CampaignStep, Decision, Planner};
 use armcal::measure::csv;
 use armcal::sim::Perturbation;
@@ -119,6 +119,10 @@ pub struct SimulateArgs {
     /// Output directory (campaign.json, estimate.json, truth.json).
     #[arg(long)]
     pub out: PathBuf,
+    /// Perturb the virtual robot's fixed parameters by the cell's stated prior too
+    /// (`[parameters] fixed_prior`, `fixed_priors`): the coverage then tests the model floor.
+    #[arg(long)]
+    pub perturb_fixed: bool,
     /// Overwrite existing output files.
     #[arg(long)]
     pub force: bool,
@@ -141,6 +145,10 @@ pub struct StudyArgs {
     /// Poses per batch of the adaptive and the random campaign.
     #[arg(long, default_value_t = 5)]
     pub batch: usize,
+    /// Perturb the virtual robot's fixed parameters by the cell's stated prior too
+    /// (`[parameters] fixed_prior`, `fixed_priors`): the coverage then tests the model floor.
+    #[arg(long)]
+    pub perturb_fixed: bool,
     /// Output record (JSON).
     #[arg(long)]
     pub out: PathBuf,
@@ -346,6 +354,18 @@ fn print_step(k: usize, s: &CampaignStep) {
                 _ => String::new(),
             }
         );
+        if let Some(f) = w.floor_sigma_mm {
+            println!(
+                "    model floor (fixed parameters at their stated prior): σ = {f:.4} mm, not reduced by more poses{}",
+                match w.true_error_inside_95_with_floor {
+                    Some(inside) => format!(
+                        "; true error {} the ellipsoid of C_s + C_floor",
+                        if inside { "inside" } else { "outside" }
+                    ),
+                    None => String::new(),
+                }
+            );
+        }
     }
 }
 
@@ -425,7 +445,10 @@ fn run_simulate(a: &SimulateArgs) -> anyhow::Result<()> {
         &cell,
         &a.target.source(),
         &a.target.settings(a.seed),
-        &Perturbation::default(),
+        &Perturbation {
+            fixed: a.perturb_fixed.then(|| cell.fixed_prior.clone()),
+            ..Perturbation::default()
+        },
         a.seed,
         &mut Progress::new(a.quiet),
     )?;
@@ -463,6 +486,7 @@ fn run_study(a: &StudyArgs) -> anyhow::Result<()> {
             targets: a.targets.clone(),
             runs: a.runs,
             batch: a.batch,
+            perturb_fixed: a.perturb_fixed,
             ..StudySettings::default()
         },
         &mut Progress::new(a.quiet),
@@ -485,7 +509,12 @@ fn run_study(a: &StudyArgs) -> anyhow::Result<()> {
         };
         let cover = |runs: &[campaign::study::RunOutcome]| {
             let (c, n) = coverage(runs);
-            format!("{:.0} % of {n}", 100.0 * c)
+            let (f, _) = coverage_with_floor(runs);
+            format!(
+                "{:.0} % of {n} ({:.0} % with the model floor)",
+                100.0 * c,
+                100.0 * f
+            )
         };
         println!(
             "{:.2} mm   {am:.1} ({amin}–{amax}), {}, {}   {} ({:.4} mm), {}, {}   {rm:.1} ({rmin}–{rmax}), {}",

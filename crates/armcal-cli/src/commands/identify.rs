@@ -239,6 +239,34 @@ pub fn print_summary(e: &Estimate) {
             decimals_or_digits(t.kpi, 5),
             decimals_or_digits(c.trace() / 3.0, 5)
         );
+        if let Some(f) = e.model_floor.as_ref().and_then(|f| f.at(&t.name)) {
+            let total = t.covariance + f.covariance;
+            let largest: Vec<String> = f
+                .contributions
+                .iter()
+                .take(3)
+                .map(|(n, v)| format!("{n} {}", decimals_or_digits(*v, 5)))
+                .collect();
+            println!(
+                "  model floor (fixed parameters at their stated prior): σ = ({}, {}, {}) mm, (1/3) tr C_floor = {} mm²{}",
+                decimals_or_digits(f.covariance[(0, 0)].sqrt(), 4),
+                decimals_or_digits(f.covariance[(1, 1)].sqrt(), 4),
+                decimals_or_digits(f.covariance[(2, 2)].sqrt(), 4),
+                decimals_or_digits(f.kpi, 5),
+                if largest.is_empty() {
+                    String::new()
+                } else {
+                    format!(" (largest: {} mm²)", largest.join(", "))
+                }
+            );
+            println!(
+                "  total (C_s + C_floor): σ = ({}, {}, {}) mm, (1/3) tr = {} mm²",
+                decimals_or_digits(total[(0, 0)].sqrt(), 4),
+                decimals_or_digits(total[(1, 1)].sqrt(), 4),
+                decimals_or_digits(total[(2, 2)].sqrt(), 4),
+                decimals_or_digits(total.trace() / 3.0, 5)
+            );
+        }
     }
     let o = &e.observability;
     println!(

@@ -13,6 +13,7 @@ pub mod identify;
 pub mod import;
 pub mod model;
 pub mod output;
+pub mod pivot;
 pub mod plan;
 pub mod predict;
 pub mod progress;

@@ -196,9 +196,10 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
     }
     for t in &record.assessment.tcp {
         println!(
-            "(1/3) tr C_s at `{}`: {} mm²",
+            "(1/3) tr C_s at `{}`: {} mm²{}",
             t.name,
-            decimals_or_digits(t.kpi, 5)
+            decimals_or_digits(t.kpi, 5),
+            floor_note(&record.assessment, &t.name)
         );
     }
     print_paths(&record.assessment.paths, "");
@@ -218,6 +219,18 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         bail!("the design violates constraints; see the report");
     }
     Ok(())
+}
+
+/// `; model floor … mm² (…; not in the KPI)` for
+/// the working pose `name`, or nothing without a floor.
+fn floor_note(a: &armcal::design::assess::DesignAssessment, name: &str) -> String {
+    match a.model_floor.as_ref().and_then(|f| f.at(name)) {
+        Some(f) => format!(
+            "; model floor (1/3) tr C_floor = {} mm² (fixed parameters at their stated prior; not in the KPI)",
+            decimals_or_digits(f.kpi, 5)
+        ),
+        None => String::new(),
+    }
 }
 
 /// Each working path's mean and largest (1/3) tr C_s, indented by `indent`.
@@ -295,9 +308,10 @@ pub fn run_evaluate(a: &EvaluateArgs) -> anyhow::Result<()> {
     println!("  φ_A(C_p) = tr(C_p)/n_p = {:.6}", ev.assessment.phi_a_cp);
     for t in &ev.assessment.tcp {
         println!(
-            "  (1/3) tr C_s at `{}` = {} mm²",
+            "  (1/3) tr C_s at `{}` = {} mm²{}",
             t.name,
-            decimals_or_digits(t.kpi, 5)
+            decimals_or_digits(t.kpi, 5),
+            floor_note(&ev.assessment, &t.name)
         );
     }
     print_paths(&ev.assessment.paths, "  ");

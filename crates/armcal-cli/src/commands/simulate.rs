@@ -46,6 +46,12 @@ pub struct Args {
     /// Perturb every parameter, not only the identifiable (free) ones.
     #[arg(long)]
     pub perturb_all: bool,
+    /// Perturb the parameters the cell holds fixed by their stated prior (`[parameters]
+    /// fixed_prior`, `fixed_priors`; default 0.5 mm, 0.1°; 0 for a frame the cell does not
+    /// give): the robot the model floor of `identify` describes. Overrides --perturb-all for
+    /// them.
+    #[arg(long)]
+    pub perturb_fixed: bool,
     /// Measure without noise.
     #[arg(long)]
     pub noise_free: bool,
@@ -107,6 +113,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         periodic: a.perturb_arcsec / Unit::Arcsec.display_factor(),
         joint_compliance: a.perturb_urad_per_nm / Unit::RadPerNmm.display_factor(),
         all: a.perturb_all,
+        fixed: a.perturb_fixed.then(|| cell.fixed_prior.clone()),
         ..Perturbation::default()
     };
     let noise = cell.noise();

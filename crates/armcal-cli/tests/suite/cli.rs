@@ -227,7 +227,7 @@ fn plan_names_the_capsule_pairs_in_contact_everywhere_and_plans_around_the_rest(
     let kpi = stdout
         .lines()
         .find_map(|l| l.strip_prefix("(1/3) tr C_s at `pick`: "))
-        .and_then(|l| l.strip_suffix(" mm²"))
+        .and_then(|l| l.split_once(" mm²").map(|(v, _)| v))
         .unwrap_or_else(|| panic!("no C_s line:\n{stdout}"));
     let digits = kpi.trim_start_matches(['0', '.']).len();
     assert!(kpi.parse::<f64>().unwrap() < 1e-3 && digits >= 3, "{kpi}");

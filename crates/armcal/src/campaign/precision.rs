@@ -44,6 +44,18 @@ pub struct WorkingSigma {
     pub true_error_mm: Option<[f64; 3]>,
     /// Simulated campaigns only: whether the true error lies in the 95 % ellipsoid.
     pub true_error_inside_95: Option<bool>,
+    /// The model floor C_floor at the working pose (mm², instrument frame, not scaled:
+    /// it comes from the fixed parameters' stated prior, not from the residuals;
+    /// [`crate::identify::model_floor`]); `None`: the estimate states none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub floor_covariance: Option<Matrix3<f64>>,
+    /// √((1/3) tr C_floor) (mm).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub floor_sigma_mm: Option<f64>,
+    /// Simulated campaigns only: whether the true error lies in the 95 % ellipsoid of
+    /// C_s + C_floor.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub true_error_inside_95_with_floor: Option<bool>,
 }
 
 impl WorkingSigma {
@@ -65,17 +77,31 @@ impl WorkingSigma {
             covariance,
             true_error_mm: None,
             true_error_inside_95: None,
+            floor_covariance: None,
+            floor_sigma_mm: None,
+            true_error_inside_95_with_floor: None,
         }
     }
 
-    /// Sets the true error `e` (mm) and whether eᵀ C_s⁻¹ e ≤ χ²₃(0.95).
+    /// Sets the model floor `floor` (mm²).
+    pub fn with_floor(mut self, floor: Matrix3<f64>) -> WorkingSigma {
+        self.floor_sigma_mm = Some((floor.trace() / 3.0).max(0.0).sqrt());
+        self.floor_covariance = Some(floor);
+        self
+    }
+
+    /// Sets the true error `e` (mm) and whether eᵀ C_s⁻¹ e ≤ χ²₃(0.95) (and, with a floor,
+    /// eᵀ (C_s + C_floor)⁻¹ e ≤ χ²₃(0.95)).
     pub fn with_true_error(mut self, e: Vector3<f64>) -> WorkingSigma {
-        let inside = self
-            .covariance
-            .try_inverse()
-            .map(|inv| (e.transpose() * inv * e)[(0, 0)] <= chi2_quantile());
+        let inside = |c: Matrix3<f64>| {
+            c.try_inverse()
+                .map(|inv| (e.transpose() * inv * e)[(0, 0)] <= chi2_quantile())
+        };
         self.true_error_mm = Some([e[0], e[1], e[2]]);
-        self.true_error_inside_95 = inside;
+        self.true_error_inside_95 = inside(self.covariance);
+        self.true_error_inside_95_with_floor = self
+            .floor_covariance
+            .and_then(|f| inside(self.covariance + f));
         self
     }
 }
@@ -90,12 +116,20 @@ pub fn scale(estimate: &Estimate) -> f64 {
     }
 }
 
-/// The precision at every working pose of an estimate, C_s scaled by `scale`.
+/// The precision at every working pose of an estimate, C_s scaled by `scale`, with the
+/// estimate's model floor beside it (the target is on C_s: the floor does not shrink with
+/// more poses).
 pub fn working_sigmas(estimate: &Estimate, scale: f64) -> Vec<WorkingSigma> {
     estimate
         .tcp
         .iter()
-        .map(|t| WorkingSigma::of(&t.name, t.covariance * scale))
+        .map(|t| {
+            let w = WorkingSigma::of(&t.name, t.covariance * scale);
+            match estimate.model_floor.as_ref().and_then(|f| f.at(&t.name)) {
+                Some(f) => w.with_floor(f.covariance),
+                None => w,
+            }
+        })
         .collect()
 }
 

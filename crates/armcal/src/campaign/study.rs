@@ -29,6 +29,20 @@ pub struct StudySettings {
     pub batch: usize,
     /// The most poses a run may measure.
     pub budget: usize,
+    /// Perturb the virtual robots' fixed parameters by the cell's stated prior too
+    /// ([`Perturbation::fixed`]): the coverage then tests the model floor.
+    #[serde(default)]
+    pub perturb_fixed: bool,
+}
+
+impl StudySettings {
+    /// The virtual robots' perturbation.
+    fn perturbation(&self, cell: &Cell) -> Perturbation {
+        Perturbation {
+            fixed: self.perturb_fixed.then(|| cell.fixed_prior.clone()),
+            ..Perturbation::default()
+        }
+    }
 }
 
 impl Default for StudySettings {
@@ -39,6 +53,7 @@ impl Default for StudySettings {
             first_seed: 1,
             batch: 5,
             budget: 400,
+            perturb_fixed: false,
         }
     }
 }
@@ -56,6 +71,9 @@ pub struct RunOutcome {
     pub sigma_mm: f64,
     /// Whether the true TCP error lay in the stated 95 % ellipsoid at every working pose.
     pub inside_95: Option<bool>,
+    /// The same for the ellipsoid of C_s + C_floor (the model floor).
+    #[serde(default)]
+    pub inside_95_with_floor: Option<bool>,
 }
 
 impl RunOutcome {
@@ -66,13 +84,22 @@ impl RunOutcome {
             poses,
             reached: sigma_mm <= target,
             sigma_mm,
-            inside_95: working
-                .iter()
-                .map(|w| w.true_error_inside_95)
-                .collect::<Option<Vec<bool>>>()
-                .map(|v| v.iter().all(|&b| b)),
+            inside_95: all_inside(working, |w| w.true_error_inside_95),
+            inside_95_with_floor: all_inside(working, |w| w.true_error_inside_95_with_floor),
         }
     }
+}
+
+/// Whether `inside` holds at every working pose (`None` if one does not know).
+fn all_inside(
+    working: &[WorkingSigma],
+    inside: impl Fn(&WorkingSigma) -> Option<bool>,
+) -> Option<bool> {
+    working
+        .iter()
+        .map(inside)
+        .collect::<Option<Vec<bool>>>()
+        .map(|v| v.iter().all(|&b| b))
 }
 
 /// The methods at one target.
@@ -105,7 +132,16 @@ pub fn poses_summary(runs: &[RunOutcome]) -> (f64, usize, usize) {
 /// Share of runs whose true error lay in the 95 % ellipsoid (over runs that know it), and
 /// how many runs that is.
 pub fn coverage(runs: &[RunOutcome]) -> (f64, usize) {
-    let known: Vec<bool> = runs.iter().filter_map(|r| r.inside_95).collect();
+    coverage_of(runs, |r| r.inside_95)
+}
+
+/// As [`coverage`], for the ellipsoid of C_s + C_floor.
+pub fn coverage_with_floor(runs: &[RunOutcome]) -> (f64, usize) {
+    coverage_of(runs, |r| r.inside_95_with_floor)
+}
+
+fn coverage_of(runs: &[RunOutcome], inside: impl Fn(&RunOutcome) -> Option<bool>) -> (f64, usize) {
+    let known: Vec<bool> = runs.iter().filter_map(inside).collect();
     let inside = known.iter().filter(|&&b| b).count();
     (inside as f64 / known.len().max(1) as f64, known.len())
 }
@@ -171,12 +207,13 @@ fn one_shot_size(cell: &Cell, target: f64) -> Result<(usize, f64, Vec<Vec<f64>>)
 /// The one-shot design measured on the virtual robot of `seed` and identified.
 fn one_shot_run(
     cell: &Cell,
+    settings: &StudySettings,
     design: &[Vec<f64>],
     seed: u64,
     target: f64,
 ) -> Result<RunOutcome, Error> {
     let model = &cell.model;
-    let truth = perturbed_truth(model, &Perturbation::default(), seed);
+    let truth = perturbed_truth(model, &settings.perturbation(cell), seed);
     let data = crate::sim::simulate(
         model,
         &truth,
@@ -218,7 +255,7 @@ fn campaign_run(
             planner,
             prior: None,
         },
-        &Perturbation::default(),
+        &settings.perturbation(cell),
         seed,
         &mut Silent,
     )?;
@@ -259,7 +296,7 @@ pub fn run(
                 .push(campaign_run(cell, settings, Planner::Kpi, target, seed)?);
             observer.step();
             row.one_shot
-                .push(one_shot_run(cell, &design, seed, target)?);
+                .push(one_shot_run(cell, settings, &design, seed, target)?);
             observer.step();
             row.random
                 .push(campaign_run(cell, settings, Planner::Random, target, seed)?);

@@ -181,6 +181,10 @@ pub struct Cell {
     pub form_changes: Vec<FormChange>,
     /// Nearly parallel axes the model still has no tilt parameter for, with the fix.
     pub form_incomplete: Vec<String>,
+    /// The stated uncertainty of the parameters a fit holds fixed (`[parameters]
+    /// fixed_prior`, `fixed_priors`): the model floor of the TCP covariance
+    /// ([`crate::identify::model_floor`]).
+    pub fixed_prior: crate::model::prior::FixedPrior,
 }
 
 impl Cell {
@@ -259,6 +263,7 @@ impl Cell {
             form: LinkForm::Auto,
             form_changes: shaped.changes,
             form_incomplete: shaped.incomplete,
+            fixed_prior: crate::model::prior::FixedPrior::default(),
         })
     }
 

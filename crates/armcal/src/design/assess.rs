@@ -7,7 +7,10 @@ use crate::cell::Cell;
 use crate::design::plan::{constraint_set, CellConstraints, DesignMargin};
 use crate::design::record::{kind_margins, KindMargin};
 use crate::design::{Criterion, DesignModel, DesignObjective, InformationWorkspace};
+use crate::identify::model_floor::{model_floor, ModelFloor};
 use crate::identify::uncertainty::{self, Observability, TcpCovariance};
+use crate::identify::Problem;
+use crate::model::identifiability::Measurement;
 use crate::Error;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
@@ -32,6 +35,10 @@ pub struct DesignAssessment {
     pub observability: Observability,
     /// Every criterion's value (see [`Criterion`]).
     pub criteria: Vec<(Criterion, f64)>,
+    /// The model floor beside C_s at the working poses ([`design_floor`]); `None` without
+    /// working poses, for distance measurements, or in files of an older armcal.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model_floor: Option<ModelFloor>,
 }
 
 /// The predicted TCP position precision along a working path: the KPI value
@@ -121,6 +128,7 @@ pub fn assess(cell: &Cell, design: &[Vec<f64>]) -> Result<DesignAssessment, Erro
         criteria.push((c, obj.value_and_gradient(&mut ows, &design.concat(), None)?));
     }
     Ok(DesignAssessment {
+        model_floor: design_floor(cell, design)?,
         paths: path_precision(cell, &d, &unc.covariance),
         phi_a_cp: unc.covariance.trace() / names.len() as f64,
         parameters: names,
@@ -130,6 +138,37 @@ pub fn assess(cell: &Cell, design: &[Vec<f64>]) -> Result<DesignAssessment, Erro
         observability: uncertainty::observability(j.rows(0, data_rows)),
         criteria,
     })
+}
+
+/// The model floor ([`crate::identify::model_floor`]) of measuring `design` on the nominal
+/// robot as `simulate` does (a point target's position, a frame target's pose), with the
+/// cell's fixed-parameter prior: what the fixed parameters add to the predicted C_s. The
+/// planner's KPI leaves it out: for a parameter fixed because the data cannot separate it the
+/// floor does not depend on the design. `None` without working poses or for distance
+/// measurements.
+pub fn design_floor(cell: &Cell, design: &[Vec<f64>]) -> Result<Option<ModelFloor>, Error> {
+    if cell.working.is_empty() || cell.measurement == Measurement::Distance {
+        return Ok(None);
+    }
+    let poses: Vec<(String, Vec<f64>)> = design
+        .iter()
+        .enumerate()
+        .map(|(i, q)| ((i + 1).to_string(), q.clone()))
+        .collect();
+    let params = cell.model.nominal();
+    let data = crate::sim::predict(&cell.model, &params, &poses, None)?;
+    let problem = Problem::new(&cell.model, &data, &cell.noise())?;
+    let (_, j) = problem.residual_and_jacobian(&params);
+    let cp =
+        uncertainty::information_inverse(&crate::linalg::gram(j.as_view()), &problem.free_names())?;
+    Ok(Some(model_floor(
+        &problem,
+        &params,
+        &j,
+        &cp,
+        &cell.working,
+        &cell.fixed_prior,
+    )))
 }
 
 /// What `armcal evaluate --json` prints: a design's assessment and how it meets the cell's

@@ -11,8 +11,10 @@ pub mod gauss_newton;
 pub mod held_out;
 pub mod kalman;
 pub mod lm;
+pub mod model_floor;
 pub mod nongeometric_choice;
 pub mod nongeometric_gate;
+pub mod pivot;
 pub mod problem;
 pub mod refit;
 pub mod residuals;
@@ -455,6 +457,18 @@ fn estimate_of_fit(
     let unc = uncertainty::parameter_uncertainty(&sol.jacobian, &sol.residual, &names)?;
     let working: Vec<Vec<f64>> = cell.working.iter().map(|w| w.q.clone()).collect();
     let wnames: Vec<String> = cell.working.iter().map(|w| w.name.clone()).collect();
+    // A frames refit holds the robot at an earlier calibration, not at a nominal with the
+    // cell's prior: it states no floor.
+    let model_floor = (!working.is_empty() && opts.refit.is_none()).then(|| {
+        model_floor::model_floor(
+            &problem,
+            &sol.params,
+            &sol.jacobian,
+            &unc.covariance,
+            &cell.working,
+            &cell.fixed_prior,
+        )
+    });
     let (tcp, tcp_constrained) = if working.is_empty() {
         (Vec::new(), Vec::new())
     } else {
@@ -539,6 +553,7 @@ fn estimate_of_fit(
         uncertainty: unc,
         tcp,
         tcp_constrained,
+        model_floor,
         observability,
         residuals,
         outliers,

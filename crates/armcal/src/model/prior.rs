@@ -10,7 +10,7 @@
 //! parameters only: a parameter of the prior that a fit holds fixed is marginalised out
 //! (its rows and columns of `C` dropped), and a name the model does not have is ignored.
 
-use crate::model::registry::{Registry, Status};
+use crate::model::registry::{Parameter, Registry, Status, Unit};
 use crate::Error;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
@@ -63,6 +63,68 @@ impl CorrelatedPrior {
             return bad("the covariance is not positive definite".into());
         }
         Ok(())
+    }
+}
+
+/// Default σ of a fixed length (mm): a link length or frame offset known from a drawing or
+/// CAD. The same as the simulation's default truth perturbation
+/// ([`crate::sim::Perturbation`]), so a simulated robot lies within what its cell states.
+pub const FIXED_LENGTH_SIGMA_MM: f64 = 0.5;
+/// Default σ of a fixed angle (deg), as [`FIXED_LENGTH_SIGMA_MM`].
+pub const FIXED_ANGLE_SIGMA_DEG: f64 = 0.1;
+/// Default σ of a fixed dimensionless parameter (a zero-reference axis component), as
+/// [`FIXED_LENGTH_SIGMA_MM`].
+pub const FIXED_UNITLESS_SIGMA: f64 = 1e-3;
+
+/// The stated prior uncertainty of the parameters a fit holds fixed (cell `[parameters]
+/// fixed_prior` per kind, `fixed_priors` per parameter): a fixed parameter `p` is taken as
+/// `p_true ~ N(p_nominal, σ²)`, independently. Only the parameters a fit holds fixed use it;
+/// an estimated parameter's uncertainty is in C_p. A non-geometric term (compliance,
+/// periodic error) left out of a fit is exact unless `parameters` names it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FixedPrior {
+    /// σ of a fixed length (mm).
+    pub length_mm: f64,
+    /// σ of a fixed angle (rad).
+    pub angle_rad: f64,
+    /// σ of a fixed dimensionless parameter.
+    pub unitless: f64,
+    /// Per-parameter σ (internal units) by name; takes precedence over the kind's. A frame
+    /// the cell does not give (`[base]`, `[tool]` absent: the world is the robot base, the
+    /// TCP the flange) is a definition and has σ = 0 here.
+    pub parameters: Vec<(String, f64)>,
+}
+
+impl Default for FixedPrior {
+    fn default() -> Self {
+        FixedPrior {
+            length_mm: FIXED_LENGTH_SIGMA_MM,
+            angle_rad: FIXED_ANGLE_SIGMA_DEG.to_radians(),
+            unitless: FIXED_UNITLESS_SIGMA,
+            parameters: Vec::new(),
+        }
+    }
+}
+
+impl FixedPrior {
+    /// The σ of `p` held fixed (internal units): its own if named, else its kind's (0 for a
+    /// non-geometric term).
+    pub fn sigma(&self, p: &Parameter) -> f64 {
+        if let Some((_, s)) = self.parameters.iter().find(|(n, _)| *n == p.name) {
+            return *s;
+        }
+        match p.unit {
+            Unit::Mm => self.length_mm,
+            Unit::Rad => self.angle_rad,
+            Unit::Unitless => self.unitless,
+            Unit::RadPerMm | Unit::RadPerNmm | Unit::Arcsec => 0.0,
+        }
+    }
+
+    /// Sets the σ of the parameter `name` (replacing an earlier one).
+    pub fn set(&mut self, name: &str, sigma: f64) {
+        self.parameters.retain(|(n, _)| n != name);
+        self.parameters.push((name.to_string(), sigma));
     }
 }
 

@@ -227,11 +227,11 @@ pub fn page(c: &ReportContent) -> Result<Page, Error> {
     }
     let mut items = Vec::new();
     for i in c.inputs {
-        let (tcp, predicted) = match &i.document {
-            Document::Design(d) => (d.assessment.tcp.first(), true),
-            Document::Estimate(e) => (e.tcp.first(), false),
+        let (tcp, predicted, floor) = match &i.document {
+            Document::Design(d) => (d.assessment.tcp.first(), true, &d.assessment.model_floor),
+            Document::Estimate(e) => (e.tcp.first(), false, &e.model_floor),
             Document::Study(_) | Document::Demo(_) | Document::Truth(_) | Document::Campaign(_) => {
-                (None, false)
+                (None, false, &None)
             }
         };
         if let Some(t) = tcp {
@@ -241,6 +241,10 @@ pub fn page(c: &ReportContent) -> Result<Page, Error> {
                 working: t.name.clone(),
                 covariance: t.covariance,
                 covariance_base: t.covariance_base,
+                floor: floor
+                    .as_ref()
+                    .and_then(|f| f.at(&t.name))
+                    .map(|f| f.covariance),
                 colour: colours.of(&i.label),
             });
         }

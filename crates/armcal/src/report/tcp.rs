@@ -25,6 +25,9 @@ pub struct TcpItem {
     pub covariance: Matrix3<f64>,
     /// C_s (mm²) in the robot base frame, if the record holds it.
     pub covariance_base: Option<Matrix3<f64>>,
+    /// The model floor C_floor (mm², instrument frame), if the record states one
+    /// ([`crate::identify::model_floor`]): drawn as the ellipsoid of C_s + C_floor.
+    pub floor: Option<Matrix3<f64>>,
     /// Palette index: the design's colour in every figure.
     pub colour: usize,
 }
@@ -37,7 +40,7 @@ pub fn tcp_section(id: &str, items: &[TcpItem]) -> Result<Option<Section>, Error
     let k = confidence_scale(3, CONFIDENCE)?;
     let mut s = Section::new(id, "TCP precision at the working pose");
     s.html(format!(
-        "<p class=\"note\">C_s is the covariance of the tool centre point at the working pose: predicted from the design before anything is measured (paper eq. 19 / appendix, C_s = G C_p Gᵀ), and from the identification afterwards. The figures show the projections of the {:.0} % confidence ellipsoid δᵀ C_s⁻¹ δ ≤ k² with k = √χ²₃({}) = {} onto the coordinate planes of the instrument frame, centred on the TCP (mm): dashed outlines are design predictions, solid ones identifications.</p>\n",
+        "<p class=\"note\">C_s is the covariance of the tool centre point at the working pose: predicted from the design before anything is measured (paper eq. 19 / appendix, C_s = G C_p Gᵀ), and from the identification afterwards. The figures show the projections of the {:.0} % confidence ellipsoid δᵀ C_s⁻¹ δ ≤ k² with k = √χ²₃({}) = {} onto the coordinate planes of the instrument frame, centred on the TCP (mm): dashed outlines are design predictions, solid ones identifications. The model floor C_floor is what the parameters held fixed add at their stated prior (the cell's <code>fixed_prior</code>); the outlines labelled \u{201c}C_s + model floor\u{201d} (dashed, instrument frame) are the ellipsoid of C_s + C_floor, the one the TCP's true error lies in.</p>\n",
         100.0 * CONFIDENCE,
         CONFIDENCE,
         fixed(k, 3)
@@ -63,6 +66,9 @@ pub fn tcp_section(id: &str, items: &[TcpItem]) -> Result<Option<Section>, Error
                 number(c[(1, 1)].sqrt()),
                 number(c[(2, 2)].sqrt()),
                 number(largest),
+                t.floor.map_or("–".into(), |f| number(f.trace() / 3.0)),
+                t.floor
+                    .map_or("–".into(), |f| number(((c + f).trace() / 3.0).sqrt())),
             ]
         })
         .collect();
@@ -77,11 +83,23 @@ pub fn tcp_section(id: &str, items: &[TcpItem]) -> Result<Option<Section>, Error
             "σ_y (mm)",
             "σ_z (mm)",
             "largest 95 % semi-axis (mm)",
+            "model floor (1/3) tr C_floor (mm²)",
+            "TCP σ with the floor (mm)",
         ],
         &rows,
-        &[3, 4, 5, 6, 7, 8],
+        &[3, 4, 5, 6, 7, 8, 9, 10],
     ));
     let series_of = |base: bool| -> Vec<EllipseSeries> {
+        // C_s + C_floor, with its own legend entry; the floor is stated in the instrument
+        // frame, so only in the instrument view
+        let floors = items.iter().filter(|_| !base).filter_map(|t| {
+            t.floor.map(|f| EllipseSeries {
+                colour: t.colour,
+                label: format!("{} (C_s + model floor)", t.label),
+                covariance: t.covariance + f,
+                dashed: true,
+            })
+        });
         items
             .iter()
             .map(|t| EllipseSeries {
@@ -102,6 +120,7 @@ pub fn tcp_section(id: &str, items: &[TcpItem]) -> Result<Option<Section>, Error
                 },
                 dashed: t.predicted,
             })
+            .chain(floors)
             .collect()
     };
     let figures = |base: bool| -> Result<Vec<Figure>, Error> {

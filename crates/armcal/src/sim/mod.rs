@@ -4,6 +4,9 @@
 
 use crate::measure::{Dataset, Measurement, MeasurementKind, NoiseModel};
 use crate::model::pose::rot_axis;
+use crate::model::prior::{
+    FixedPrior, FIXED_ANGLE_SIGMA_DEG, FIXED_LENGTH_SIGMA_MM, FIXED_UNITLESS_SIGMA,
+};
 use crate::model::{forward_kinematics, observed_pose, Data, Model, Observed, Pose, Unit};
 use crate::Error;
 use nalgebra::Vector3;
@@ -38,18 +41,25 @@ pub struct Perturbation {
     /// Perturb every parameter (`true`) or only the free ones (`false`, the default: the
     /// truth then lies in the identifiable set and identification can recover it exactly).
     pub all: bool,
+    /// Perturb the parameters the model holds fixed by their stated prior instead
+    /// (`nominal + σ z`, σ of the cell's [`FixedPrior`], 0 for an exact one; overrides
+    /// `all` for them): the robot a fit's model floor ([`crate::identify::model_floor`])
+    /// describes. `None` (the default): as `all` says.
+    #[serde(default)]
+    pub fixed: Option<FixedPrior>,
 }
 
 impl Default for Perturbation {
     fn default() -> Self {
         Perturbation {
-            length: 0.5,
-            angle: 0.1f64.to_radians(),
-            unitless: 1e-3,
+            length: FIXED_LENGTH_SIGMA_MM,
+            angle: FIXED_ANGLE_SIGMA_DEG.to_radians(),
+            unitless: FIXED_UNITLESS_SIGMA,
             compliance: default_compliance(),
             periodic: default_periodic(),
             joint_compliance: default_joint_compliance(),
             all: false,
+            fixed: None,
         }
     }
 }
@@ -66,7 +76,9 @@ fn default_periodic() -> f64 {
     20.0 / Unit::Arcsec.display_factor()
 }
 
-/// The true parameters: nominal + N(0, σ_kind²) per parameter (free ones unless `all`).
+/// The true parameters: nominal + N(0, σ_kind²) per parameter (free ones unless `all`); a
+/// fixed one nominal + N(0, σ²) of its stated prior if `p.fixed` is given (the same draw z
+/// per parameter whatever the statuses, so a seed's free parameters do not change).
 pub fn perturbed_truth(model: &Model, p: &Perturbation, seed: u64) -> Vec<f64> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let unit_normal = Normal::new(0.0, 1.0).expect("valid normal");
@@ -76,6 +88,9 @@ pub fn perturbed_truth(model: &Model, p: &Perturbation, seed: u64) -> Vec<f64> {
         .map(|par| {
             // Draw for every parameter so the sequence does not depend on the statuses.
             let z: f64 = unit_normal.sample(&mut rng);
+            if let (Some(prior), false) = (&p.fixed, par.status.is_free()) {
+                return par.nominal + prior.sigma(par) * z;
+            }
             if !(p.all || par.status.is_free()) {
                 return par.nominal;
             }

@@ -23,8 +23,10 @@ mod identify {
     mod identification_input;
     mod identification_validation;
     mod mixed_measurements;
+    mod model_floor;
     mod payload;
     mod periodic;
+    mod pivot;
     mod priors_and_noise;
     mod stations;
 }

@@ -89,6 +89,12 @@ struct RawParameters {
     fixed: Vec<String>,
     #[serde(default)]
     priors: BTreeMap<String, toml::Table>,
+    /// σ of the fixed parameters per kind, `{ length_mm = 0.5, angle_deg = 0.1, unitless =
+    /// 0.001 }` ([`crate::model::prior::FixedPrior`]).
+    fixed_prior: Option<toml::Table>,
+    /// σ of fixed parameters by pattern, `{ "tool.z" = { sigma_mm = 0.2 } }`.
+    #[serde(default)]
+    fixed_priors: BTreeMap<String, toml::Table>,
     measurement: Option<String>,
     /// Compliant joints, `["j2", "j3"]` ([`crate::model::compliance`]).
     compliance: Option<Vec<String>>,
@@ -170,6 +176,12 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
 
     let (measurement, auto_free) =
         parameters::parameters(&ctx, raw.parameters.as_ref(), &mut model)?;
+    let fixed_prior = parameters::fixed_prior(
+        &ctx,
+        raw.parameters.as_ref(),
+        &model,
+        [("base", raw.base.is_some()), ("tool", raw.tool.is_some())],
+    )?;
     let (working, mut warnings) = working::working(&ctx, &raw.working, &model)?;
     let (working_paths, path_warnings) =
         working::working_paths(&ctx, &raw.working_path, &model, dir)?;
@@ -210,6 +222,7 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
         form,
         form_changes: shaped.changes,
         form_incomplete: shaped.incomplete,
+        fixed_prior,
     };
     cell.declared_free = cell.model.registry.free();
     if cell.auto_free {

@@ -6,6 +6,7 @@ use super::fields::*;
 use super::*;
 use crate::model::compliance::ComplianceSpec;
 use crate::model::periodic::PeriodicSpec;
+use crate::model::prior::FixedPrior;
 
 /// Applies `[parameters]` to `model`; returns the measurement type (pose if every target is
 /// a frame, else position, unless given) and whether the free set is `auto`.
@@ -53,40 +54,7 @@ pub(super) fn parameters(
                 ))
             }
         };
-        let mut priors = Vec::new();
-        for (name, t) in &p.priors {
-            let i = model
-                .registry
-                .matching(name)
-                .map_err(|e| ctx.err(span.clone(), &format!("parameters.priors.{name}"), e))?;
-            let unit = model.registry.get(i[0]).unit;
-            // One σ has one unit: a pattern over lengths and angles together is an error.
-            if let Some(&other) = i.iter().find(|&&k| model.registry.get(k).unit != unit) {
-                let (a, b) = (model.registry.get(i[0]), model.registry.get(other));
-                return Err(ctx.err(
-                    span.clone(),
-                    &format!("parameters.priors.{name}"),
-                    format!(
-                        "the pattern matches parameters of different units, `{}` ({}) and `{}` \
-                         ({}); give one prior per unit",
-                        a.name,
-                        a.unit.display_name(),
-                        b.name,
-                        b.unit.display_name()
-                    ),
-                ));
-            }
-            let s = sole_unit_value(t, "sigma", unit)
-                .map_err(|e| ctx.err(span.clone(), &format!("parameters.priors.{name}"), e))?;
-            if s <= 0.0 {
-                return Err(ctx.err(
-                    span,
-                    &format!("parameters.priors.{name}"),
-                    "sigma must be positive",
-                ));
-            }
-            priors.push((name.clone(), s));
-        }
+        let priors = pattern_sigmas(ctx, &span, "parameters.priors", &p.priors, model)?;
         if !free.is_empty() {
             // An explicit free list: everything else is fixed, but the compliance and periodic
             // terms the section asks for stay free (unless `fixed` names them).
@@ -111,6 +79,118 @@ pub(super) fn parameters(
         }
     }
     Ok((measurement, auto_free))
+}
+
+/// `(pattern, σ)` of every entry `pattern = { sigma_<unit> = … }` of `entries` (the field
+/// `field`), σ in the unit of the parameters the pattern matches (internal units). The
+/// error names the entry: a pattern matching nothing or parameters of different units, a
+/// missing or non-positive σ.
+fn pattern_sigmas(
+    ctx: &Ctx,
+    span: &std::ops::Range<usize>,
+    field: &str,
+    entries: &BTreeMap<String, toml::Table>,
+    model: &Model,
+) -> Result<Vec<(String, f64)>, Error> {
+    let mut sigmas = Vec::new();
+    for (name, t) in entries {
+        let field = format!("{field}.{name}");
+        let i = model
+            .registry
+            .matching(name)
+            .map_err(|e| ctx.err(span.clone(), &field, e))?;
+        let unit = model.registry.get(i[0]).unit;
+        // One σ has one unit: a pattern over lengths and angles together is an error.
+        if let Some(&other) = i.iter().find(|&&k| model.registry.get(k).unit != unit) {
+            let (a, b) = (model.registry.get(i[0]), model.registry.get(other));
+            return Err(ctx.err(
+                span.clone(),
+                &field,
+                format!(
+                    "the pattern matches parameters of different units, `{}` ({}) and `{}` \
+                     ({}); give one prior per unit",
+                    a.name,
+                    a.unit.display_name(),
+                    b.name,
+                    b.unit.display_name()
+                ),
+            ));
+        }
+        let s = sole_unit_value(t, "sigma", unit).map_err(|e| ctx.err(span.clone(), &field, e))?;
+        if s <= 0.0 {
+            return Err(ctx.err(span.clone(), &field, "sigma must be positive"));
+        }
+        sigmas.push((name.clone(), s));
+    }
+    Ok(sigmas)
+}
+
+/// The stated uncertainty of the fixed parameters ([`FixedPrior`]): `[parameters]
+/// fixed_prior = { length_mm, angle_deg, unitless }` per kind (defaults
+/// [`FixedPrior::default`]), then `fixed_priors = { pattern = { sigma_<unit> = … } }` per
+/// parameter. A frame of `frames` (`("tool", given)`) the cell does not give is a
+/// definition (the TCP is the flange origin): its parameters have σ = 0 unless
+/// `fixed_priors` names them.
+pub(super) fn fixed_prior(
+    ctx: &Ctx,
+    section: Option<&Spanned<RawParameters>>,
+    model: &Model,
+    frames: [(&str, bool); 2],
+) -> Result<FixedPrior, Error> {
+    let mut prior = FixedPrior::default();
+    for (frame, given) in frames {
+        if !given {
+            for p in model.registry.iter().filter(|p| p.frame() == frame) {
+                prior.set(&p.name, 0.0);
+            }
+        }
+    }
+    let Some(p) = section else {
+        return Ok(prior);
+    };
+    let span = p.span();
+    let p = p.get_ref();
+    if let Some(t) = &p.fixed_prior {
+        let field = "parameters.fixed_prior";
+        let mut used = Vec::new();
+        let kinds = [
+            ("length", Unit::Mm, &mut prior.length_mm),
+            ("angle", Unit::Rad, &mut prior.angle_rad),
+            ("unitless", Unit::Unitless, &mut prior.unitless),
+        ];
+        for (key, unit, slot) in kinds {
+            if let Some(v) =
+                unit_value(t, key, unit, &mut used).map_err(|e| ctx.err(span.clone(), field, e))?
+            {
+                if v < 0.0 {
+                    return Err(ctx.err(span.clone(), field, format!("`{key}` must be ≥ 0")));
+                }
+                *slot = v;
+            }
+        }
+        let spellings = [
+            unit_spellings("length", Unit::Mm),
+            unit_spellings("angle", Unit::Rad),
+            "unitless".to_string(),
+        ];
+        check_unused(t, &used, &[], &spellings).map_err(|e| ctx.err(span.clone(), field, e))?;
+    }
+    for (pattern, s) in pattern_sigmas(
+        ctx,
+        &span,
+        "parameters.fixed_priors",
+        &p.fixed_priors,
+        model,
+    )? {
+        for i in model
+            .registry
+            .matching(&pattern)
+            .expect("pattern_sigmas checked it")
+        {
+            prior.set(&model.registry.get(i).name, s);
+        }
+    }
+    Ok(prior)
 }
 
 /// `[parameters] compliance = ["j2", "j3"]` and `periodic = { joints = ["j1"], harmonics =

@@ -1,0 +1,70 @@
+//! `armcal pivot`: TCP (tool-tip) calibration from poses touching one fixed point.
+
+use super::output::{
+    load_cell, load_params_at_payload, with_note, AcceptUnconverged, NoteStyle, Outputs,
+};
+use armcal::identify::pivot::{pivot_calibration, PivotSettings};
+use armcal::measure::csv;
+use std::path::{Path, PathBuf};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Cell file or built-in robot: its model gives the flange pose of every touch pose.
+    #[arg(long)]
+    pub cell: String,
+    /// The touch poses (CSV: pose_id, q1_deg, …): the tool tip on one fixed point, the tool
+    /// tilted about at least two different axes.
+    #[arg(long)]
+    pub poses: PathBuf,
+    /// The calibrated robot (estimate.json) to take the flange poses from; default the
+    /// nominal model.
+    #[arg(long)]
+    pub estimate: Option<PathBuf>,
+    /// Largest accepted condition number of the pivot design matrix [R_i −I] (unit-free).
+    #[arg(long, default_value_t = PivotSettings::default().max_condition)]
+    pub max_condition: f64,
+    /// Output: the tool frame, its covariance and the residuals (JSON).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Overwrite existing output files.
+    #[arg(long)]
+    pub force: bool,
+    #[command(flatten)]
+    pub accept: AcceptUnconverged,
+}
+
+pub fn run(a: &Args) -> anyhow::Result<()> {
+    let mut inputs = vec![Path::new(&a.cell), a.poses.as_path()];
+    inputs.extend(a.estimate.as_deref());
+    let outputs = Outputs::plan(a.force, &inputs, &[a.out.as_path()])?;
+    let cell = load_cell(&a.cell)?;
+    let model = &cell.model;
+    let (params, note, _) = load_params_at_payload(a.estimate.as_deref(), &a.accept, model, None)?;
+    let poses: Vec<Vec<f64>> = csv::read_configurations(&a.poses, model, None)?
+        .into_iter()
+        .map(|(_, q)| q)
+        .collect();
+    let settings = PivotSettings {
+        max_condition: a.max_condition,
+    };
+    let p = pivot_calibration(model, &params, &poses, &settings)?;
+    let json = with_note(p.to_json()?, note.as_deref(), NoteStyle::Json);
+    outputs.commit(&[(a.out.as_path(), json.as_str())])?;
+    let [x, y, z] = p.tool_xyz_mm;
+    let [sx, sy, sz] = p.tool_sigma_mm;
+    let [px, py, pz] = p.point_xyz_mm;
+    println!(
+        "pivot calibration of `{}` from {} poses (largest tilt {:.1}°, condition number {:.1})",
+        cell.name, p.poses, p.max_tilt_deg, p.condition_number
+    );
+    println!("tool tip in the flange frame: ({x:.4}, {y:.4}, {z:.4}) mm, σ = ({sx:.4}, {sy:.4}, {sz:.4}) mm");
+    println!("touched point in the world:   ({px:.4}, {py:.4}, {pz:.4}) mm");
+    println!(
+        "residual σ̂ = {:.4} mm per axis (max distance of a pose's tip from the point {:.4} mm)",
+        p.residual_sigma_mm,
+        p.residuals_mm.iter().copied().fold(0.0, f64::max)
+    );
+    println!("in the cell file:\n{}", p.cell_snippet());
+    println!("→ {}", a.out.display());
+    Ok(())
+}
