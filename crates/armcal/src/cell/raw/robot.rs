@@ -1,5 +1,6 @@
 //! `[robot]` (a built-in robot, a URDF file or inline `[[robot.links]]`, joint `limits`,
-//! `[[robot.capsules]]`, `convention`) and `[[tool_capsules]]`.
+//! `[[robot.capsules]]`, the skeleton's `link_radius_mm` and `link_radii_mm`, `convention`)
+//! and `[[tool_capsules]]`.
 
 use super::fields::*;
 use super::*;
@@ -39,6 +40,7 @@ pub(super) fn robot(
             source: format!("URDF file {}", path.display()),
             spec,
             capsules: Vec::new(),
+            collision: String::new(),
         }
     } else {
         let mut links = Vec::new();
@@ -79,6 +81,7 @@ pub(super) fn robot(
                 targets: vec![],
             },
             capsules: Vec::new(),
+            collision: String::new(),
         }
     };
     if let Some(limits) = &rr.limits {
@@ -118,7 +121,116 @@ pub(super) fn robot(
             .map_err(|e| ctx.err(c.span(), &format!("robot.capsules[{i}]"), e))?;
         robot.capsules.push(cap);
     }
+    if rr.builtin.is_some() && !rr.capsules.is_empty() {
+        robot.collision = format!(
+            "{}, and the cell's {} [[robot.capsules]]",
+            robot.collision,
+            rr.capsules.len()
+        );
+    } else if !rr.capsules.is_empty() {
+        robot.collision = format!("the cell's {} [[robot.capsules]]", rr.capsules.len());
+    }
     Ok(robot)
+}
+
+/// The arm's collision model when the cell does not draw it: a robot from `urdf` or
+/// `[[robot.links]]` without `[[robot.capsules]]` gets its skeleton
+/// ([`crate::robots::skeleton`], on the frames of `given`, the chain as the cell assembles
+/// it) with the radii of `link_radius_mm` and `link_radii_mm`; the tool's own segment is left
+/// out when the cell has `[[tool_capsules]]`. The radius fields are refused where no skeleton
+/// is built (a built-in robot's capsules are hand-made; `[[robot.capsules]]` replace the
+/// skeleton).
+pub(super) fn collision_model(
+    ctx: &Ctx,
+    rr: &RawRobot,
+    rspan: Range<usize>,
+    robot: &mut Robot,
+    given: &Model,
+    tool_capsules: &[Capsule],
+) -> Result<(), Error> {
+    use crate::robots::skeleton;
+    let radius_field = match (&rr.link_radius_mm, &rr.link_radii_mm) {
+        (Some(_), _) => Some("robot.link_radius_mm"),
+        (None, Some(_)) => Some("robot.link_radii_mm"),
+        (None, None) => None,
+    };
+    if rr.builtin.is_some() || !rr.capsules.is_empty() {
+        if let Some(field) = radius_field {
+            let why = if rr.builtin.is_some() {
+                "a built-in robot has hand-made capsules; the skeleton's radius applies to a \
+                 robot from `urdf` or `[[robot.links]]` (add capsules with [[robot.capsules]])"
+            } else {
+                "the cell draws the arm with [[robot.capsules]], which replace the skeleton; \
+                 remove one or the other"
+            };
+            return Err(ctx.err(rspan, field, why));
+        }
+        return Ok(());
+    }
+    let check = |field: &str, r: f64| {
+        if r.is_finite() && r >= 0.0 {
+            Ok(r)
+        } else {
+            Err(ctx.err(
+                rspan.clone(),
+                field,
+                format!("{r} is not a radius: give a finite length ≥ 0 mm"),
+            ))
+        }
+    };
+    let (default, how) = match rr.link_radius_mm {
+        Some(r) => (
+            check("robot.link_radius_mm", r)?,
+            "[robot] link_radius_mm".to_string(),
+        ),
+        None => {
+            let r = skeleton::default_link_radius(given);
+            let how = format!(
+                "default: {:.0} % of the arm's {:.0} mm skeleton; set [robot] link_radius_mm",
+                100.0 * skeleton::DEFAULT_RADIUS_SHARE,
+                skeleton::arm_length(given)
+            );
+            (r, how)
+        }
+    };
+    let per_frame = rr.link_radii_mm.clone().unwrap_or_default();
+    for (frame, r) in &per_frame {
+        check(&format!("robot.link_radii_mm.{frame}"), *r)?;
+    }
+    let with_tool = tool_capsules.is_empty();
+    let radius = |frame: &str| per_frame.get(frame).copied().unwrap_or(default);
+    let capsules = skeleton::skeleton_capsules(given, &radius, with_tool);
+    if let Some(frame) = per_frame
+        .keys()
+        .find(|f| !capsules.iter().any(|c| c.frame == **f))
+    {
+        let mut carriers: Vec<&str> = capsules.iter().map(|c| c.frame.as_str()).collect();
+        carriers.dedup();
+        return Err(ctx.err(
+            rspan,
+            &format!("robot.link_radii_mm.{frame}"),
+            format!(
+                "no skeleton capsule is on frame `{frame}`; the skeleton's frames are {}",
+                carriers.join(", ")
+            ),
+        ));
+    }
+    let mut text = format!(
+        "skeleton: {} capsules between successive joint origins{}, radius {} mm ({how})",
+        capsules.len(),
+        if with_tool {
+            " and to the tool origin"
+        } else {
+            ""
+        },
+        default
+    );
+    for (frame, r) in &per_frame {
+        text.push_str(&format!(", {frame} {r} mm"));
+    }
+    robot.capsules = capsules;
+    robot.collision = text;
+    Ok(())
 }
 
 /// A joint's lower limit is not above its upper one (equal limits lock the joint); the error
