@@ -5,6 +5,7 @@
 //! targets: those belong to a cell). Lengths in mm, angles in rad, as everywhere inside
 //! armcal.
 
+pub mod bounding;
 mod irb120;
 mod kuka;
 mod motoman;

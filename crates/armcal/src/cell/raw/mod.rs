@@ -147,7 +147,7 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
     let rspan = raw.robot.span();
     let rr = raw.robot.into_inner();
 
-    let mut robot = robot::robot(&ctx, &rr, rspan.clone(), dir)?;
+    let (mut robot, shapes) = robot::robot(&ctx, &rr, rspan.clone(), dir)?;
     let (instrument, instrument_geometry, instrument_name) =
         instrument::instrument(&ctx, raw.instrument)?;
     let (base, tool) = frames::base_and_tool(&ctx, &raw.base, &raw.tool)?;
@@ -167,7 +167,15 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
     let mut tool_capsules = robot::tool_capsules(&ctx, &raw.tool_capsules)?;
     let form = robot::link_form(&ctx, &rr, rspan.clone())?;
     let given = Model::from_spec(&spec).map_err(model_error)?;
-    robot::collision_model(&ctx, &rr, rspan.clone(), &mut robot, &given, &tool_capsules)?;
+    let collision_warnings = robot::collision_model(
+        &ctx,
+        &rr,
+        rspan.clone(),
+        &mut robot,
+        &given,
+        &tool_capsules,
+        &shapes,
+    )?;
     let shaped = shape_robot(&mut robot, &given, spec, form, &mut tool_capsules)
         .map_err(|e| ctx.err(rspan.clone(), "robot.convention", e))?;
     let mut spec = shaped.spec;
@@ -181,6 +189,7 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
     let (working_paths, path_warnings) =
         working::working_paths(&ctx, &raw.working_path, &model, dir)?;
     warnings.extend(path_warnings);
+    warnings.extend(collision_warnings);
     let obstacles = obstacles::obstacles(&ctx, &raw.obstacles)?;
     let design = design::design(&ctx, raw.design.as_ref())?;
     design::check_joint_margin(&ctx, raw.design.as_ref(), &design, &model)?;

@@ -4,16 +4,19 @@
 
 use super::fields::*;
 use super::*;
+use crate::model::urdf::CollisionShape;
 use std::ops::Range;
 
 /// The robot of `[robot]`: exactly one of `builtin`, `urdf` (relative to `dir`) or
-/// `[[robot.links]]`, with its `limits` overrides and `[[robot.capsules]]`.
+/// `[[robot.links]]`, with its `limits` overrides and `[[robot.capsules]]`; and a URDF's
+/// `<collision>` shapes (for [`collision_model`]).
 pub(super) fn robot(
     ctx: &Ctx,
     rr: &RawRobot,
     rspan: Range<usize>,
     dir: &Path,
-) -> Result<Robot, Error> {
+) -> Result<(Robot, Vec<CollisionShape>), Error> {
+    let mut shapes = Vec::new();
     let file = ctx.file;
     let sources = rr.builtin.is_some() as usize
         + rr.urdf.is_some() as usize
@@ -31,8 +34,10 @@ pub(super) fn robot(
         robot
     } else if let Some(u) = &rr.urdf {
         let path = dir.join(u);
-        let spec = crate::model::urdf::read_urdf(&path, rr.tip.as_deref())
-            .map_err(|e| ctx.err(rspan.clone(), "robot.urdf", e))?;
+        let (spec, urdf_shapes) =
+            crate::model::urdf::read_urdf_with_collisions(&path, rr.tip.as_deref())
+                .map_err(|e| ctx.err(rspan.clone(), "robot.urdf", e))?;
+        shapes = urdf_shapes;
         check_values(ctx, &spec.links, rspan.clone(), "robot.urdf")?;
         Robot {
             name: rr.name.clone().unwrap_or_else(|| spec.name.clone()),
@@ -130,16 +135,18 @@ pub(super) fn robot(
     } else if !rr.capsules.is_empty() {
         robot.collision = format!("the cell's {} [[robot.capsules]]", rr.capsules.len());
     }
-    Ok(robot)
+    Ok((robot, shapes))
 }
 
 /// The arm's collision model when the cell does not draw it: a robot from `urdf` or
-/// `[[robot.links]]` without `[[robot.capsules]]` gets its skeleton
+/// `[[robot.links]]` without `[[robot.capsules]]` gets the capsules bounding its URDF
+/// `<collision>` shapes ([`crate::robots::bounding`]), and its skeleton
 /// ([`crate::robots::skeleton`], on the frames of `given`, the chain as the cell assembles
-/// it) with the radii of `link_radius_mm` and `link_radii_mm`; the tool's own segment is left
-/// out when the cell has `[[tool_capsules]]`. The radius fields are refused where no skeleton
-/// is built (a built-in robot's capsules are hand-made; `[[robot.capsules]]` replace the
-/// skeleton).
+/// it) on every frame no such capsule is on, with the radii of `link_radius_mm` and
+/// `link_radii_mm`; the tool's own segment is left out when the cell has `[[tool_capsules]]`.
+/// The radius fields are refused where no skeleton is built (a built-in robot's capsules are
+/// hand-made; `[[robot.capsules]]` replace the skeleton). Returns warnings (meshes, which
+/// armcal does not read).
 pub(super) fn collision_model(
     ctx: &Ctx,
     rr: &RawRobot,
@@ -147,7 +154,8 @@ pub(super) fn collision_model(
     robot: &mut Robot,
     given: &Model,
     tool_capsules: &[Capsule],
-) -> Result<(), Error> {
+    shapes: &[CollisionShape],
+) -> Result<Vec<String>, Error> {
     use crate::robots::skeleton;
     let radius_field = match (&rr.link_radius_mm, &rr.link_radii_mm) {
         (Some(_), _) => Some("robot.link_radius_mm"),
@@ -165,7 +173,19 @@ pub(super) fn collision_model(
             };
             return Err(ctx.err(rspan, field, why));
         }
-        return Ok(());
+        return Ok(Vec::new());
+    }
+    let mut warnings = Vec::new();
+    let mut bounded = Vec::new();
+    for shape in shapes {
+        match crate::robots::bounding::bounding_capsule(shape) {
+            Some(c) => bounded.push(c),
+            None => warnings.push(format!(
+                "URDF link `{}` (frame `{}`): its collision mesh cannot be read (armcal reads \
+                 boxes, cylinders, capsules and spheres); the skeleton stands in for it",
+                shape.link, shape.frame
+            )),
+        }
     }
     let check = |field: &str, r: f64| {
         if r.is_finite() && r >= 0.0 {
@@ -199,7 +219,8 @@ pub(super) fn collision_model(
     }
     let with_tool = tool_capsules.is_empty();
     let radius = |frame: &str| per_frame.get(frame).copied().unwrap_or(default);
-    let capsules = skeleton::skeleton_capsules(given, &radius, with_tool);
+    let mut capsules = skeleton::skeleton_capsules(given, &radius, with_tool);
+    capsules.retain(|c| !bounded.iter().any(|b| b.frame == c.frame));
     if let Some(frame) = per_frame
         .keys()
         .find(|f| !capsules.iter().any(|c| c.frame == **f))
@@ -215,22 +236,26 @@ pub(super) fn collision_model(
             ),
         ));
     }
-    let mut text = format!(
-        "skeleton: {} capsules between successive joint origins{}, radius {} mm ({how})",
+    let mut text = if bounded.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "{} capsules bounding the URDF's <collision> shapes; on the other frames, ",
+            bounded.len()
+        )
+    };
+    text += &format!(
+        "skeleton: {} capsules between successive joint origins, radius {} mm ({how})",
         capsules.len(),
-        if with_tool {
-            " and to the tool origin"
-        } else {
-            ""
-        },
         default
     );
     for (frame, r) in &per_frame {
         text.push_str(&format!(", {frame} {r} mm"));
     }
-    robot.capsules = capsules;
+    bounded.extend(capsules);
+    robot.capsules = bounded;
     robot.collision = text;
-    Ok(())
+    Ok(warnings)
 }
 
 /// A joint's lower limit is not above its upper one (equal limits lock the joint); the error
