@@ -250,7 +250,7 @@ fn deepest(
     let (v, s, k) = best;
     let face_normal = |k: usize| {
         let mut n = Vector3::zeros();
-        n[k / 2] = if k % 2 == 0 { 1.0 } else { -1.0 };
+        n[k / 2] = if k.is_multiple_of(2) { 1.0 } else { -1.0 };
         n
     };
     // At a crossing inside (the minimum where one face's value rises and another's falls),
