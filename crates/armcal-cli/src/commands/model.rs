@@ -60,6 +60,11 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     );
     println!("{} ({})", cell.name, cell.origin);
     println!("source: {}", cell.robot.source);
+    println!(
+        "collision model: {} ({} capsules with the tool's)",
+        cell.robot.collision,
+        cell.capsules.len()
+    );
     for c in &cell.form_changes {
         println!(
             "complete, minimal form (convention = \"{}\"): {c}",

@@ -158,7 +158,27 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         rep.refine_status.as_deref().unwrap_or("skipped"),
         rep.time.as_secs_f64()
     );
+    let unchecked_arm = a.collisions == "on" && rep.arm_capsules == 0;
+    if a.collisions == "on" {
+        println!(
+            "arm collision model: {}; {} capsules move with the joints",
+            rep.collision_model, rep.arm_capsules
+        );
+    }
+    if unchecked_arm {
+        eprintln!(
+            "WARNING: the arm of `{}` has NO collision model (no capsule moves with a joint): \
+             self collision, the obstacles and the floor are NOT checked, and a feasible pose \
+             is only within the joint limits and the checks listed. Draw the arm with \
+             [[robot.capsules]] (or leave them out for the skeleton, [robot] link_radius_mm).",
+            cell.name
+        );
+    }
     match (rep.feasible, &rep.min_margin) {
+        (true, _) if unchecked_arm => println!(
+            "constraints: {} per pose; every pose within them, but the arm's collisions are NOT checked",
+            rep.constraints_per_pose
+        ),
         (false, Some(m)) => println!(
             "constraints: {} per pose; NOT FEASIBLE (worst: {:.4} on `{}` at pose {})",
             rep.constraints_per_pose,

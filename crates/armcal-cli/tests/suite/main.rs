@@ -7,6 +7,7 @@ mod browser;
 mod campaign_cli;
 mod check_cli;
 mod cli;
+mod collision_model_cli;
 mod compensate_cli;
 mod error_causes;
 mod estimate_checks;

@@ -88,6 +88,17 @@ pub fn to_cell_toml(cell: &Cell, identified: &Model, spec: &ModelSpec) -> Result
                 "\n[[obstacles]]\nname = {}\nkind = \"capsule\"\na_mm = {a:?}\nb_mm = {b:?}\nradius_mm = {radius:?}",
                 toml_text::string(name)
             ),
+            Obstacle::Box {
+                name,
+                center,
+                size,
+                rpy,
+            } => writeln!(
+                s.tail,
+                "\n[[obstacles]]\nname = {}\nkind = \"box\"\ncenter_mm = {center:?}\nsize_mm = {size:?}\nrpy_deg = {:?}",
+                toml_text::string(name),
+                rpy.map(f64::to_degrees)
+            ),
             Obstacle::HalfSpace {
                 name,
                 normal,

@@ -70,6 +70,19 @@ pub enum Obstacle {
         /// Radius around the segment (mm).
         radius: f64,
     },
+    /// A box (a table, a fixture, a fence): the points within `size / 2` of `center` along
+    /// each of its edges, the edges along the axes of `Rz(rpy₃) Ry(rpy₂) Rx(rpy₁)` (fixed-axis
+    /// roll, pitch, yaw, as every rpy of a cell).
+    Box {
+        /// Obstacle name, used in messages.
+        name: String,
+        /// Centre (mm, world frame).
+        center: [f64; 3],
+        /// Full edge lengths along the box's x, y and z (mm, > 0).
+        size: [f64; 3],
+        /// Orientation: roll, pitch, yaw (rad).
+        rpy: [f64; 3],
+    },
     /// The free side is `normal · x ≥ offset` (normal of unit length).
     HalfSpace {
         /// Obstacle name, used in messages.
@@ -79,6 +92,27 @@ pub enum Obstacle {
         /// Distance of the boundary plane from the world origin along the normal (mm).
         offset: f64,
     },
+}
+
+impl Obstacle {
+    /// The obstacle's name.
+    pub fn name(&self) -> &str {
+        match self {
+            Obstacle::Capsule { name, .. }
+            | Obstacle::Box { name, .. }
+            | Obstacle::HalfSpace { name, .. } => name,
+        }
+    }
+}
+
+/// A box obstacle as the geometry's [`Cuboid`](crate::geometry::Cuboid) (world frame, mm).
+pub fn box_cuboid(center: &[f64; 3], size: &[f64; 3], rpy: &[f64; 3]) -> crate::geometry::Cuboid {
+    let pose = crate::model::Pose::from_xyz_rpy(*center, *rpy);
+    crate::geometry::Cuboid {
+        center: pose.trans,
+        rotation: pose.rot,
+        half: nalgebra::Vector3::from(*size) * 0.5,
+    }
 }
 
 /// The unit normal of the half-space `name` with the (possibly unnormalised) `normal`; an

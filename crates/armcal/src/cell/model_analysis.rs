@@ -117,6 +117,12 @@ pub struct ModelRecord {
     pub cell: String,
     /// The robot's source (datasheet, paper).
     pub source: String,
+    /// Where the arm's capsules come from ([`crate::robots::Robot::collision`]).
+    #[serde(default)]
+    pub collision_model: String,
+    /// The cell's capsules (robot and tool; mm, in their chain frames).
+    #[serde(default)]
+    pub capsules: Vec<crate::robots::Capsule>,
     /// The convention converted to (`dh`, `mdh`, `zrp`), if any.
     pub convention: Option<String>,
     /// The link form the cell asked for.
@@ -142,6 +148,8 @@ impl ModelRecord {
         ModelRecord {
             cell: cell.name.clone(),
             source: cell.robot.source.clone(),
+            collision_model: cell.robot.collision.clone(),
+            capsules: cell.capsules.clone(),
             convention: analysis.convention.map(|f| f.name().to_string()),
             form: cell.form.name().to_string(),
             form_changes: cell.form_changes.clone(),

@@ -106,6 +106,14 @@ pub struct PlanResult {
     /// ([`ConstraintSet::pairs_in_contact`]).
     #[serde(default)]
     pub pairs_in_contact: Vec<String>,
+    /// Robot capsules that move with a joint and are checked against each other, the
+    /// obstacles and the half-spaces ([`ConstraintSet::arm_capsules`]); 0: the arm has no
+    /// collision model, and "feasible" says nothing about collisions.
+    #[serde(default)]
+    pub arm_capsules: usize,
+    /// Where the robot's capsules come from ([`crate::robots::Robot::collision`]).
+    #[serde(default)]
+    pub collision_model: String,
     /// Random draws made to fill the candidate pool.
     pub pool_draws: usize,
     /// Criterion value after the exchange, before the refinement (NaN when no feasible pool
@@ -183,6 +191,8 @@ fn infeasible_report(
         feasible: false,
         constraints_per_pose: set.len(),
         pairs_in_contact: set.pairs_in_contact().to_vec(),
+        arm_capsules: set.arm_capsules(),
+        collision_model: set.collision_model().to_string(),
         pool_draws: draws,
         exchange_value: f64::NAN,
         exchange_sweeps: 0,
@@ -413,6 +423,8 @@ pub fn plan(
         min_margin,
         constraints_per_pose: set.len(),
         pairs_in_contact: set.pairs_in_contact().to_vec(),
+        arm_capsules: set.arm_capsules(),
+        collision_model: set.collision_model().to_string(),
         pool_draws: draws,
         exchange_value,
         exchange_sweeps: sweeps,

@@ -387,6 +387,8 @@ pub fn plan_from_pool(
         feasible,
         constraints_per_pose: set.len(),
         pairs_in_contact: set.pairs_in_contact().to_vec(),
+        arm_capsules: set.arm_capsules(),
+        collision_model: set.collision_model().to_string(),
         pool_draws: 0,
         exchange_value: selection_value,
         exchange_sweeps: sweeps,

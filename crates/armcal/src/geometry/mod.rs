@@ -3,13 +3,17 @@
 //! One small module per query, in the style of parry:
 //! - [`segment_distance`](mod@segment_distance): closest points between two segments and the gradient of their
 //!   distance w.r.t. the endpoints (Ericson §5.1.9; the paper's eq. 21 and 23);
+//! - [`box_distance`]: signed distance from a segment to a box, with its gradient (capsule
+//!   against a table, a fixture, a fence);
 //! - [`fit`]: plane, circle and line through points, with the covariance of the fitted
 //!   axis (book §4.6).
 //!
-//! The constraint set of a cell built from these (incidence, capsule–capsule, half-space,
+//! The constraint set of a cell built from these (incidence, capsule–capsule, capsule–box, half-space,
 //! line of sight) is design work: [`crate::design::cell_constraints`].
 
+pub mod box_distance;
 pub mod fit;
 pub mod segment_distance;
 
+pub use box_distance::{segment_box_distance, Cuboid, SegmentBoxDistance};
 pub use segment_distance::{point_segment_distance, segment_distance, SegmentDistance};

@@ -118,6 +118,23 @@
       ctx.strokeStyle = rgb(color, 0.55); ctx.lineWidth = 1; ctx.stroke();
     };
   }
+  // The faces of a box obstacle that face the camera, each sorted by its mean depth; the
+  // name on the top face's centre.
+  function boxItems(faces, color) {
+    var out = [];
+    faces.forEach(function (f, k) {
+      if (f.normal[0] * cam.e[0] + f.normal[1] * cam.e[1] + f.normal[2] * cam.e[2] <= 0) { return; }
+      var pts = f.corners.map(project);
+      var depth = 0, cx = 0, cy = 0;
+      pts.forEach(function (p) { depth += p[2]; cx += p[0]; cy += p[1]; });
+      out.push({ depth: depth / 4, draw: function () {
+        polygonPath(pts);
+        ctx.fillStyle = rgb(color, 0.45); ctx.fill();
+        ctx.strokeStyle = rgb(mix(color, [0, 0, 0], 0.3)); ctx.lineWidth = 1; ctx.stroke();
+      }, label: k === 4 ? { at: [cx / 4, cy / 4], text: f.name } : null });
+    });
+    return out;
+  }
   function gridItem() {
     var z = scene.ground, step = 500;
     return function () {
@@ -190,6 +207,9 @@
     var items = [];
     scene.obstacles.forEach(function (o) {
       items.push(capsuleItem(o.a, o.b, o.r, hitObstacle[o.name] ? HIT : OBSTACLE, o.name));
+    });
+    scene.boxes.forEach(function (faces) {
+      items.push.apply(items, boxItems(faces, hitObstacle[faces[0].name] ? HIT : OBSTACLE));
     });
     scene.robot.forEach(function (c, i) {
       var e = pose.caps[i];

@@ -17,9 +17,12 @@
 //! Half-spaces are drawn as the polygon where their plane `n·x = offset` cuts the scene's
 //! box: every capsule at every pose, the tracker and targets, stretched until each plane
 //! crosses it, plus 200 mm.
+//!
+//! (Over 600 lines: one scene, its JSON types and the geometry that places every body of it
+//! — capsules, boxes, planes and their bounds — for the script.)
 
 use super::html::escape;
-use crate::cell::{half_space_unit_normal, Cell, Obstacle};
+use crate::cell::{box_cuboid, half_space_unit_normal, Cell, Obstacle};
 use crate::design::cell_constraints::{robot_capsules, JOINT_MARGIN_TOLERANCE};
 use crate::design::plan::constraint_set;
 use crate::design::ConstraintKind;
@@ -52,7 +55,7 @@ struct ObstacleCapsule {
     r: f64,
 }
 
-/// The boundary of a half-space, clipped to the scene box.
+/// The boundary of a half-space, clipped to the scene box; or a face of a box obstacle.
 #[derive(Serialize)]
 struct Plane {
     name: String,
@@ -115,6 +118,8 @@ struct Scene {
     ground: f64,
     robot: Vec<RobotCapsule>,
     obstacles: Vec<ObstacleCapsule>,
+    /// Box obstacles: each one's six faces (outward normals), named for the box.
+    boxes: Vec<Vec<Plane>>,
     planes: Vec<Plane>,
     /// The instrument frame's origin (mm), if the cell has an instrument.
     tracker: Option<[f64; 3]>,
@@ -146,7 +151,7 @@ pub fn cell_view_section(cell: &Cell, designs: &[(&str, &[Vec<f64>])]) -> Result
         escape(&cell.name)
     ));
     html.push_str(
-        "<p class=\"cell-view-help\">Robot capsules (orange), obstacles (blue-grey), wall and \
+        "<p class=\"cell-view-help\">Robot capsules (orange), obstacles (blue-grey capsules and boxes), wall and \
          floor (translucent), tracker and laser beam to the reflector (green; red when the \
          pose violates a constraint, with the capsules involved). Drag to orbit, wheel to \
          zoom, arrow keys or the slider to step through the poses.</p>\n",
@@ -354,6 +359,7 @@ fn scene(cell: &Cell, designs: &[(&str, &[Vec<f64>])]) -> Result<Scene, Error> {
     let mut focus = bounds.clone();
     let mut obstacles = Vec::new();
     let mut half_spaces = Vec::new();
+    let mut boxes = Vec::new();
     for o in &cell.obstacles {
         match o {
             Obstacle::Capsule { name, a, b, radius } => {
@@ -365,6 +371,20 @@ fn scene(cell: &Cell, designs: &[(&str, &[Vec<f64>])]) -> Result<Scene, Error> {
                     b: b.map(mm),
                     r: mm(*radius),
                 });
+            }
+            Obstacle::Box {
+                name,
+                center,
+                size,
+                rpy,
+            } => {
+                let faces = box_faces(name, &box_cuboid(center, size, rpy));
+                for f in &faces {
+                    for c in &f.corners {
+                        bounds.add(&Vector3::from(*c), 0.0);
+                    }
+                }
+                boxes.push(faces);
             }
             Obstacle::HalfSpace {
                 name,
@@ -415,6 +435,7 @@ fn scene(cell: &Cell, designs: &[(&str, &[Vec<f64>])]) -> Result<Scene, Error> {
         ground: mm(ground),
         robot,
         obstacles,
+        boxes,
         planes,
         tracker: tracker.map(|t| [t.x, t.y, t.z].map(mm)),
         target_names: if model.targets.is_empty() {
@@ -456,13 +477,41 @@ fn mark_named(
         }
     }
     if let Some((_, other)) = name.rsplit_once(" / ") {
-        let is_obstacle = cell.obstacles.iter().any(|o| match o {
-            Obstacle::Capsule { name, .. } | Obstacle::HalfSpace { name, .. } => name == other,
-        });
+        let is_obstacle = cell.obstacles.iter().any(|o| o.name() == other);
         if is_obstacle {
             hit_obstacles.push(other.to_string());
         }
     }
+}
+
+/// The six faces of a box obstacle: outward normal and four corners each (mm).
+fn box_faces(name: &str, b: &crate::geometry::Cuboid) -> Vec<Plane> {
+    let corner = |k: usize| {
+        let sign = |bit: usize| if k & bit != 0 { 1.0 } else { -1.0 };
+        let local = Vector3::new(sign(1) * b.half.x, sign(2) * b.half.y, sign(4) * b.half.z);
+        let p = b.center + b.rotation * local;
+        [p.x, p.y, p.z].map(mm)
+    };
+    // Corner k has +x if bit 1 is set, +y for bit 2, +z for bit 4; each face in order.
+    const FACES: [(usize, f64, [usize; 4]); 6] = [
+        (0, 1.0, [1, 3, 7, 5]),
+        (0, -1.0, [0, 4, 6, 2]),
+        (1, 1.0, [2, 6, 7, 3]),
+        (1, -1.0, [0, 1, 5, 4]),
+        (2, 1.0, [4, 5, 7, 6]),
+        (2, -1.0, [0, 2, 3, 1]),
+    ];
+    FACES
+        .iter()
+        .map(|(axis, sign, corners)| {
+            let n = b.rotation.column(*axis) * *sign;
+            Plane {
+                name: name.to_string(),
+                normal: [n.x, n.y, n.z].map(|v| round_to(v, 1e4)),
+                corners: corners.iter().map(|&k| corner(k)).collect(),
+            }
+        })
+        .collect()
 }
 
 /// An axis-aligned box that grows to hold points and spheres.

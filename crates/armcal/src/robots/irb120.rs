@@ -82,5 +82,6 @@ pub fn irb120() -> Robot {
             targets: vec![],
         },
         capsules,
+        collision: super::HAND_MADE.into(),
     }
 }

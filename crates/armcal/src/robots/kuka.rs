@@ -97,6 +97,7 @@ fn build(k: Kr) -> Robot {
             targets: vec![],
         },
         capsules,
+        collision: super::HAND_MADE.into(),
     }
 }
 

@@ -5,11 +5,13 @@
 //! targets: those belong to a cell). Lengths in mm, angles in rad, as everywhere inside
 //! armcal.
 
+pub mod bounding;
 mod irb120;
 mod kuka;
 mod motoman;
 mod paper;
 pub mod puma560;
+pub mod skeleton;
 mod ur10;
 
 use crate::model::{Joint, JointKind, LinkGeometry, LinkSpec, ModelSpec};
@@ -43,7 +45,16 @@ pub struct Robot {
     pub spec: ModelSpec,
     /// Link capsules for collision checks.
     pub capsules: Vec<Capsule>,
+    /// Where the capsules come from, in words (`plan` and `model` print it): hand-made, the
+    /// cell's `[[robot.capsules]]`, the URDF's `<collision>` shapes or the skeleton
+    /// ([`skeleton`]) with its radius.
+    #[serde(default)]
+    pub collision: String,
 }
+
+/// [`Robot::collision`] of the built-in robots.
+pub(crate) const HAND_MADE: &str =
+    "hand-made capsules of the built-in robot, sized from its outline drawings";
 
 /// `capsules`, fixed to frames of `from`, re-expressed in the same-named frames of `to`, an
 /// equivalent chain (same forward kinematics, e.g. [`crate::model::complete::in_form`]). A

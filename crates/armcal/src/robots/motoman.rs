@@ -106,5 +106,6 @@ pub fn motoman(arm: Arm) -> Robot {
             targets: vec![],
         },
         capsules,
+        collision: super::HAND_MADE.into(),
     }
 }

@@ -96,5 +96,6 @@ pub fn notional(lambda: f64, mu: f64) -> Robot {
             targets: vec![],
         },
         capsules,
+        collision: super::HAND_MADE.into(),
     }
 }

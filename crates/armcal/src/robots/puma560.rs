@@ -94,6 +94,7 @@ pub(super) fn puma560() -> Robot {
         ),
         spec,
         capsules: dh_capsules(),
+        collision: super::HAND_MADE.into(),
     }
 }
 
@@ -119,6 +120,7 @@ pub(super) fn puma560_zrp() -> Robot {
         ),
         spec,
         capsules,
+        collision: super::HAND_MADE.into(),
     }
 }
 

@@ -72,5 +72,6 @@ pub fn ur10() -> Robot {
             targets: vec![],
         },
         capsules,
+        collision: super::HAND_MADE.into(),
     }
 }

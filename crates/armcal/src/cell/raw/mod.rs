@@ -61,6 +61,12 @@ struct RawRobot {
     limits: Option<BTreeMap<String, [f64; 2]>>,
     #[serde(default)]
     capsules: Vec<Spanned<toml::Table>>,
+    /// Radius (mm) of every skeleton capsule ([`crate::robots::skeleton`]) of a robot from
+    /// `urdf` or `[[robot.links]]` without `[[robot.capsules]]`; default
+    /// [`crate::robots::skeleton::default_link_radius`].
+    link_radius_mm: Option<f64>,
+    /// Per-frame skeleton radii, `{ j2 = 80 }` (mm), over `link_radius_mm`.
+    link_radii_mm: Option<BTreeMap<String, f64>>,
     /// `auto` (default), `as-given`, `dh`, `mdh` or `zrp` ([`LinkForm`]).
     convention: Option<String>,
     /// Direction of gravity in the base frame (any length), default `[0, 0, -1]`.
@@ -147,7 +153,7 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
     let rspan = raw.robot.span();
     let rr = raw.robot.into_inner();
 
-    let mut robot = robot::robot(&ctx, &rr, rspan.clone(), dir)?;
+    let (mut robot, shapes) = robot::robot(&ctx, &rr, rspan.clone(), dir)?;
     let (instrument, instrument_geometry, instrument_name) =
         instrument::instrument(&ctx, raw.instrument)?;
     let (base, tool) = frames::base_and_tool(&ctx, &raw.base, &raw.tool)?;
@@ -167,6 +173,15 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
     let mut tool_capsules = robot::tool_capsules(&ctx, &raw.tool_capsules)?;
     let form = robot::link_form(&ctx, &rr, rspan.clone())?;
     let given = Model::from_spec(&spec).map_err(model_error)?;
+    let collision_warnings = robot::collision_model(
+        &ctx,
+        &rr,
+        rspan.clone(),
+        &mut robot,
+        &given,
+        &tool_capsules,
+        &shapes,
+    )?;
     let shaped = shape_robot(&mut robot, &given, spec, form, &mut tool_capsules)
         .map_err(|e| ctx.err(rspan.clone(), "robot.convention", e))?;
     let mut spec = shaped.spec;
@@ -186,6 +201,7 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
     let (working_paths, path_warnings) =
         working::working_paths(&ctx, &raw.working_path, &model, dir)?;
     warnings.extend(path_warnings);
+    warnings.extend(collision_warnings);
     let obstacles = obstacles::obstacles(&ctx, &raw.obstacles)?;
     let design = design::design(&ctx, raw.design.as_ref())?;
     design::check_joint_margin(&ctx, raw.design.as_ref(), &design, &model)?;

@@ -1,4 +1,4 @@
-//! `[[obstacles]]`: capsules and half-spaces in the world frame.
+//! `[[obstacles]]`: capsules, boxes and half-spaces in the world frame.
 
 use super::fields::*;
 use super::*;
@@ -35,6 +35,31 @@ fn obstacle(t: &toml::Table, i: usize) -> Result<Obstacle, String> {
                 radius: c.radius,
             })
         }
+        Some("box") => {
+            let mut used = Vec::new();
+            let center = unit_triple(t, "center", Unit::Mm, &mut used)?
+                .ok_or("missing `center_mm = [x, y, z]` (the box's centre, world frame)")?;
+            let size = unit_triple(t, "size", Unit::Mm, &mut used)?
+                .ok_or("missing `size_mm = [x, y, z]` (the full edge lengths)")?;
+            if let Some(s) = size.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
+                return Err(format!(
+                    "`size_mm` holds {s}: every edge length must be a finite length > 0 mm"
+                ));
+            }
+            let rpy = unit_triple(t, "rpy", Unit::Rad, &mut used)?.unwrap_or([0.0; 3]);
+            let valid = [
+                unit_spellings("center", Unit::Mm),
+                unit_spellings("size", Unit::Mm),
+                unit_spellings("rpy", Unit::Rad),
+            ];
+            check_unused(t, &used, &["kind", "name"], &valid)?;
+            Ok(Obstacle::Box {
+                name,
+                center,
+                size,
+                rpy,
+            })
+        }
         Some("half-space") => {
             let mut used = Vec::new();
             let n = unit_triple(t, "normal", Unit::Unitless, &mut used)?
@@ -54,8 +79,8 @@ fn obstacle(t: &toml::Table, i: usize) -> Result<Obstacle, String> {
             })
         }
         Some(k) => Err(format!(
-            "unknown obstacle kind `{k}`; use capsule or half-space"
+            "unknown obstacle kind `{k}`; use capsule, box or half-space"
         )),
-        None => Err("missing `kind` (capsule or half-space)".into()),
+        None => Err("missing `kind` (capsule, box or half-space)".into()),
     }
 }

@@ -1,18 +1,22 @@
 //! `[robot]` (a built-in robot, a URDF file or inline `[[robot.links]]`, joint `limits`,
-//! `[[robot.capsules]]`, `convention`) and `[[tool_capsules]]`.
+//! `[[robot.capsules]]`, the skeleton's `link_radius_mm` and `link_radii_mm`, `convention`)
+//! and `[[tool_capsules]]`.
 
 use super::fields::*;
 use super::*;
+use crate::model::urdf::CollisionShape;
 use std::ops::Range;
 
 /// The robot of `[robot]`: exactly one of `builtin`, `urdf` (relative to `dir`) or
-/// `[[robot.links]]`, with its `limits` overrides and `[[robot.capsules]]`.
+/// `[[robot.links]]`, with its `limits` overrides and `[[robot.capsules]]`; and a URDF's
+/// `<collision>` shapes (for [`collision_model`]).
 pub(super) fn robot(
     ctx: &Ctx,
     rr: &RawRobot,
     rspan: Range<usize>,
     dir: &Path,
-) -> Result<Robot, Error> {
+) -> Result<(Robot, Vec<CollisionShape>), Error> {
+    let mut shapes = Vec::new();
     let file = ctx.file;
     let sources = rr.builtin.is_some() as usize
         + rr.urdf.is_some() as usize
@@ -30,8 +34,10 @@ pub(super) fn robot(
         robot
     } else if let Some(u) = &rr.urdf {
         let path = dir.join(u);
-        let spec = crate::model::urdf::read_urdf(&path, rr.tip.as_deref())
-            .map_err(|e| ctx.err(rspan.clone(), "robot.urdf", e))?;
+        let (spec, urdf_shapes) =
+            crate::model::urdf::read_urdf_with_collisions(&path, rr.tip.as_deref())
+                .map_err(|e| ctx.err(rspan.clone(), "robot.urdf", e))?;
+        shapes = urdf_shapes;
         check_values(ctx, &spec.links, rspan.clone(), "robot.urdf")?;
         Robot {
             name: rr.name.clone().unwrap_or_else(|| spec.name.clone()),
@@ -39,6 +45,7 @@ pub(super) fn robot(
             source: format!("URDF file {}", path.display()),
             spec,
             capsules: Vec::new(),
+            collision: String::new(),
         }
     } else {
         let mut links = Vec::new();
@@ -79,6 +86,7 @@ pub(super) fn robot(
                 targets: vec![],
             },
             capsules: Vec::new(),
+            collision: String::new(),
         }
     };
     if let Some(limits) = &rr.limits {
@@ -118,7 +126,136 @@ pub(super) fn robot(
             .map_err(|e| ctx.err(c.span(), &format!("robot.capsules[{i}]"), e))?;
         robot.capsules.push(cap);
     }
-    Ok(robot)
+    if rr.builtin.is_some() && !rr.capsules.is_empty() {
+        robot.collision = format!(
+            "{}, and the cell's {} [[robot.capsules]]",
+            robot.collision,
+            rr.capsules.len()
+        );
+    } else if !rr.capsules.is_empty() {
+        robot.collision = format!("the cell's {} [[robot.capsules]]", rr.capsules.len());
+    }
+    Ok((robot, shapes))
+}
+
+/// The arm's collision model when the cell does not draw it: a robot from `urdf` or
+/// `[[robot.links]]` without `[[robot.capsules]]` gets the capsules bounding its URDF
+/// `<collision>` shapes ([`crate::robots::bounding`]), and its skeleton
+/// ([`crate::robots::skeleton`], on the frames of `given`, the chain as the cell assembles
+/// it) on every frame no such capsule is on, with the radii of `link_radius_mm` and
+/// `link_radii_mm`; the tool's own segment is left out when the cell has `[[tool_capsules]]`.
+/// The radius fields are refused where no skeleton is built (a built-in robot's capsules are
+/// hand-made; `[[robot.capsules]]` replace the skeleton). Returns warnings (meshes, which
+/// armcal does not read).
+pub(super) fn collision_model(
+    ctx: &Ctx,
+    rr: &RawRobot,
+    rspan: Range<usize>,
+    robot: &mut Robot,
+    given: &Model,
+    tool_capsules: &[Capsule],
+    shapes: &[CollisionShape],
+) -> Result<Vec<String>, Error> {
+    use crate::robots::skeleton;
+    let radius_field = match (&rr.link_radius_mm, &rr.link_radii_mm) {
+        (Some(_), _) => Some("robot.link_radius_mm"),
+        (None, Some(_)) => Some("robot.link_radii_mm"),
+        (None, None) => None,
+    };
+    if rr.builtin.is_some() || !rr.capsules.is_empty() {
+        if let Some(field) = radius_field {
+            let why = if rr.builtin.is_some() {
+                "a built-in robot has hand-made capsules; the skeleton's radius applies to a \
+                 robot from `urdf` or `[[robot.links]]` (add capsules with [[robot.capsules]])"
+            } else {
+                "the cell draws the arm with [[robot.capsules]], which replace the skeleton; \
+                 remove one or the other"
+            };
+            return Err(ctx.err(rspan, field, why));
+        }
+        return Ok(Vec::new());
+    }
+    let mut warnings = Vec::new();
+    let mut bounded = Vec::new();
+    for shape in shapes {
+        match crate::robots::bounding::bounding_capsule(shape) {
+            Some(c) => bounded.push(c),
+            None => warnings.push(format!(
+                "URDF link `{}` (frame `{}`): its collision mesh cannot be read (armcal reads \
+                 boxes, cylinders, capsules and spheres); the skeleton stands in for it",
+                shape.link, shape.frame
+            )),
+        }
+    }
+    let check = |field: &str, r: f64| {
+        if r.is_finite() && r >= 0.0 {
+            Ok(r)
+        } else {
+            Err(ctx.err(
+                rspan.clone(),
+                field,
+                format!("{r} is not a radius: give a finite length ≥ 0 mm"),
+            ))
+        }
+    };
+    let (default, how) = match rr.link_radius_mm {
+        Some(r) => (
+            check("robot.link_radius_mm", r)?,
+            "[robot] link_radius_mm".to_string(),
+        ),
+        None => {
+            let r = skeleton::default_link_radius(given);
+            let how = format!(
+                "default: {:.0} % of the arm's {:.0} mm skeleton; set [robot] link_radius_mm",
+                100.0 * skeleton::DEFAULT_RADIUS_SHARE,
+                skeleton::arm_length(given)
+            );
+            (r, how)
+        }
+    };
+    let per_frame = rr.link_radii_mm.clone().unwrap_or_default();
+    for (frame, r) in &per_frame {
+        check(&format!("robot.link_radii_mm.{frame}"), *r)?;
+    }
+    let with_tool = tool_capsules.is_empty();
+    let radius = |frame: &str| per_frame.get(frame).copied().unwrap_or(default);
+    let mut capsules = skeleton::skeleton_capsules(given, &radius, with_tool);
+    capsules.retain(|c| !bounded.iter().any(|b| b.frame == c.frame));
+    if let Some(frame) = per_frame
+        .keys()
+        .find(|f| !capsules.iter().any(|c| c.frame == **f))
+    {
+        let mut carriers: Vec<&str> = capsules.iter().map(|c| c.frame.as_str()).collect();
+        carriers.dedup();
+        return Err(ctx.err(
+            rspan,
+            &format!("robot.link_radii_mm.{frame}"),
+            format!(
+                "no skeleton capsule is on frame `{frame}`; the skeleton's frames are {}",
+                carriers.join(", ")
+            ),
+        ));
+    }
+    let mut text = if bounded.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "{} capsules bounding the URDF's <collision> shapes; on the other frames, ",
+            bounded.len()
+        )
+    };
+    text += &format!(
+        "skeleton: {} capsules between successive joint origins, radius {} mm ({how})",
+        capsules.len(),
+        default
+    );
+    for (frame, r) in &per_frame {
+        text.push_str(&format!(", {frame} {r} mm"));
+    }
+    bounded.extend(capsules);
+    robot.capsules = bounded;
+    robot.collision = text;
+    Ok(warnings)
 }
 
 /// A joint's lower limit is not above its upper one (equal limits lock the joint); the error

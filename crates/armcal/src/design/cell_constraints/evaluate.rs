@@ -164,6 +164,14 @@ impl ConstraintSet {
                 }
                 sd.distance - ci.radius - ob.radius
             }
+            Item::Box { i, b } => {
+                let ci = &self.capsules[i];
+                let sd = segment_box_distance(&ends[i][0], &ends[i][1], &self.boxes[b]);
+                if let Some(grad) = grad {
+                    two_point_gradient(grad, twists, &sd.normal, &sd.p, ci.joints, &sd.p, 0);
+                }
+                sd.distance - ci.radius
+            }
             Item::HalfSpace { i, end, h } => {
                 let (ci, hs) = (&self.capsules[i], &self.half_spaces[h]);
                 let x = ends[i][end];
@@ -187,6 +195,13 @@ impl ConstraintSet {
                     beam_gradient(grad, twists, &sd.normal, sd.s, &p, &sd.q, 0);
                 }
                 sd.distance - self.beam_radius - ob.radius
+            }
+            Item::BeamBox { b } => {
+                let sd = segment_box_distance(&p, &tracker, &self.boxes[b]);
+                if let Some(grad) = grad {
+                    beam_gradient(grad, twists, &sd.normal, sd.s, &p, &sd.p, 0);
+                }
+                sd.distance - self.beam_radius
             }
         }
     }
@@ -336,18 +351,27 @@ fn spread_configuration(lower: &[f64], upper: &[f64], k: usize, q: &mut [f64]) {
 }
 
 /// Leaves out the robot capsule pairs that overlap at every one of `samples` spread
-/// configurations (those of [`constraint_ranges`]), keeping their names in
+/// configurations (those of [`constraint_ranges`]), and the robot–obstacle and robot–half-space
+/// constraints that keep one negative value at all of them, keeping their names in
 /// `set.pairs_in_contact` (see the module documentation: bodies in contact by construction).
-/// Only the pairs not yet seen apart are evaluated, and the sampling stops when every pair
-/// has been: a few configurations for a robot without such a pair.
+/// Only the constraints not yet seen apart (or changing) are evaluated, and the sampling
+/// stops when none is left: a few configurations for a robot without such a pair.
 pub(super) fn drop_pairs_in_contact(set: &mut ConstraintSet, samples: usize) {
+    let constant_only = |i: usize| {
+        matches!(
+            set.items[i],
+            Item::Obstacle { .. } | Item::Box { .. } | Item::HalfSpace { .. }
+        )
+    };
     let mut touching: Vec<bool> = (0..set.len())
-        .map(|i| set.kind(i) == ConstraintKind::SelfCollision)
+        .map(|i| set.kind(i) == ConstraintKind::SelfCollision || constant_only(i))
         .collect();
+    let constant: Vec<bool> = (0..set.len()).map(constant_only).collect();
     let (lower, upper) = set.model.joint_limits();
     let params = set.model.nominal();
     let mut ws = set.workspace();
     let mut values = vec![0.0; set.len()];
+    let mut first = vec![f64::NAN; set.len()];
     let mut q = vec![0.0; lower.len()];
     let mut rows: Vec<usize> = (0..set.len()).filter(|&i| touching[i]).collect();
     for k in 0..samples {
@@ -357,7 +381,10 @@ pub(super) fn drop_pairs_in_contact(set: &mut ConstraintSet, samples: usize) {
         spread_configuration(&lower, &upper, k, &mut q);
         set.evaluate_rows(&mut ws, &params, &q, &rows, &mut values, None);
         for &i in &rows {
-            touching[i] = values[i] < 0.0;
+            if k == 0 {
+                first[i] = values[i];
+            }
+            touching[i] = values[i] < 0.0 && (!constant[i] || (values[i] - first[i]).abs() < 1e-9);
         }
         rows.retain(|&i| touching[i]);
     }
@@ -376,8 +403,9 @@ pub(super) fn drop_pairs_in_contact(set: &mut ConstraintSet, samples: usize) {
 }
 
 impl ConstraintSet {
-    /// Robot capsule pairs not checked because they overlap at every sampled configuration
-    /// (names as [`ConstraintSet::names`]).
+    /// Robot capsule pairs not checked because they overlap at every sampled configuration,
+    /// and robot–obstacle constraints left out because they keep one negative value there (a
+    /// capsule from the base origin on the floor); names as [`ConstraintSet::names`].
     pub fn pairs_in_contact(&self) -> &[String] {
         &self.pairs_in_contact
     }

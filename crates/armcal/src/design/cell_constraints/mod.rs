@@ -12,8 +12,9 @@
 //! | incidence | `cos β − cos β_max` | paper eq. 4, Table 4 (β_max = 30°) |
 //! | self collision | `d_P(bᵢ, bⱼ) − rᵢ − rⱼ` | eq. 20–21 |
 //! | obstacle | `d_P(bᵢ, o) − rᵢ − r_o` | eq. 20, §3.2 (car body) |
+//! | box obstacle | `φ_B(bᵢ) − rᵢ` | signed segment–box distance ([`segment_box_distance`]) |
 //! | half-space | `n · x − rᵢ − offset` at both capsule endpoints | §3.2 (wall `x − r ≥ −450`, floor `z − r ≥ 0`) |
-//! | line of sight | `d_P(beam, b) − r_beam − r_b` | §3.2, Table 5 |
+//! | line of sight | `d_P(beam, b) − r_beam − r_b` (`φ_B(beam) − r_beam` for a box) | §3.2, Table 5 |
 //!
 //! **Incidence.** β is the angle between the reflector's z axis `z` and the unit beam
 //! `g = (t − p)/|t − p|` from the reflector position `p` to the tracker origin `t` (the
@@ -30,7 +31,9 @@
 //! segment distance is `n · (Ṗ − Q̇)` (see
 //! [`segment_distance`](crate::geometry::segment_distance())); for two robot capsules only
 //! the joints between their frames contribute (a common joint moves both rigidly and
-//! `n · (ω × (P − Q)) = 0`).
+//! `n · (ω × (P − Q)) = 0`). A box stands still: the derivative of the signed segment–box
+//! distance is `n · Ṗ`, with `P` the segment's closest (or deepest) point and `n` the box's
+//! outward normal there ([`segment_box_distance`](crate::geometry::segment_box_distance())).
 //!
 //! **Which robot pairs are checked (the set 𝓘 of eq. 24b).** The robot's bodies are its
 //! capsule-carrying chain frames (`base, j1, …, jn, tool`, in chain order), each body being
@@ -57,6 +60,14 @@
 //! `base`) do not move: they are checked against the moving robot capsules and against the
 //! beam, but not against obstacles and half-spaces (the value would not depend on q).
 //!
+//! **Obstacles in contact by construction.** A robot capsule's obstacle or half-space
+//! constraint whose value is the same negative number at every one of the 256 spread
+//! configurations is left out like a pair in contact, and listed with them: a capsule that
+//! starts at the base origin on the floor (a skeleton-derived first link,
+//! [`crate::robots::skeleton`]) dips into the floor by its radius whatever the joints do; no
+//! design could change that. A constraint negative everywhere but not constant (an arm that
+//! always hits a table) stays, and makes the design infeasible.
+//!
 //! **Line of sight.** The beam from the reflector to the tracker origin is a capsule of radius
 //! [`ConstraintSettings::beam_radius`]. It is checked against every robot capsule and every
 //! obstacle capsule, except the robot capsules that carry the reflector: a capsule whose
@@ -79,12 +90,15 @@
 //! and the cell says it is allowed; "no configuration changes" is checked at 256 spread
 //! configurations.
 //!
+//! (Over 600 lines, about 180 of them this documentation: one concept, the set's assembly;
+//! its evaluation is already in `evaluate.rs`.)
+//!
 //! This file assembles the set from a cell ([`ConstraintSet::new`]); `evaluate.rs` computes
 //! values and gradients at a configuration; `measurable.rs` lists what makes a pose
 //! unmeasurable.
 
-use crate::cell::{half_space_unit_normal, Cell, DesignClearance, Obstacle};
-use crate::geometry::{point_segment_distance, segment_distance};
+use crate::cell::{box_cuboid, half_space_unit_normal, Cell, DesignClearance, Obstacle};
+use crate::geometry::{point_segment_distance, segment_box_distance, segment_distance, Cuboid};
 use crate::model::fixed_kinematics::FixedKinematics;
 use crate::model::{forward_kinematics, Data, Model, Twist};
 use crate::Error;
@@ -97,11 +111,11 @@ pub enum ConstraintKind {
     Incidence,
     /// Two robot capsules (eq. 20).
     SelfCollision,
-    /// A robot capsule and an obstacle capsule.
+    /// A robot capsule and an obstacle (capsule or box).
     Obstacle,
     /// A robot capsule endpoint and a half-space (wall, floor).
     HalfSpace,
-    /// The laser beam and a robot or obstacle capsule.
+    /// The laser beam and a robot capsule or an obstacle.
     LineOfSight,
 }
 
@@ -234,9 +248,11 @@ enum Item {
     Incidence,
     Pair { i: usize, j: usize },
     Obstacle { i: usize, o: usize },
+    Box { i: usize, b: usize },
     HalfSpace { i: usize, end: usize, h: usize },
     BeamRobot { i: usize },
     BeamObstacle { o: usize },
+    BeamBox { b: usize },
 }
 
 impl Item {
@@ -244,9 +260,11 @@ impl Item {
         match self {
             Item::Incidence => ConstraintKind::Incidence,
             Item::Pair { .. } => ConstraintKind::SelfCollision,
-            Item::Obstacle { .. } => ConstraintKind::Obstacle,
+            Item::Obstacle { .. } | Item::Box { .. } => ConstraintKind::Obstacle,
             Item::HalfSpace { .. } => ConstraintKind::HalfSpace,
-            Item::BeamRobot { .. } | Item::BeamObstacle { .. } => ConstraintKind::LineOfSight,
+            Item::BeamRobot { .. } | Item::BeamObstacle { .. } | Item::BeamBox { .. } => {
+                ConstraintKind::LineOfSight
+            }
         }
     }
 }
@@ -279,6 +297,7 @@ pub struct ConstraintSet {
     model: Model,
     capsules: Vec<RobotCapsule>,
     obstacles: Vec<WorldCapsule>,
+    boxes: Vec<Cuboid>,
     half_spaces: Vec<HalfSpace>,
     items: Vec<Item>,
     names: Vec<String>,
@@ -298,6 +317,10 @@ pub struct ConstraintSet {
     joint_tolerance: f64,
     /// Robot capsule pairs left out because they overlap everywhere (`evaluate.rs`).
     pairs_in_contact: Vec<String>,
+    /// Robot capsules that move with a joint, if collisions are checked.
+    arm_capsules: usize,
+    /// The cell robot's [`crate::robots::Robot::collision`].
+    collision_model: String,
 }
 
 /// Reusable buffers for [`ConstraintSet::evaluate`], of the set that made them
@@ -350,6 +373,8 @@ impl ConstraintSet {
         }
         let mut obstacles = Vec::new();
         let mut obstacle_names = Vec::new();
+        let mut boxes = Vec::new();
+        let mut box_names = Vec::new();
         let mut half_spaces = Vec::new();
         let mut half_space_names = Vec::new();
         for o in &cell.obstacles {
@@ -361,6 +386,15 @@ impl ConstraintSet {
                         radius: *radius,
                     });
                     obstacle_names.push(name.clone());
+                }
+                Obstacle::Box {
+                    name,
+                    center,
+                    size,
+                    rpy,
+                } => {
+                    boxes.push(box_cuboid(center, size, rpy));
+                    box_names.push(name.clone());
                 }
                 Obstacle::HalfSpace {
                     name,
@@ -416,6 +450,10 @@ impl ConstraintSet {
                     items.push(Item::Obstacle { i, o });
                     names.push(format!("{} / {name}", c.label));
                 }
+                for (b, name) in box_names.iter().enumerate() {
+                    items.push(Item::Box { i, b });
+                    names.push(format!("{} / {name}", c.label));
+                }
             }
             for (i, c) in capsules.iter().enumerate() {
                 if c.joints == 0 {
@@ -441,6 +479,10 @@ impl ConstraintSet {
                 items.push(Item::BeamObstacle { o });
                 names.push(format!("beam / {name}"));
             }
+            for (b, name) in box_names.iter().enumerate() {
+                items.push(Item::BeamBox { b });
+                names.push(format!("beam / {name}"));
+            }
         }
         let (mut lower, mut upper) = model.joint_limits();
         debug_assert_eq!(lower.len(), dof);
@@ -462,6 +504,7 @@ impl ConstraintSet {
             model,
             capsules,
             obstacles,
+            boxes,
             half_spaces,
             items,
             names,
@@ -474,7 +517,12 @@ impl ConstraintSet {
             constant: vec![false; n],
             joint_tolerance: 0.0,
             pairs_in_contact: Vec::new(),
+            arm_capsules: 0,
+            collision_model: cell.robot.collision.clone(),
         };
+        if options.collisions {
+            set.arm_capsules = set.capsules.iter().filter(|c| c.joints > 0).count();
+        }
         drop_pairs_in_contact(&mut set, 256);
         // 16 samples: the constraints the refinement keeps no margin from (see
         // `CellConstraints` in plan.rs).
@@ -530,6 +578,19 @@ impl ConstraintSet {
     /// Name of constraint `i`.
     pub fn name(&self, i: usize) -> &str {
         &self.names[i]
+    }
+
+    /// Robot capsules that move with a joint, checked against each other, the obstacles and
+    /// the half-spaces (0 when the set checks no collisions, or when the arm has no
+    /// collision model: then a feasible pose is only within the joint limits, and a caller
+    /// should say so).
+    pub fn arm_capsules(&self) -> usize {
+        self.arm_capsules
+    }
+
+    /// Where the cell robot's capsules come from ([`crate::robots::Robot::collision`]).
+    pub fn collision_model(&self) -> &str {
+        &self.collision_model
     }
 
     /// Kind of constraint `i`.

@@ -13,6 +13,16 @@ use super::{unique, CONTINUOUS_RANGE, M_PER_MM};
 /// Reads a URDF file and imports the chain from its root to `tip` (default: the single leaf
 /// link). Errors name the file.
 pub fn read_urdf(path: impl AsRef<Path>, tip: Option<&str>) -> Result<ModelSpec, Error> {
+    read_urdf_with_collisions(path, tip).map(|(spec, _)| spec)
+}
+
+/// [`read_urdf`], with the `<collision>` shapes of the chain's links, each on the chain frame
+/// its URDF link moves with (the root link's on `base`, a joint's child link's on the frame
+/// named for that joint).
+pub fn read_urdf_with_collisions(
+    path: impl AsRef<Path>,
+    tip: Option<&str>,
+) -> Result<(ModelSpec, Vec<CollisionShape>), Error> {
     let path = path.as_ref();
     let file = path.display().to_string();
     let text =
@@ -20,7 +30,7 @@ pub fn read_urdf(path: impl AsRef<Path>, tip: Option<&str>) -> Result<ModelSpec,
             file: file.clone(),
             message: format!("cannot read the URDF file: {e}"),
         })?;
-    from_urdf_str(&text, tip).map_err(|e| Error::File {
+    parse(&text, tip).map_err(|e| Error::File {
         file,
         message: match e {
             Error::Input(m) => m,
@@ -32,6 +42,11 @@ pub fn read_urdf(path: impl AsRef<Path>, tip: Option<&str>) -> Result<ModelSpec,
 /// Parses URDF text and imports the chain from its root to `tip` (default: the single leaf);
 /// a text nesting deeper than [`super::depth::MAX_DEPTH`] is refused before parsing.
 pub fn from_urdf_str(xml: &str, tip: Option<&str>) -> Result<ModelSpec, Error> {
+    parse(xml, tip).map(|(spec, _)| spec)
+}
+
+/// The chain of `xml` and its links' collision shapes.
+fn parse(xml: &str, tip: Option<&str>) -> Result<(ModelSpec, Vec<CollisionShape>), Error> {
     super::depth::check_depth(xml)?;
     // The XML parser under urdf-rs (RustyXML 0.3) panics on some malformed documents instead
     // of returning an error: an attribute name with an undeclared namespace prefix
@@ -54,12 +69,82 @@ pub fn from_urdf_str(xml: &str, tip: Option<&str>) -> Result<ModelSpec, Error> {
         )
     })?;
     let robot = parsed.map_err(|e| Error::Input(format!("not a valid URDF document: {e}")))?;
-    from_urdf_robot(&robot, tip)
+    let (spec, frames) = import(&robot, tip)?;
+    Ok((spec, collision_shapes(&robot, &frames)))
+}
+
+/// A `<collision>` shape of a chain link, in armcal's units.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CollisionShape {
+    /// The chain frame it moves with.
+    pub frame: String,
+    /// The URDF link it belongs to.
+    pub link: String,
+    /// Its `<origin>` in the link frame (mm, rad).
+    pub origin: crate::model::Pose<f64>,
+    /// The shape.
+    pub geometry: CollisionGeometry,
+}
+
+/// A URDF collision geometry (lengths in mm), centred on its origin; a cylinder's and a
+/// capsule's axis is the origin's z axis.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CollisionGeometry {
+    /// Edge lengths along x, y, z.
+    Box([f64; 3]),
+    /// Radius and length.
+    Cylinder(f64, f64),
+    /// Radius and the length of its cylindrical part.
+    Capsule(f64, f64),
+    /// Radius.
+    Sphere(f64),
+    /// A mesh file: armcal does not read meshes.
+    Mesh(String),
+}
+
+/// The collision shapes of the chain's URDF links (`frames`: URDF link → chain frame).
+fn collision_shapes(robot: &urdf_rs::Robot, frames: &[(String, String)]) -> Vec<CollisionShape> {
+    use urdf_rs::Geometry as G;
+    let mm = |v: f64| v / M_PER_MM;
+    let mut out = Vec::new();
+    for (link, frame) in frames {
+        let Some(l) = robot.links.iter().find(|l| l.name == *link) else {
+            continue;
+        };
+        for c in &l.collision {
+            let geometry = match &c.geometry {
+                G::Box { size } => CollisionGeometry::Box(size.0.map(mm)),
+                G::Cylinder { radius, length } => {
+                    CollisionGeometry::Cylinder(mm(*radius), mm(*length))
+                }
+                G::Capsule { radius, length } => {
+                    CollisionGeometry::Capsule(mm(*radius), mm(*length))
+                }
+                G::Sphere { radius } => CollisionGeometry::Sphere(mm(*radius)),
+                G::Mesh { filename, .. } => CollisionGeometry::Mesh(filename.clone()),
+            };
+            out.push(CollisionShape {
+                frame: frame.clone(),
+                link: link.clone(),
+                origin: crate::model::Pose::from_xyz_rpy(c.origin.xyz.0.map(mm), c.origin.rpy.0),
+                geometry,
+            });
+        }
+    }
+    out
 }
 
 /// Imports the serial chain of a parsed URDF robot from its root link to `tip` (default: the
 /// single leaf link).
 pub fn from_urdf_robot(robot: &urdf_rs::Robot, tip: Option<&str>) -> Result<ModelSpec, Error> {
+    import(robot, tip).map(|(spec, _)| spec)
+}
+
+/// The chain, and which chain frame each URDF link on it moves with.
+fn import(
+    robot: &urdf_rs::Robot,
+    tip: Option<&str>,
+) -> Result<(ModelSpec, Vec<(String, String)>), Error> {
     let err = |m: String| Error::Input(format!("URDF robot `{}`: {m}", robot.name));
     if robot.links.is_empty() {
         return Err(err("has no links".into()));
@@ -163,8 +248,10 @@ pub fn from_urdf_robot(robot: &urdf_rs::Robot, tip: Option<&str>) -> Result<Mode
 
     let mut names: HashSet<String> = ["base".to_string(), "tool".to_string()].into();
     let mut out = vec![identity_frame("base")];
+    let mut frames = vec![(root.to_string(), "base".to_string())];
     for j in path {
         let name = unique(&sanitise(&j.name), &mut names);
+        frames.push((j.child.link.clone(), name.clone()));
         out.push(import_joint(j, name).map_err(|m| err(format!("joint `{}`: {m}", j.name)))?);
     }
     if out.iter().all(|l| l.joint.is_none()) {
@@ -173,7 +260,7 @@ pub fn from_urdf_robot(robot: &urdf_rs::Robot, tip: Option<&str>) -> Result<Mode
         )));
     }
     out.push(identity_frame("tool"));
-    Ok(ModelSpec {
+    let spec = ModelSpec {
         compliance: None,
         periodic: None,
         payloads: Vec::new(),
@@ -181,7 +268,8 @@ pub fn from_urdf_robot(robot: &urdf_rs::Robot, tip: Option<&str>) -> Result<Mode
         instrument: None,
         links: out,
         targets: Vec::new(),
-    })
+    };
+    Ok((spec, frames))
 }
 
 /// One URDF joint as a link spec (lengths in mm).

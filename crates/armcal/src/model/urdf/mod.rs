@@ -16,8 +16,11 @@
 //! given (an omitted limit, URDF ≥ 1.2, means ±[`CONTINUOUS_RANGE`]); continuous joints get
 //! ±[`CONTINUOUS_RANGE`] = ±2π; prismatic joints need finite limits (m → mm). An identity
 //! `base` frame precedes the chain and an identity `tool` frame ends it, so the result has the
-//! shape of every armcal robot. Inertia, geometry, mimic targets off the chain, and links off
-//! the chain are ignored.
+//! shape of every armcal robot. [`read_urdf_with_collisions`] also returns the chain links'
+//! `<collision>` shapes (box, cylinder, capsule, sphere; a mesh by its file name, which armcal
+//! does not read), each on the chain frame its link moves with; the cell bounds them by
+//! capsules (`robots/bounding.rs`). Inertia, visual geometry, mimic targets off the
+//! chain, and links off the chain are ignored.
 //!
 //! **Export** ([`to_urdf`]) writes any chain, in any convention, as a URDF serial chain. Every
 //! link transform is split at its joint motion, `T_i(q) = A_i · J(q) · B_i`, with `A_i` the
@@ -37,7 +40,10 @@ pub mod export;
 pub mod import;
 
 pub use export::to_urdf;
-pub use import::{from_urdf_robot, from_urdf_str, read_urdf};
+pub use import::{
+    from_urdf_robot, from_urdf_str, read_urdf, read_urdf_with_collisions, CollisionGeometry,
+    CollisionShape,
+};
 
 use std::collections::HashSet;
 

@@ -92,6 +92,7 @@ fn margins_at(cell: &Cell, data: &mut Data<f64>, q: &[f64]) -> [f64; 5] {
                     let oc = capsule(&Vector3::from(*a), &Vector3::from(*b), *radius);
                     m[1] = m[1].min(distance(c, &oc));
                 }
+                Obstacle::Box { .. } => panic!("the paper cells of this test have no boxes"),
                 Obstacle::HalfSpace { normal, offset, .. } => {
                     let n = Vector3::from(*normal).normalize();
                     for end in [c.segment.a, c.segment.b] {

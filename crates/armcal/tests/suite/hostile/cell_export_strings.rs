@@ -4,7 +4,7 @@
 //! Every string a cell export writes must read back as itself.
 
 use armcal::cell::export::{export_model, ExportFormat};
-use armcal::cell::{Cell, Obstacle};
+use armcal::cell::Cell;
 use std::path::Path;
 
 /// The fuzzer's input, minimized by hand: the paper cell with the instrument's name.
@@ -74,11 +74,7 @@ fn every_cell_export_reads_back_with_the_same_names() {
                 let mut v: Vec<String> = m.instrument.iter().map(|i| i.name.clone()).collect();
                 v.extend(m.targets.iter().map(|t| t.name.clone()));
                 v.extend(c.working.iter().map(|w| w.name.clone()));
-                v.extend(c.obstacles.iter().map(|o| match o {
-                    Obstacle::Capsule { name, .. } | Obstacle::HalfSpace { name, .. } => {
-                        name.clone()
-                    }
-                }));
+                v.extend(c.obstacles.iter().map(|o| o.name().to_string()));
                 v
             };
             assert_eq!(names(&again), names(&cell), "{format}");
