@@ -19,3 +19,4 @@ mod readme;
 mod refit_cli;
 mod scale;
 mod workflow;
+mod units_signs_cli;

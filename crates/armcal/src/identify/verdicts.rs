@@ -20,6 +20,10 @@ pub struct Verdicts {
     pub chi2: Chi2Verdict,
     /// How many parameters were identified of the generic count.
     pub identifiability: IdentifiabilityVerdict,
+    /// Units, blunders, gross misfit, joint signs and zeros ([`super::fit_checks`]); empty
+    /// in files of an older armcal.
+    #[serde(default)]
+    pub fit: super::FitChecks,
 }
 
 /// The χ² test of the a-posteriori variance factor σ̂₀² = rᵀr / (m − n) and what it means
@@ -46,6 +50,17 @@ pub struct Chi2Verdict {
 }
 
 impl Chi2Verdict {
+    /// A failing test (residuals too large for the stated σ) names the measurements with the
+    /// largest residuals in its meaning.
+    pub fn name_worst_rows(&mut self, rows: &[super::fit_checks::WorstRow]) {
+        if self.outcome == Chi2Outcome::SigmaTooSmall && !rows.is_empty() {
+            self.meaning.push_str(&format!(
+                "; the largest residuals: {}",
+                super::fit_checks::rows_words(rows)
+            ));
+        }
+    }
+
     /// The verdict of the χ² test recorded in `u`.
     pub fn of(u: &ParameterUncertainty) -> Chi2Verdict {
         let outcome = Chi2Outcome::of(u.dof, u.p_value);
