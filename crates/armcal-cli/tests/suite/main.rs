@@ -18,5 +18,5 @@ mod pool_cli;
 mod readme;
 mod refit_cli;
 mod scale;
-mod workflow;
 mod units_signs_cli;
+mod workflow;

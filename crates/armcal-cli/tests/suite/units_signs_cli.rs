@@ -31,7 +31,12 @@ fn corrupt(data: &str, out: &Path, f: impl Fn(usize, &mut Vec<f64>)) {
             .map(|x| x.parse().unwrap())
             .collect();
         f(row, &mut v);
-        let num = |x: &[f64]| x.iter().map(|x| format!("{x}")).collect::<Vec<_>>().join(",");
+        let num = |x: &[f64]| {
+            x.iter()
+                .map(|x| format!("{x}"))
+                .collect::<Vec<_>>()
+                .join(",")
+        };
         written.push(format!(
             "{},{},{},{}",
             fields[0],
@@ -56,7 +61,10 @@ fn simulated(dir: &Path) -> String {
 fn refused(data: &str, expected: &[&str], est: &Path) -> (String, String) {
     let (ok, out, err) = armcal(&identify_paper_cell(data, &["--quiet"], &s(est)));
     assert!(!ok, "identify accepted it: {out}");
-    assert!(err.contains("no estimate written") && err.contains("--accept-misfit"), "{err}");
+    assert!(
+        err.contains("no estimate written") && err.contains("--accept-misfit"),
+        "{err}"
+    );
     for e in expected {
         assert!(err.contains(e), "`{e}` not in: {err}");
     }
@@ -70,10 +78,18 @@ fn mislabelled_data_units_are_named_and_refused() {
     let data = simulated(&dir);
     let est = dir.join("est.json");
     let metres = dir.join("metres.csv");
-    corrupt(&data, &metres, |_, v| v[6..].iter_mut().for_each(|x| *x /= 1000.0));
-    refused(&s(&metres), &["data's length columns", "likely hold metres", "x_m"], &est);
+    corrupt(&data, &metres, |_, v| {
+        v[6..].iter_mut().for_each(|x| *x /= 1000.0)
+    });
+    refused(
+        &s(&metres),
+        &["data's length columns", "likely hold metres", "x_m"],
+        &est,
+    );
     let inches = dir.join("inches.csv");
-    corrupt(&data, &inches, |_, v| v[6..].iter_mut().for_each(|x| *x /= 25.4));
+    corrupt(&data, &inches, |_, v| {
+        v[6..].iter_mut().for_each(|x| *x /= 25.4)
+    });
     refused(&s(&inches), &["likely hold inches", "x_in"], &est);
     let radians = dir.join("radians.csv");
     corrupt(&data, &radians, |_, v| {
@@ -102,7 +118,10 @@ fn mislabelled_data_units_are_named_and_refused() {
     let (ok, _, err) = armcal(&["report", &s(&est), "--out", &s(&report)]);
     assert!(ok && err.contains("does not fit its data"), "{err}");
     let html = std::fs::read_to_string(report.join("report.html")).unwrap();
-    assert!(html.contains("does not fit its data"), "the report is not marked");
+    assert!(
+        html.contains("does not fit its data"),
+        "the report is not marked"
+    );
     let pred = dir.join("pred.csv");
     let (ok, _, err) = armcal(&[
         "predict",
@@ -117,7 +136,10 @@ fn mislabelled_data_units_are_named_and_refused() {
     ]);
     assert!(ok, "{err}");
     let text = std::fs::read_to_string(&pred).unwrap();
-    assert!(text.contains("does not fit its data"), "the prediction is not marked");
+    assert!(
+        text.contains("does not fit its data"),
+        "the prediction is not marked"
+    );
 }
 
 /// The paper robot as inline links of a cell (the paper cell with `builtin` replaced), j4's
@@ -129,12 +151,36 @@ fn inline_cell(d4: &str) -> String {
     };
     links.push_str(&frame("base"));
     let joints = [
-        ("dh", "[-82, 82]", "theta_deg = 0\nd_mm = 0\na_mm = 350\nalpha_deg = 90".to_string()),
-        ("hayati", "[-77, 31]", "theta_deg = 0\na_mm = 650\nalpha_deg = 0\nbeta_deg = 0".into()),
-        ("dh", "[-13, 154]", "theta_deg = -90\nd_mm = 0\na_mm = 145\nalpha_deg = 90".into()),
-        ("dh", "[-347, 347]", format!("theta_deg = 0\n{d4}\na_mm = 0\nalpha_deg = -90")),
-        ("dh", "[-87, 87]", "theta_deg = 0\nd_mm = 0\na_mm = 0\nalpha_deg = 90".into()),
-        ("dh", "[-347, 347]", "theta_deg = 180\nd_mm = -170\na_mm = 0\nalpha_deg = 180".into()),
+        (
+            "dh",
+            "[-82, 82]",
+            "theta_deg = 0\nd_mm = 0\na_mm = 350\nalpha_deg = 90".to_string(),
+        ),
+        (
+            "hayati",
+            "[-77, 31]",
+            "theta_deg = 0\na_mm = 650\nalpha_deg = 0\nbeta_deg = 0".into(),
+        ),
+        (
+            "dh",
+            "[-13, 154]",
+            "theta_deg = -90\nd_mm = 0\na_mm = 145\nalpha_deg = 90".into(),
+        ),
+        (
+            "dh",
+            "[-347, 347]",
+            format!("theta_deg = 0\n{d4}\na_mm = 0\nalpha_deg = -90"),
+        ),
+        (
+            "dh",
+            "[-87, 87]",
+            "theta_deg = 0\nd_mm = 0\na_mm = 0\nalpha_deg = 90".into(),
+        ),
+        (
+            "dh",
+            "[-347, 347]",
+            "theta_deg = 180\nd_mm = -170\na_mm = 0\nalpha_deg = 180".into(),
+        ),
     ];
     for (i, (convention, limits, fields)) in joints.iter().enumerate() {
         links.push_str(&format!(
@@ -165,19 +211,52 @@ fn model_units_are_named_and_refused() {
     let good = dir.join("inline.toml");
     std::fs::write(&good, inline_cell("d_mm = -600")).unwrap();
     let est = dir.join("good.json");
-    let (ok, out, err) = armcal(&["identify", "--cell", &s(&good), "--data", &data, "--quiet", "--out", &s(&est)]);
+    let (ok, out, err) = armcal(&[
+        "identify",
+        "--cell",
+        &s(&good),
+        "--data",
+        &data,
+        "--quiet",
+        "--out",
+        &s(&est),
+    ]);
     assert!(ok, "{err}");
-    assert!(ALARMS.iter().all(|a| !out.contains(a) && !err.contains(a)), "{out}{err}");
+    assert!(
+        ALARMS.iter().all(|a| !out.contains(a) && !err.contains(a)),
+        "{out}{err}"
+    );
     // `d_m = -600`: the one length in metres is named.
     let dm = dir.join("dm.toml");
     std::fs::write(&dm, inline_cell("d_m = -600")).unwrap();
     let bad = dir.join("bad.json");
-    let (ok, _, err) = armcal(&["identify", "--cell", &s(&dm), "--data", &data, "--quiet", "--out", &s(&bad)]);
-    assert!(!ok && err.contains("`j4.d` was fitted to") && err.contains("millimetres written where metres are meant"), "{err}");
+    let (ok, _, err) = armcal(&[
+        "identify",
+        "--cell",
+        &s(&dm),
+        "--data",
+        &data,
+        "--quiet",
+        "--out",
+        &s(&bad),
+    ]);
+    assert!(
+        !ok && err.contains("`j4.d` was fitted to")
+            && err.contains("millimetres written where metres are meant"),
+        "{err}"
+    );
     assert!(!bad.exists());
     // A URDF in millimetres: the model's lengths are named.
     let urdf = dir.join("good.urdf");
-    let (ok, _, err) = armcal(&["export", "--estimate", &s(&est), "--format", "urdf", "--out", &s(&urdf)]);
+    let (ok, _, err) = armcal(&[
+        "export",
+        "--estimate",
+        &s(&est),
+        "--format",
+        "urdf",
+        "--out",
+        &s(&urdf),
+    ]);
     assert!(ok, "{err}");
     let text = std::fs::read_to_string(&urdf).unwrap();
     let mut scaled = String::new();
@@ -197,8 +276,22 @@ fn model_units_are_named_and_refused() {
     std::fs::write(dir.join("mm.urdf"), scaled).unwrap();
     let cell = dir.join("urdf-mm.toml");
     std::fs::write(&cell, paper_cell_with("urdf = \"mm.urdf\"\n")).unwrap();
-    let (ok, _, err) = armcal(&["identify", "--cell", &s(&cell), "--data", &data, "--quiet", "--out", &s(&bad)]);
-    assert!(!ok && err.contains("the model's lengths are likely millimetres written where metres are meant") && err.contains("URDF"), "{err}");
+    let (ok, _, err) = armcal(&[
+        "identify",
+        "--cell",
+        &s(&cell),
+        "--data",
+        &data,
+        "--quiet",
+        "--out",
+        &s(&bad),
+    ]);
+    assert!(
+        !ok && err
+            .contains("the model's lengths are likely millimetres written where metres are meant")
+            && err.contains("URDF"),
+        "{err}"
+    );
     assert!(!bad.exists());
 }
 
@@ -211,10 +304,16 @@ fn negated_joints_are_diagnosed() {
     corrupt(&data, &q1, |_, v| v[0] = -v[0]);
     let (out, _) = refused(
         &s(&q1),
-        &["the model does not fit the data: check joint signs, zeros and units", "the worst rows: line "],
+        &[
+            "the model does not fit the data: check joint signs, zeros and units",
+            "the worst rows: line ",
+        ],
         &est,
     );
-    assert!(out.contains("sign and zero diagnosis: `q1` negated explains the data"), "{out}");
+    assert!(
+        out.contains("sign and zero diagnosis: `q1` negated explains the data"),
+        "{out}"
+    );
     let q46 = dir.join("q46.csv");
     corrupt(&data, &q46, |_, v| {
         v[3] = -v[3];
@@ -237,8 +336,14 @@ fn a_blunder_row_is_named() {
         }
     });
     let (out, _) = refused(&s(&blunder), &["blunders: line 20 (pose `19`)"], &est);
-    assert!(out.contains("BLUNDERS: line 20 (pose `19`)") && out.contains("--robust huber"), "{out}");
-    assert!(!out.contains("sign and zero diagnosis"), "a blunder needs no diagnosis: {out}");
+    assert!(
+        out.contains("BLUNDERS: line 20 (pose `19`)") && out.contains("--robust huber"),
+        "{out}"
+    );
+    assert!(
+        !out.contains("sign and zero diagnosis"),
+        "a blunder needs no diagnosis: {out}"
+    );
 }
 
 #[test]

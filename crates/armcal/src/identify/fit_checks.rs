@@ -58,7 +58,10 @@ impl std::fmt::Display for WorstRow {
 
 /// The rows joined for a sentence.
 pub fn rows_words(rows: &[WorstRow]) -> String {
-    rows.iter().map(|r| r.to_string()).collect::<Vec<_>>().join(", ")
+    rows.iter()
+        .map(|r| r.to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// The gross-misfit verdict (module doc).
@@ -126,7 +129,11 @@ impl FitChecks {
             .diagnosis
             .iter()
             .map(|d| format!("sign and zero diagnosis: {}", d.message));
-        units.chain(blunders).chain(misfit).chain(diagnosis).collect()
+        units
+            .chain(blunders)
+            .chain(misfit)
+            .chain(diagnosis)
+            .collect()
     }
 }
 
@@ -182,8 +189,7 @@ pub fn check(
         })
         .map(|(i, r)| (i, r.norm))
         .collect();
-    let rms_mm =
-        (kept.iter().map(|(_, e)| e * e).sum::<f64>() / kept.len().max(1) as f64).sqrt();
+    let rms_mm = (kept.iter().map(|(_, e)| e * e).sum::<f64>() / kept.len().max(1) as f64).sqrt();
     kept.sort_by(|a, b| b.1.total_cmp(&a.1));
     let worst_rows: Vec<WorstRow> = kept.iter().take(WORST).map(|&(i, e)| row(i, e)).collect();
     let sigma_ratio = estimate

@@ -7,7 +7,8 @@
 //! — transforms the data's joint values and is scored by a quick fit: the nominal robot
 //! with only the instrument, base, tool and target frames and the joint offsets free
 //! (the free set the as-read data identify at the nominal), Levenberg–Marquardt from the
-//! nominal, at most [`QUICK_ITERATIONS`] iterations. The hypotheses are independent and run
+//! nominal, at most [`QUICK_ITERATIONS`] iterations, on at most [`QUICK_CONFIGURATIONS`]
+//! of the data's configurations. The hypotheses are independent and run
 //! in parallel. One *explains the data* when its residual RMS is within the plausible model
 //! error (the nominal robot's geometry is kept, so the error it may leave is the nominal
 //! model's, [`super::fit_checks::plausible_model_error`]) and below half the RMS of the data
@@ -26,6 +27,9 @@ use serde::{Deserialize, Serialize};
 
 /// Iteration limit of each hypothesis's quick fit.
 pub const QUICK_ITERATIONS: usize = 60;
+/// The quick fits use at most this many of the data's configurations, evenly spread (a sign
+/// or zero mistake shows at every configuration that moves the joint).
+pub const QUICK_CONFIGURATIONS: usize = 200;
 
 /// One way the data's joint values may differ from the model's.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -65,7 +69,11 @@ impl Hypothesis {
             Hypothesis::AsRead => "the joint values as read".to_string(),
             Hypothesis::Negated { joints } => format!(
                 "{} negated",
-                joints.iter().map(|&j| name(j)).collect::<Vec<_>>().join(" and ")
+                joints
+                    .iter()
+                    .map(|&j| name(j))
+                    .collect::<Vec<_>>()
+                    .join(" and ")
             ),
             Hypothesis::ZeroShift { joint, degrees } => {
                 format!("{}'s zero shifted by {degrees:+}°", name(*joint))
@@ -106,7 +114,9 @@ pub struct SignDiagnosis {
 /// Every hypothesis for `model`'s joints (module doc).
 pub fn hypotheses(model: &Model) -> Vec<Hypothesis> {
     let n = model.dof();
-    let mut out: Vec<Hypothesis> = (0..n).map(|j| Hypothesis::Negated { joints: vec![j] }).collect();
+    let mut out: Vec<Hypothesis> = (0..n)
+        .map(|j| Hypothesis::Negated { joints: vec![j] })
+        .collect();
     for a in 0..n {
         for b in a + 1..n {
             out.push(Hypothesis::Negated { joints: vec![a, b] });
@@ -138,7 +148,9 @@ fn quick_model(model: &Model, data: &Dataset) -> Result<Model, Error> {
         let Some(field) = field else {
             continue;
         };
-        quick.registry.set_status(l.first_param + field, Status::Free);
+        quick
+            .registry
+            .set_status(l.first_param + field, Status::Free);
     }
     let (quick, _) = super::frames_model(&quick, data, &quick.nominal())?;
     Ok(quick)
@@ -146,7 +158,12 @@ fn quick_model(model: &Model, data: &Dataset) -> Result<Model, Error> {
 
 /// The RMS (mm) of the position errors after the quick fit of `quick` to `data` under
 /// `hypothesis`; `None` when the fit fails.
-fn score(quick: &Model, data: &Dataset, noise: &NoiseModel, hypothesis: &Hypothesis) -> Option<f64> {
+fn score(
+    quick: &Model,
+    data: &Dataset,
+    noise: &NoiseModel,
+    hypothesis: &Hypothesis,
+) -> Option<f64> {
     let mut d = data.clone();
     for q in d.configurations.iter_mut() {
         hypothesis.apply(q);
@@ -177,6 +194,19 @@ pub fn diagnose(
     tolerance_mm: f64,
     fit_rms_mm: f64,
 ) -> Result<SignDiagnosis, Error> {
+    let step = data
+        .configurations
+        .len()
+        .div_ceil(QUICK_CONFIGURATIONS)
+        .max(1);
+    let every: Vec<usize> = (0..data.configurations.len()).step_by(step).collect();
+    let sample;
+    let data = if step > 1 {
+        sample = data.subset(&every);
+        &sample
+    } else {
+        data
+    };
     let quick = quick_model(model, data)?;
     let fit = |h: Hypothesis| {
         score(&quick, data, noise, &h).map(|rms_mm| HypothesisFit {
@@ -186,7 +216,9 @@ pub fn diagnose(
         })
     };
     let as_read = fit(Hypothesis::AsRead).ok_or_else(|| {
-        Error::Numerical("the quick fit of the frames and joint offsets failed on the data as read".into())
+        Error::Numerical(
+            "the quick fit of the frames and joint offsets failed on the data as read".into(),
+        )
     })?;
     let all = hypotheses(model);
     let tried = all.len();

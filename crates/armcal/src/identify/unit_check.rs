@@ -27,10 +27,10 @@
 //! (the median over its pairs, [`super::fit_checks::plausible_model_error`]) is a blunder
 //! (one coordinate of 10¹² mm).
 
-use crate::measure::{Dataset, MeasurementKind};
-use crate::model::{forward_kinematics, observed_position, Data, JointKind, Model, Observed};
 use super::ParameterEstimate;
+use crate::measure::{Dataset, MeasurementKind};
 use crate::model::Segment;
+use crate::model::{forward_kinematics, observed_position, Data, JointKind, Model, Observed};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -116,7 +116,10 @@ fn pair_groups(data: &Dataset) -> Vec<Vec<usize>> {
         if measured_position(&m.kind).is_none() {
             continue;
         }
-        let key = (m.observed, data.config_stations.get(m.config).copied().unwrap_or(0));
+        let key = (
+            m.observed,
+            data.config_stations.get(m.config).copied().unwrap_or(0),
+        );
         match groups.iter_mut().find(|(k, _)| *k == key) {
             Some((_, v)) => v.push(i),
             None => groups.push((key, vec![i])),
@@ -223,7 +226,13 @@ pub(crate) fn median(v: &mut [f64]) -> Option<f64> {
 
 /// The median ratio `d_measured / d_model` of the pairs at joint-angle factor
 /// `angle_factor`.
-fn scale_at(model: &Model, params: &[f64], data: &Dataset, groups: &[Vec<usize>], f: f64) -> Option<f64> {
+fn scale_at(
+    model: &Model,
+    params: &[f64],
+    data: &Dataset,
+    groups: &[Vec<usize>],
+    f: f64,
+) -> Option<f64> {
     let points = predicted(model, params, data, f);
     let mut ratios: Vec<f64> = pairs(data, groups, &points)
         .iter()
@@ -347,7 +356,12 @@ fn finding(s: f64, subject: &str, unit: &str, message: String) -> DataScale {
 /// The measurements whose median discrepancy `|d_measured − s d_model|` over their pairs
 /// exceeds `tolerance_mm`, worst first; empty when more than 5 % of the measurements
 /// (at least one) would be.
-fn blunders(data: &Dataset, pairs: &[(usize, usize, f64, f64)], s: f64, tolerance_mm: f64) -> Vec<(usize, f64)> {
+fn blunders(
+    data: &Dataset,
+    pairs: &[(usize, usize, f64, f64)],
+    s: f64,
+    tolerance_mm: f64,
+) -> Vec<(usize, f64)> {
     let mut by_row: Vec<Vec<f64>> = vec![Vec::new(); data.measurements.len()];
     for &(i, j, dm, dp) in pairs {
         let e = (dm - s * dp).abs();
