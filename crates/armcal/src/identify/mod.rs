@@ -464,6 +464,13 @@ fn estimate_of_fit(
     let kept = (0..model.param_count())
         .filter(|&i| !is_frame_parameter(model, i))
         .count();
+    // the generic count is of geometric parameters: the non-geometric terms (compliance,
+    // periodic errors) are counted apart
+    let geometric = problem
+        .free
+        .iter()
+        .filter(|&&i| !model.is_joint_correction(i))
+        .count();
     let rank_deficit = if let Some(refit) = &opts.refit {
         refit::deficit(cell, refit, names.len(), kept)
     } else if cell.auto_free {
@@ -471,7 +478,7 @@ fn estimate_of_fit(
         crate::model::rank_deficit::rank_deficit(
             &declared,
             &sol.params,
-            names.len(),
+            geometric,
             cell.measurement,
             Some(&train.configurations),
         )?
@@ -556,7 +563,7 @@ fn estimate_of_fit(
             identifiability: IdentifiabilityVerdict::of(
                 model,
                 cell.measurement,
-                names.len(),
+                &problem.free,
                 &reasons,
                 rank_deficit.as_ref(),
             ),

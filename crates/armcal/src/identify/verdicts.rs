@@ -107,8 +107,13 @@ impl Chi2Verdict {
 pub struct IdentifiabilityVerdict {
     /// The cell's measurement type (position, pose, distance).
     pub measurement: Measurement,
-    /// Number of parameters estimated.
+    /// Number of geometric parameters estimated (the non-geometric terms are counted
+    /// apart, in `nongeometric`).
     pub identified: usize,
+    /// The non-geometric terms estimated (joint compliance, periodic gear errors), which the
+    /// generic count of geometric parameters does not include.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub nongeometric: Vec<String>,
     /// The generic count; `None` where it depends on the target layout (several points).
     pub expected: Option<usize>,
     /// Parameters left out with a reason (see the estimate's `fixed_reasons`).
@@ -118,15 +123,24 @@ pub struct IdentifiabilityVerdict {
 }
 
 impl IdentifiabilityVerdict {
-    /// The verdict for `identified` parameters estimated from `measurement` data, with the
-    /// parameters fixed for a reason and the rank deficit that explains a shortfall.
+    /// The verdict for the parameters `free` (registry indices of `model`) estimated from
+    /// `measurement` data, with the parameters fixed for a reason and the rank deficit that
+    /// explains a shortfall. The geometric parameters are compared with the generic count;
+    /// the non-geometric terms are named as such.
     pub fn of(
         model: &Model,
         measurement: Measurement,
-        identified: usize,
+        free: &[usize],
         fixed_reasons: &[(String, String)],
         deficit: Option<&RankDeficit>,
     ) -> IdentifiabilityVerdict {
+        let (terms, geometric): (Vec<usize>, Vec<usize>) =
+            free.iter().partition(|&&i| model.is_joint_correction(i));
+        let identified = geometric.len();
+        let nongeometric: Vec<String> = terms
+            .iter()
+            .map(|&i| model.registry.get(i).name.clone())
+            .collect();
         let expected = expected_count(model, measurement);
         let fixed: Vec<String> = fixed_reasons.iter().map(|(n, _)| n.clone()).collect();
         let what = measurement.words();
@@ -147,15 +161,25 @@ impl IdentifiabilityVerdict {
                 )
             ),
             Some(e) => format!(
-                "{identified} parameters estimated, more than the {e} {what} measurements identify for this robot in generic geometry (priors, or a free set that is not minimal){left_out}"
+                "{identified} geometric parameters estimated, more than the {e} {what} measurements identify for this robot in generic geometry (priors, or a free set that is not minimal){left_out}"
             ),
             None => format!(
                 "{identified} parameters estimated (the generic count for several targets depends on their layout){left_out}"
             ),
         };
+        let meaning = if nongeometric.is_empty() {
+            meaning
+        } else {
+            format!(
+                "{meaning}; besides, {} non-geometric terms (joint compliance, periodic gear errors: {}), which the generic count of geometric parameters does not include",
+                nongeometric.len(),
+                nongeometric.join(", ")
+            )
+        };
         IdentifiabilityVerdict {
             measurement,
             identified,
+            nongeometric,
             expected,
             fixed,
             meaning,
