@@ -71,9 +71,21 @@ pub struct Args {
     /// Folds of the cross-validation of `--nongeometric auto` (seeded by --seed).
     #[arg(long, default_value_t = 5)]
     pub folds: usize,
+    /// Write the estimate although the model does not fit the data (a gross misfit) or the
+    /// data's or the model's units look wrong; the estimate, and every output made with it,
+    /// then says so.
+    #[arg(long)]
+    pub accept_misfit: bool,
+    /// Try every joint sign and zero hypothesis on the data (a quick fit each) even when the
+    /// fit shows no gross misfit (it always runs on an unexplained one).
+    #[arg(long)]
+    pub diagnose_signs: bool,
     #[command(flatten)]
     pub accept: AcceptUnconverged,
 }
+
+/// The flag that accepts a refused fit.
+const ACCEPT_MISFIT: &str = "--accept-misfit";
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let files = station_files(&a.data);
@@ -113,8 +125,19 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
             "auto" => NonGeometric::Auto { folds: a.folds },
             other => NonGeometric::Only(Candidate::from_name(other).expect("clap checked")),
         },
+        diagnose_signs: a.diagnose_signs,
+        accept_misfit: a.accept_misfit.then(|| ACCEPT_MISFIT.to_string()),
     };
     let est = identify(&cell, &data, &opts, &mut Progress::new(a.quiet))?;
+    if let Some(fit) = est.verdicts.as_ref().map(|v| &v.fit) {
+        if fit.refuses() && !a.accept_misfit {
+            print_summary(&est);
+            bail!(
+                "{}\nno estimate written: correct the data or the cell, or pass {ACCEPT_MISFIT} to write it anyway (marked as not fitting its data)",
+                fit.reasons().join("\n")
+            );
+        }
+    }
     outputs.commit(&[(&a.out, &serde_json::to_string_pretty(&est)?)])?;
     print_summary(&est);
     println!("\nestimate → {}", a.out.display());
@@ -217,6 +240,7 @@ pub fn print_summary(e: &Estimate) {
     if let Some(v) = &e.verdicts {
         println!("χ² verdict: {}", v.chi2.meaning);
         println!("identifiability: {}", v.identifiability.meaning);
+        print_fit_checks(&v.fit);
     }
     let r = &e.residuals;
     println!("residuals (mm)      RMS        max        p95");
@@ -343,6 +367,30 @@ pub fn print_summary(e: &Estimate) {
                 );
             }
         }
+    }
+}
+
+/// What the checks of the fit found: units, blunders, a gross misfit, the sign and zero
+/// diagnosis, and whether a refused fit was accepted.
+fn print_fit_checks(fit: &armcal::identify::FitChecks) {
+    for u in &fit.units {
+        println!("UNITS ({}): {}", u.subject, u.message);
+    }
+    if !fit.blunders.is_empty() {
+        println!(
+            "BLUNDERS: {} lie farther from the other measurements than the model allows by more than the plausible model error ({:.1} mm): remove them, or fit with --robust huber",
+            armcal::identify::fit_checks::rows_words(&fit.blunders),
+            fit.plausible_mm
+        );
+    }
+    if let Some(m) = &fit.misfit {
+        println!("MISFIT: {}", m.message);
+    }
+    if let Some(d) = &fit.diagnosis {
+        println!("sign and zero diagnosis: {}", d.message);
+    }
+    if let Some(how) = &fit.accepted {
+        println!("ACCEPTED with {how}: this estimate does not fit its data; every output made with it says so");
     }
 }
 

@@ -159,7 +159,9 @@ fn data_joints_past_a_limit_warn_a_little_and_refuse_far_naming_file_line_and_jo
     // q1's limits are ±82°.
     write(&dir, "near.csv", &with_q1("82.5"));
     let (ok, err) = identify(&dir, "near.csv");
-    assert!(ok, "{err}");
+    // The changed row no longer matches its measured point: the fit checks (issue 30 item 4)
+    // name it as a blunder and refuse the fit; the limit warning comes first.
+    assert!(!ok && err.contains("blunders: line 6 (pose `5`)"), "{err}");
     assert!(
         err.contains("warning: ")
             && err.contains(

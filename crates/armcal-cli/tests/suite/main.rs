@@ -19,4 +19,5 @@ mod pool_cli;
 mod readme;
 mod refit_cli;
 mod scale;
+mod units_signs_cli;
 mod workflow;

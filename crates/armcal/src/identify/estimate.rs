@@ -350,6 +350,29 @@ impl Estimate {
                 self.cell, v.solver
             ));
         }
+        if v.fit.refuses() {
+            let why = v.fit.reasons().join("; ");
+            let line = match (&v.fit.accepted, acceptance.accepted) {
+                (Some(how), _) => format!(
+                    "armcal: estimate of cell `{}` does not fit its data, accepted with {how} when identified: {why}",
+                    self.cell
+                ),
+                (None, true) => format!(
+                    "armcal: estimate of cell `{}` does not fit its data, used with {accept}: {why}",
+                    self.cell
+                ),
+                (None, false) => {
+                    return Err(Error::Input(format!(
+                        "the estimate (cell `{}`) does not fit its data: {why}. Identify again, or {flag}",
+                        self.cell
+                    )))
+                }
+            };
+            usability.overridden = Some(match usability.overridden.take() {
+                Some(o) => format!("{o}; {line}"),
+                None => line,
+            });
+        }
         if v.chi2.outcome != Chi2Outcome::Consistent {
             usability.notes.push(format!("χ² test: {}", v.chi2.meaning));
         }

@@ -6,6 +6,7 @@
 pub mod circle_point;
 pub mod estimate;
 pub mod fingerprint;
+pub mod fit_checks;
 mod free_set;
 pub mod gauss_newton;
 pub mod held_out;
@@ -19,9 +20,11 @@ pub mod problem;
 pub mod refit;
 pub mod residuals;
 pub mod robust;
+pub mod sign_diagnosis;
 pub mod solver;
 mod split;
 pub mod uncertainty;
+pub mod unit_check;
 pub mod verdicts;
 
 pub use estimate::{
@@ -29,6 +32,7 @@ pub use estimate::{
     ParameterEstimate, ResidualReport, SolverReport, Usability, Validation,
 };
 pub use fingerprint::ModelFingerprint;
+pub use fit_checks::FitChecks;
 pub use gauss_newton::gauss_newton;
 pub use kalman::{kalman_filter, KalmanSettings};
 pub use lm::{levenberg_marquardt, LmSettings};
@@ -116,6 +120,13 @@ pub struct IdentifySettings {
     /// Which of the cell's non-geometric terms (compliance, periodic errors) the fit keeps,
     /// or a choice by cross-validation ([`nongeometric_choice`]).
     pub nongeometric: NonGeometric,
+    /// Run the joint sign and zero diagnosis ([`sign_diagnosis`]) even without a gross
+    /// misfit (it always runs on an unexplained one).
+    pub diagnose_signs: bool,
+    /// How the caller accepts a fit the checks refuse ([`fit_checks`]: a gross misfit or a
+    /// unit mistake), in its own words (the CLI: its flag); recorded in the estimate, whose
+    /// every later use then says so. `None`: not accepted.
+    pub accept_misfit: Option<String>,
 }
 
 impl Default for IdentifySettings {
@@ -130,6 +141,8 @@ impl Default for IdentifySettings {
             refit: None,
             start: None,
             nongeometric: NonGeometric::AsCell,
+            diagnose_signs: false,
+            accept_misfit: None,
         }
     }
 }
@@ -374,11 +387,26 @@ pub fn identify(
     observer.start("uncertainty, observability and residuals", None);
     let estimate = estimate_of_fit(&stationed, data, opts, &split, fit, &noise, observer);
     observer.finish();
+    let mut estimate = estimate?;
+    let checks = phase(observer, "units, misfit, joint signs and zeros", || {
+        fit_checks::check(
+            &stationed.model,
+            train,
+            &noise,
+            &estimate,
+            opts.diagnose_signs,
+            opts.accept_misfit.as_deref(),
+        )
+    })?;
+    if let Some(v) = estimate.verdicts.as_mut() {
+        v.chi2.name_worst_rows(&checks.worst_rows);
+        v.fit = checks;
+    }
     // an estimate belongs to the cell as its file describes it, whatever stations its data name
-    estimate.map(|e| Estimate {
+    Ok(Estimate {
         fingerprint: Some(ModelFingerprint::of(&cell.model)),
         nongeometric_choice: choice,
-        ..e
+        ..estimate
     })
 }
 
@@ -438,6 +466,13 @@ fn estimate_of_fit(
     let kept = (0..model.param_count())
         .filter(|&i| !is_frame_parameter(model, i))
         .count();
+    // the generic count is of geometric parameters: the non-geometric terms (compliance,
+    // periodic errors) are counted apart
+    let geometric = problem
+        .free
+        .iter()
+        .filter(|&&i| !model.is_joint_correction(i))
+        .count();
     let rank_deficit = if let Some(refit) = &opts.refit {
         refit::deficit(cell, refit, names.len(), kept)
     } else if cell.auto_free {
@@ -445,7 +480,7 @@ fn estimate_of_fit(
         crate::model::rank_deficit::rank_deficit(
             &declared,
             &sol.params,
-            names.len(),
+            geometric,
             cell.measurement,
             Some(&train.configurations),
         )?
@@ -542,10 +577,11 @@ fn estimate_of_fit(
             identifiability: IdentifiabilityVerdict::of(
                 model,
                 cell.measurement,
-                names.len(),
+                &problem.free,
                 &reasons,
                 rank_deficit.as_ref(),
             ),
+            fit: FitChecks::default(),
         }),
         fingerprint: None,
         free: names,

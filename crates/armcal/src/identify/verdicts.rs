@@ -20,6 +20,10 @@ pub struct Verdicts {
     pub chi2: Chi2Verdict,
     /// How many parameters were identified of the generic count.
     pub identifiability: IdentifiabilityVerdict,
+    /// Units, blunders, gross misfit, joint signs and zeros ([`super::fit_checks`]); empty
+    /// in files of an older armcal.
+    #[serde(default)]
+    pub fit: super::FitChecks,
 }
 
 /// The χ² test of the a-posteriori variance factor σ̂₀² = rᵀr / (m − n) and what it means
@@ -46,6 +50,17 @@ pub struct Chi2Verdict {
 }
 
 impl Chi2Verdict {
+    /// A failing test (residuals too large for the stated σ) names the measurements with the
+    /// largest residuals in its meaning.
+    pub fn name_worst_rows(&mut self, rows: &[super::fit_checks::WorstRow]) {
+        if self.outcome == Chi2Outcome::SigmaTooSmall && !rows.is_empty() {
+            self.meaning.push_str(&format!(
+                "; the largest residuals: {}",
+                super::fit_checks::rows_words(rows)
+            ));
+        }
+    }
+
     /// The verdict of the χ² test recorded in `u`.
     pub fn of(u: &ParameterUncertainty) -> Chi2Verdict {
         let outcome = Chi2Outcome::of(u.dof, u.p_value);
@@ -92,8 +107,13 @@ impl Chi2Verdict {
 pub struct IdentifiabilityVerdict {
     /// The cell's measurement type (position, pose, distance).
     pub measurement: Measurement,
-    /// Number of parameters estimated.
+    /// Number of geometric parameters estimated (the non-geometric terms are counted
+    /// apart, in `nongeometric`).
     pub identified: usize,
+    /// The non-geometric terms estimated (joint compliance, periodic gear errors), which the
+    /// generic count of geometric parameters does not include.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub nongeometric: Vec<String>,
     /// The generic count; `None` where it depends on the target layout (several points).
     pub expected: Option<usize>,
     /// Parameters left out with a reason (see the estimate's `fixed_reasons`).
@@ -103,15 +123,24 @@ pub struct IdentifiabilityVerdict {
 }
 
 impl IdentifiabilityVerdict {
-    /// The verdict for `identified` parameters estimated from `measurement` data, with the
-    /// parameters fixed for a reason and the rank deficit that explains a shortfall.
+    /// The verdict for the parameters `free` (registry indices of `model`) estimated from
+    /// `measurement` data, with the parameters fixed for a reason and the rank deficit that
+    /// explains a shortfall. The geometric parameters are compared with the generic count;
+    /// the non-geometric terms are named as such.
     pub fn of(
         model: &Model,
         measurement: Measurement,
-        identified: usize,
+        free: &[usize],
         fixed_reasons: &[(String, String)],
         deficit: Option<&RankDeficit>,
     ) -> IdentifiabilityVerdict {
+        let (terms, geometric): (Vec<usize>, Vec<usize>) =
+            free.iter().partition(|&&i| model.is_joint_correction(i));
+        let identified = geometric.len();
+        let nongeometric: Vec<String> = terms
+            .iter()
+            .map(|&i| model.registry.get(i).name.clone())
+            .collect();
         let expected = expected_count(model, measurement);
         let fixed: Vec<String> = fixed_reasons.iter().map(|(n, _)| n.clone()).collect();
         let what = measurement.words();
@@ -132,15 +161,25 @@ impl IdentifiabilityVerdict {
                 )
             ),
             Some(e) => format!(
-                "{identified} parameters estimated, more than the {e} {what} measurements identify for this robot in generic geometry (priors, or a free set that is not minimal){left_out}"
+                "{identified} geometric parameters estimated, more than the {e} {what} measurements identify for this robot in generic geometry (priors, or a free set that is not minimal){left_out}"
             ),
             None => format!(
                 "{identified} parameters estimated (the generic count for several targets depends on their layout){left_out}"
             ),
         };
+        let meaning = if nongeometric.is_empty() {
+            meaning
+        } else {
+            format!(
+                "{meaning}; besides, {} non-geometric terms (joint compliance, periodic gear errors: {}), which the generic count of geometric parameters does not include",
+                nongeometric.len(),
+                nongeometric.join(", ")
+            )
+        };
         IdentifiabilityVerdict {
             measurement,
             identified,
+            nongeometric,
             expected,
             fixed,
             meaning,

@@ -117,6 +117,9 @@ fn estimate_lines(e: &Estimate) -> Vec<Line> {
             grade: Grade::Check,
         },
     });
+    if let Some(line) = e.verdicts.as_ref().and_then(|v| fit_line(&v.fit)) {
+        lines.push(line);
+    }
     if let Some(v) = &e.verdicts {
         let grade = if v.chi2.outcome == Chi2Outcome::Consistent {
             Grade::Good
@@ -195,6 +198,34 @@ fn estimate_lines(e: &Estimate) -> Vec<Line> {
         });
     }
     lines
+}
+
+/// What the checks of the fit found (units, blunders, a gross misfit, the sign and zero
+/// diagnosis), and how a refused fit was accepted; `None` when they found nothing.
+fn fit_line(fit: &crate::identify::FitChecks) -> Option<Line> {
+    let mut found = fit.reasons();
+    if found.is_empty() {
+        return None;
+    }
+    let grade = if fit.refuses() {
+        found.push(match &fit.accepted {
+            Some(how) => format!("this estimate does not fit its data; accepted with {how}"),
+            None => "this estimate does not fit its data".to_string(),
+        });
+        Grade::Bad
+    } else {
+        Grade::Check
+    };
+    let html = found
+        .iter()
+        .map(|f| flagged(code_spans(&escape(f)), grade))
+        .collect::<Vec<_>>()
+        .join("<br>");
+    Some(Line {
+        key: "model and data",
+        html,
+        grade,
+    })
 }
 
 /// The grade of an estimate: the worst of its lines.
