@@ -69,10 +69,12 @@
 //! Constraints that need the tracker (incidence, line of sight) are left out when the model
 //! has no instrument frame; incidence also needs `instrument.max_incidence` in the cell.
 //!
-//! **Clearance and joint margin** (the cell's `[design]`, [`DesignClearance`]). A set built
-//! with [`ConstraintSettings::clearance`] `c` requires `g(q) ≥ c` of every distance
-//! constraint (self collision, obstacle, half-space, line of sight) and keeps every revolute
-//! joint [`ConstraintSettings::joint_margin`] inside its limits; [`ConstraintSet::evaluate`]
+//! **Clearance and margins** (the cell's `[design]`, [`DesignClearance`]). A set built
+//! with [`ConstraintSettings::clearance`] `c` requires `g(q) ≥ c` of every robot and
+//! obstacle distance constraint (self collision, obstacle, half-space), `g(q) ≥`
+//! [`ConstraintSettings::line_of_sight_margin`] of every line-of-sight constraint,
+//! `β ≤ β_max −` [`ConstraintSettings::incidence_margin`] of the incidence, and keeps every
+//! revolute joint [`ConstraintSettings::joint_margin`] inside its limits; [`ConstraintSet::evaluate`]
 //! still returns the distances themselves, [`ConstraintSet::required`] the least value each
 //! must keep. A distance that no configuration changes and that lies below the clearance (a
 //! base column standing on the floor: 0 mm for every q) is exempt — no design can widen it,
@@ -81,7 +83,7 @@
 //!
 //! This file assembles the set from a cell ([`ConstraintSet::new`]); `evaluate.rs` computes
 //! values and gradients at a configuration; `measurable.rs` lists what makes a pose
-//! unmeasurable.
+//! unmeasurable; `tracker_shift.rs` what does when the instrument stands up to `D` mm off.
 
 use crate::cell::{half_space_unit_normal, Cell, DesignClearance, Obstacle};
 use crate::geometry::{point_segment_distance, segment_distance};
@@ -125,14 +127,24 @@ pub struct ConstraintSettings {
     pub clearance: f64,
     /// Distance (rad) every revolute joint keeps from its limits (0: the limits themselves).
     pub joint_margin: f64,
+    /// Angle (rad) the incidence angle keeps below the cell's limit: `β ≤ β_max − m`, i.e.
+    /// `g(q) = cos β − cos β_max ≥ cos(β_max − m) − cos β_max` (0: the limit itself, paper
+    /// eq. 4).
+    pub incidence_margin: f64,
+    /// Least value (mm) of every q-dependent line-of-sight constraint (0: the beam capsule
+    /// may touch).
+    pub line_of_sight_margin: f64,
 }
 
 impl ConstraintSettings {
-    /// These settings with the cell's `[design]` clearance and joint margin.
+    /// These settings with the cell's `[design]` clearance, joint, incidence and
+    /// line-of-sight margins.
     pub fn with_clearance(self, design: &DesignClearance) -> Self {
         ConstraintSettings {
             clearance: design.clearance,
             joint_margin: design.joint_margin,
+            incidence_margin: design.incidence_margin,
+            line_of_sight_margin: design.line_of_sight_margin,
             ..self
         }
     }
@@ -148,6 +160,8 @@ impl Default for ConstraintSettings {
             reflector: None,
             clearance: 0.0,
             joint_margin: 0.0,
+            incidence_margin: 0.0,
+            line_of_sight_margin: 0.0,
         }
     }
 }
@@ -328,6 +342,8 @@ impl ConstraintSet {
         for (what, v) in [
             ("clearance", options.clearance),
             ("joint margin", options.joint_margin),
+            ("incidence margin", options.incidence_margin),
+            ("line-of-sight margin", options.line_of_sight_margin),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(Error::Input(format!(
@@ -482,15 +498,34 @@ impl ConstraintSet {
             .into_iter()
             .map(is_flat)
             .collect();
-        if options.clearance > 0.0 {
+        if let Some(max) = max_incidence.filter(|_| options.incidence_margin > 0.0) {
+            if options.incidence_margin >= max {
+                return Err(Error::Input(format!(
+                    "an incidence margin of {:.3}° leaves no angle below the limit of {:.3}°",
+                    options.incidence_margin.to_degrees(),
+                    max.to_degrees()
+                )));
+            }
+        }
+        if options.clearance > 0.0 || options.line_of_sight_margin > 0.0 {
             // Exempt from the clearance: constant over 256 samples and below it everywhere.
             let dense = constraint_ranges(&set, 256);
             for (i, r) in dense.into_iter().enumerate() {
-                let exempt = is_flat(r) && r.1 < options.clearance;
-                if set.kind(i) != ConstraintKind::Incidence && !exempt {
-                    set.required[i] = options.clearance;
+                let wanted = match set.kind(i) {
+                    ConstraintKind::Incidence => 0.0,
+                    ConstraintKind::LineOfSight => options.line_of_sight_margin,
+                    _ => options.clearance,
+                };
+                if !(is_flat(r) && r.1 < wanted) {
+                    set.required[i] = wanted;
                 }
             }
+        }
+        let incidence = (0..set.len()).find(|&i| set.kind(i) == ConstraintKind::Incidence);
+        if let Some(i) = incidence.filter(|_| options.incidence_margin > 0.0) {
+            // β ≤ β_max − m  ⇔  cos β − cos β_max ≥ cos(β_max − m) − cos β_max.
+            let max = set.cos_max.acos();
+            set.required[i] = (max - options.incidence_margin).cos() - set.cos_max;
         }
         set.joint_tolerance = if options.joint_margin > 0.0 {
             JOINT_MARGIN_TOLERANCE
@@ -585,9 +620,11 @@ fn reflector_carriers(
 
 mod evaluate;
 mod measurable;
+mod tracker_shift;
 pub use evaluate::JOINT_MARGIN_TOLERANCE;
 use evaluate::{constraint_ranges, drop_pairs_in_contact, is_flat};
 #[cfg(test)]
 mod tests;
 
-pub use measurable::{unmeasurable_poses, Unmeasurable, Violation};
+pub use measurable::{unmeasurable_poses, unmeasurable_poses_at, Unmeasurable, Violation};
+pub use tracker_shift::{tracker_shift, TrackerShift};
