@@ -440,16 +440,29 @@ pub fn step(
         let n = state.settings.budget.map_or(state.settings.batch, |b| {
             state.settings.batch.min(b - measured)
         });
-        // Planned with the instrument and targets where the latest converged fit (this
-        // step's, else an earlier one's; the nominal before any) puts them: the tracker's
-        // incidence, line of sight and the TCP variance in its frame are evaluated there.
+        // Planned where the cell puts the instrument: its `[design]` incidence and
+        // line-of-sight margins are what keep a pose measurable with the tracker some
+        // centimetres off. Not where the latest fit puts it: with the links nominal (the
+        // capsules are drawn on them) an estimated tracker is only as good as the estimate
+        // of the links it is traded against, and a first batch of the fewest poses (no
+        // redundancy) can fit exactly with the tracker far off (`campaign simulate --seed 3`
+        // on the paper cell: 446 mm and 6.5° about z, and a pose planned at 28° there met
+        // the reflector at 32.4°). The predicted σ's use the latest converged fit (this
+        // step's, else an earlier one's; the nominal before any).
         let latest = fit
             .as_ref()
             .filter(|f| f.status.is_converged())
             .map(|f| f.params.as_slice())
             .or(state.warm_start());
         let at = cell_at(fit_cell, latest);
-        let qs = plan_batch(&at, &state.settings, &data.configurations, n, k, observer)?;
+        let qs = plan_batch(
+            fit_cell,
+            &state.settings,
+            &data.configurations,
+            n,
+            k,
+            observer,
+        )?;
         let mut all = data.configurations.clone();
         all.extend(qs.iter().cloned());
         let s = fit.as_ref().map_or(1.0, |f| f.covariance_scale);

@@ -89,12 +89,19 @@ mod tests {
         for case in 0..200 {
             let p = random_point(&mut rng, 500.0);
             let t = p + random_point(&mut rng, 3000.0);
-            let (a0, a1) = (random_point(&mut rng, 1500.0), random_point(&mut rng, 1500.0));
+            let (a0, a1) = (
+                random_point(&mut rng, 1500.0),
+                random_point(&mut rng, 1500.0),
+            );
             let radius = rng.random_range(0.0..200.0);
             let (d, s) = segment_cone_distance(&p, &t, radius, &a0, &a1);
             for k in 0..600 {
                 let dir = random_point(&mut rng, 1.0).normalize();
-                let len = if k % 2 == 0 { radius } else { radius * rng.random::<f64>() };
+                let len = if k % 2 == 0 {
+                    radius
+                } else {
+                    radius * rng.random::<f64>()
+                };
                 let beam = segment_distance(&p, &(t + dir * len), &a0, &a1).distance;
                 assert!(beam >= d - 1e-9, "case {case}: a beam at {beam} < {d}");
             }
@@ -104,7 +111,10 @@ mod tests {
                 let x = a0 + (a1 - a0) * u;
                 let worst = t + (x - c).normalize() * radius;
                 let beam = segment_distance(&p, &worst, &a0, &a1).distance;
-                assert!((beam - d).abs() < 1e-6, "case {case}: worst beam {beam} vs {d}");
+                assert!(
+                    (beam - d).abs() < 1e-6,
+                    "case {case}: worst beam {beam} vs {d}"
+                );
             }
         }
     }
@@ -114,8 +124,14 @@ mod tests {
     fn without_a_ball_it_is_the_segment_distance() {
         let mut rng = ChaCha8Rng::seed_from_u64(8);
         for _ in 0..200 {
-            let (p, t) = (random_point(&mut rng, 1000.0), random_point(&mut rng, 1000.0));
-            let (a0, a1) = (random_point(&mut rng, 1000.0), random_point(&mut rng, 1000.0));
+            let (p, t) = (
+                random_point(&mut rng, 1000.0),
+                random_point(&mut rng, 1000.0),
+            );
+            let (a0, a1) = (
+                random_point(&mut rng, 1000.0),
+                random_point(&mut rng, 1000.0),
+            );
             let (d, _) = segment_cone_distance(&p, &t, 0.0, &a0, &a1);
             let exact = segment_distance(&p, &t, &a0, &a1).distance;
             assert!((d - exact).abs() < 1e-7 * (1.0 + exact), "{d} vs {exact}");

@@ -4,9 +4,7 @@
 
 use crate::measure::{Dataset, Measurement, MeasurementKind, NoiseModel};
 use crate::model::pose::rot_axis;
-use crate::model::{
-    forward_kinematics, observed_pose, Data, Model, Observed, Pose, Segment, Unit,
-};
+use crate::model::{forward_kinematics, observed_pose, Data, Model, Observed, Pose, Segment, Unit};
 use crate::Error;
 use nalgebra::Vector3;
 use rand::SeedableRng;

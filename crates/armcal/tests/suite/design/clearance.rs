@@ -218,6 +218,22 @@ fn design_section_errors_name_file_and_field() {
             "joint_margin_deg = 0\njoint_margin_rad = 0\n",
             "twice",
         ),
+        // An incidence margin must leave an angle below the instrument's 30° limit.
+        (
+            "incidence_margin_deg = 0\n",
+            "incidence_margin_deg = 30\n",
+            "design.incidence_margin_deg",
+        ),
+        (
+            "incidence_margin_deg = 0\n",
+            "incidence_margin_deg = -1\n",
+            "design.incidence_margin_deg",
+        ),
+        (
+            "line_of_sight_margin_mm = 0\n",
+            "line_of_sight_margin_mm = 501\n",
+            "design.line_of_sight_margin_mm",
+        ),
     ] {
         let text = armcal::cell::builtin::PAPER_CELL_OBSTACLES.replace(from, to);
         let e = Cell::from_toml(&text, "c.toml", Path::new("."))
