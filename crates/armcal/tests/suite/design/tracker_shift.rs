@@ -2,15 +2,20 @@
 //! roof and mount beam in the beam's way) with the tracker moved 50 mm, and on the same cell
 //! with the tracker brought to 1.8 m of the robot, no displacement of 1 000 spread over the
 //! sphere and its inside gives any incidence or line-of-sight constraint a smaller value than
-//! `evaluate_shifted`, and the best of them comes within the sampling's resolution of it.
+//! `evaluate_shifted`, and the best of them comes within the sampling's resolution of it. The
+//! beam's part, the distance of a segment to the hull of a point and a ball, is checked
+//! against its definition on random geometry.
 
 use crate::common::example_cell;
 use armcal::design::cell_constraints::{ConstraintSet, ConstraintSettings};
 use armcal::design::ConstraintKind;
+use armcal::geometry::{point_segment_distance, segment_cone_distance, segment_distance};
 use armcal::measure::csv::read_configurations;
 use armcal::model::{forward_kinematics, Data};
 use armcal::Cell;
 use nalgebra::Vector3;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 use std::path::Path;
 
 /// `n` directions spread over the unit sphere (a Fibonacci lattice).
@@ -124,4 +129,70 @@ fn the_worst_tracker_displacement_is_exact() {
     );
     let near = Cell::from_toml(&text, "near.toml", Path::new(".")).unwrap();
     check(&near, 80.0);
+}
+
+fn random_point(rng: &mut ChaCha8Rng, scale: f64) -> Vector3<f64> {
+    Vector3::new(
+        rng.random_range(-scale..scale),
+        rng.random_range(-scale..scale),
+        rng.random_range(-scale..scale),
+    )
+}
+
+/// Against the definition: no beam `p → t + δ` with `|δ| ≤ D` comes closer to the segment
+/// than the cone distance (600 random offsets, inside and on the sphere), and the offset
+/// built from the minimiser attains it (so the value is exact, not a bound).
+#[test]
+fn no_shifted_beam_comes_closer_and_the_worst_one_attains_it() {
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    for case in 0..200 {
+        let p = random_point(&mut rng, 500.0);
+        let t = p + random_point(&mut rng, 3000.0);
+        let (a0, a1) = (
+            random_point(&mut rng, 1500.0),
+            random_point(&mut rng, 1500.0),
+        );
+        let radius = rng.random_range(0.0..200.0);
+        let (d, s) = segment_cone_distance(&p, &t, radius, &a0, &a1);
+        for k in 0..600 {
+            let dir = random_point(&mut rng, 1.0).normalize();
+            let len = if k % 2 == 0 {
+                radius
+            } else {
+                radius * rng.random::<f64>()
+            };
+            let beam = segment_distance(&p, &(t + dir * len), &a0, &a1).distance;
+            assert!(beam >= d - 1e-9, "case {case}: a beam at {beam} < {d}");
+        }
+        if d > 1e-6 {
+            let c = p + (t - p) * s;
+            let (_, u) = point_segment_distance(&c, &a0, &a1);
+            let x = a0 + (a1 - a0) * u;
+            let worst = t + (x - c).normalize() * radius;
+            let beam = segment_distance(&p, &worst, &a0, &a1).distance;
+            assert!(
+                (beam - d).abs() < 1e-6,
+                "case {case}: worst beam {beam} vs {d}"
+            );
+        }
+    }
+}
+
+/// Without a ball the cone is the segment `pt`: the segment–segment distance.
+#[test]
+fn without_a_ball_it_is_the_segment_distance() {
+    let mut rng = ChaCha8Rng::seed_from_u64(8);
+    for _ in 0..200 {
+        let (p, t) = (
+            random_point(&mut rng, 1000.0),
+            random_point(&mut rng, 1000.0),
+        );
+        let (a0, a1) = (
+            random_point(&mut rng, 1000.0),
+            random_point(&mut rng, 1000.0),
+        );
+        let (d, _) = segment_cone_distance(&p, &t, 0.0, &a0, &a1);
+        let exact = segment_distance(&p, &t, &a0, &a1).distance;
+        assert!((d - exact).abs() < 1e-7 * (1.0 + exact), "{d} vs {exact}");
+    }
 }
