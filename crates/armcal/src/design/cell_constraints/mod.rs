@@ -69,12 +69,11 @@
 //! Constraints that need the tracker (incidence, line of sight) are left out when the model
 //! has no instrument frame; incidence also needs `instrument.max_incidence` in the cell.
 //!
-//! **Clearance and margins** (the cell's `[design]`, [`DesignClearance`]). A set built
-//! with [`ConstraintSettings::clearance`] `c` requires `g(q) ≥ c` of every robot and
-//! obstacle distance constraint (self collision, obstacle, half-space), `g(q) ≥`
-//! [`ConstraintSettings::line_of_sight_margin`] of every line-of-sight constraint,
-//! `β ≤ β_max −` [`ConstraintSettings::incidence_margin`] of the incidence, and keeps every
-//! revolute joint [`ConstraintSettings::joint_margin`] inside its limits; [`ConstraintSet::evaluate`]
+//! **Clearance and margins** (the cell's `[design]`, [`DesignClearance`]; `required.rs`). A
+//! set requires `g(q) ≥` [`ConstraintSettings::clearance`] of every robot and obstacle
+//! distance, `≥` [`ConstraintSettings::line_of_sight_margin`] of the beam, `β ≤ β_max −`
+//! [`ConstraintSettings::incidence_margin`], and keeps every revolute joint
+//! [`ConstraintSettings::joint_margin`] inside its limits; [`ConstraintSet::evaluate`]
 //! still returns the distances themselves, [`ConstraintSet::required`] the least value each
 //! must keep. A distance that no configuration changes and that lies below the clearance (a
 //! base column standing on the floor: 0 mm for every q) is exempt — no design can widen it,
@@ -127,12 +126,9 @@ pub struct ConstraintSettings {
     pub clearance: f64,
     /// Distance (rad) every revolute joint keeps from its limits (0: the limits themselves).
     pub joint_margin: f64,
-    /// Angle (rad) the incidence angle keeps below the cell's limit: `β ≤ β_max − m`, i.e.
-    /// `g(q) = cos β − cos β_max ≥ cos(β_max − m) − cos β_max` (0: the limit itself, paper
-    /// eq. 4).
+    /// Angle (rad) the incidence keeps below the cell's limit, `β ≤ β_max − m` (0: eq. 4).
     pub incidence_margin: f64,
-    /// Least value (mm) of every q-dependent line-of-sight constraint (0: the beam capsule
-    /// may touch).
+    /// Least value (mm) of every q-dependent line-of-sight constraint (0: may touch).
     pub line_of_sight_margin: f64,
 }
 
@@ -498,35 +494,7 @@ impl ConstraintSet {
             .into_iter()
             .map(is_flat)
             .collect();
-        if let Some(max) = max_incidence.filter(|_| options.incidence_margin > 0.0) {
-            if options.incidence_margin >= max {
-                return Err(Error::Input(format!(
-                    "an incidence margin of {:.3}° leaves no angle below the limit of {:.3}°",
-                    options.incidence_margin.to_degrees(),
-                    max.to_degrees()
-                )));
-            }
-        }
-        if options.clearance > 0.0 || options.line_of_sight_margin > 0.0 {
-            // Exempt from the clearance: constant over 256 samples and below it everywhere.
-            let dense = constraint_ranges(&set, 256);
-            for (i, r) in dense.into_iter().enumerate() {
-                let wanted = match set.kind(i) {
-                    ConstraintKind::Incidence => 0.0,
-                    ConstraintKind::LineOfSight => options.line_of_sight_margin,
-                    _ => options.clearance,
-                };
-                if !(is_flat(r) && r.1 < wanted) {
-                    set.required[i] = wanted;
-                }
-            }
-        }
-        let incidence = (0..set.len()).find(|&i| set.kind(i) == ConstraintKind::Incidence);
-        if let Some(i) = incidence.filter(|_| options.incidence_margin > 0.0) {
-            // β ≤ β_max − m  ⇔  cos β − cos β_max ≥ cos(β_max − m) − cos β_max.
-            let max = set.cos_max.acos();
-            set.required[i] = (max - options.incidence_margin).cos() - set.cos_max;
-        }
+        required::set_required(&mut set, options, max_incidence)?;
         set.joint_tolerance = if options.joint_margin > 0.0 {
             JOINT_MARGIN_TOLERANCE
         } else {
@@ -620,6 +588,7 @@ fn reflector_carriers(
 
 mod evaluate;
 mod measurable;
+mod required;
 mod tracker_shift;
 pub use evaluate::JOINT_MARGIN_TOLERANCE;
 use evaluate::{constraint_ranges, drop_pairs_in_contact, is_flat};
