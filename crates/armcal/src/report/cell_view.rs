@@ -87,9 +87,7 @@ struct PoseView {
     /// Joints outside their limits and violated constraints.
     violations: Vec<String>,
     /// Constraints met but closer than the cell's `[design]` asks (a distance under
-    /// `clearance_mm`, a beam within `line_of_sight_margin_mm`, an incidence within
-    /// `incidence_margin_deg` of its limit, a joint within `joint_margin_deg` of a limit), each
-    /// with its value.
+    /// `clearance_mm`, a joint within `joint_margin_deg` of a limit, …), each with its value.
     below_required: Vec<String>,
     /// Indices (into `robot`) of the capsules named in violated constraints.
     hit: Vec<usize>,
@@ -319,25 +317,7 @@ fn scene(cell: &Cell, designs: &[(&str, &[Vec<f64>])]) -> Result<Scene, Error> {
                     violations.push(name.to_string());
                     mark_named(name, &robot, cell, &mut hit, &mut hit_obstacles);
                 } else if *v < set.required(i) {
-                    below_required.push(match set.kind(i) {
-                        ConstraintKind::Incidence => format!(
-                            "incidence {:.1}° (incidence_margin_deg {:.1} below {:.1}°)",
-                            set.incidence_angle(*v).to_degrees(),
-                            cell.design.incidence_margin.to_degrees(),
-                            set.max_incidence().unwrap_or_default().to_degrees()
-                        ),
-                        kind => format!(
-                            "{} {:.1} mm ({} {:.1})",
-                            set.name(i),
-                            mm(*v),
-                            if kind == ConstraintKind::LineOfSight {
-                                "line_of_sight_margin_mm"
-                            } else {
-                                "clearance_mm"
-                            },
-                            mm(set.required(i))
-                        ),
-                    });
+                    below_required.push(set.shortfall(i, *v));
                 }
             }
             hit.sort_unstable();

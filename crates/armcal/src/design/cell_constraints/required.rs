@@ -44,3 +44,25 @@ pub(super) fn set_required(
     }
     Ok(())
 }
+
+impl ConstraintSet {
+    /// Constraint `i` at value `v` below its [`ConstraintSet::required`] value, named with
+    /// the `[design]` field that asks for it: `incidence 28.6° (incidence_margin_deg 2.0)`,
+    /// `beam / car-roof 12.3 mm (line_of_sight_margin_mm 20.0)`, `capsule j2#0 / j4#0 3.1 mm
+    /// (clearance_mm 5.0)`.
+    pub fn shortfall(&self, i: usize, v: f64) -> String {
+        let required = self.required(i);
+        match self.kind(i) {
+            ConstraintKind::Incidence => format!(
+                "incidence {:.1}° (incidence_margin_deg {:.1})",
+                self.incidence_angle(v).to_degrees(),
+                (self.cos_max.acos() - self.incidence_angle(required)).to_degrees()
+            ),
+            ConstraintKind::LineOfSight => format!(
+                "{} {v:.1} mm (line_of_sight_margin_mm {required:.1})",
+                self.name(i)
+            ),
+            _ => format!("{} {v:.1} mm (clearance_mm {required:.1})", self.name(i)),
+        }
+    }
+}
