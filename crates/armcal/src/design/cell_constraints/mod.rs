@@ -61,8 +61,8 @@
 //! [`ConstraintSettings::beam_radius`]. It is checked against every robot capsule and every
 //! obstacle capsule, except the robot capsules that carry the reflector: a capsule whose
 //! frame has at most one joint between it and the reflector is left out when the reflector
-//! point lies within its radius plus the beam radius (for a frame with one joint in between,
-//! at any of 16 values of that joint over its range, nominal parameters). In the paper cell
+//! point lies within its radius plus the beam radius and line-of-sight margin (for a frame
+//! with one joint in between, at any of 16 values of that joint, nominal parameters). In the paper cell
 //! that removes the reflector holder on `tool`; the wrist capsule on `j5` keeps its
 //! constraint because the reflector sits 339 mm beyond it.
 //!
@@ -442,7 +442,8 @@ impl ConstraintSet {
             }
         }
         if options.line_of_sight && has_tracker {
-            let carriers = reflector_carriers(&model, &capsules, reflector, options.beam_radius);
+            let reach = options.beam_radius + options.line_of_sight_margin;
+            let carriers = reflector_carriers(&model, &capsules, reflector, reach);
             for (i, c) in capsules.iter().enumerate() {
                 if !carriers[i] {
                     items.push(Item::BeamRobot { i });
