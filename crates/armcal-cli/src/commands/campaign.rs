@@ -116,6 +116,10 @@ pub struct SimulateArgs {
     /// Seed of the virtual robot, its measurement noise and the planner.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// σ (mm, per axis) of where the virtual instrument stands off the cell's position: a
+    /// tracker set up by tape measure is centimetres off.
+    #[arg(long, default_value_t = 20.0, value_name = "MM")]
+    pub instrument_offset_mm: f64,
     /// Output directory (campaign.json, estimate.json, truth.json).
     #[arg(long)]
     pub out: PathBuf,
@@ -440,6 +444,12 @@ fn run_simulate(a: &SimulateArgs) -> anyhow::Result<()> {
         &[Path::new(&a.target.cell)],
         &[&files.state, &files.estimate, &truth_path],
     )?;
+    if !(a.instrument_offset_mm.is_finite() && a.instrument_offset_mm >= 0.0) {
+        anyhow::bail!(
+            "--instrument-offset-mm {}: give a distance ≥ 0",
+            a.instrument_offset_mm
+        );
+    }
     let cell = load_cell(&a.target.cell)?;
     let sim = campaign::simulate(
         &cell,
@@ -447,6 +457,7 @@ fn run_simulate(a: &SimulateArgs) -> anyhow::Result<()> {
         &a.target.settings(a.seed),
         &Perturbation {
             fixed: a.perturb_fixed.then(|| cell.fixed_prior.clone()),
+            instrument_length: Some(a.instrument_offset_mm),
             ..Perturbation::default()
         },
         a.seed,

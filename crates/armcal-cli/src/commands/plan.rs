@@ -6,6 +6,7 @@ use super::output::{load_cell, Outputs};
 use super::progress::Progress;
 use anyhow::bail;
 use armcal::design::assess::{evaluate_design, PathPrecision};
+use armcal::design::cell_constraints::TrackerShift;
 use armcal::design::plan::PlanSettings;
 use armcal::design::record::KindMargin;
 use armcal::design::user_pool::{PoolReport, PoolSettings};
@@ -76,6 +77,10 @@ pub struct EvaluateArgs {
     /// Print the evaluation (criteria, covariances, constraint margins) as JSON instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Also count the poses that stay measurable with the tracker up to this many mm from
+    /// where the cell puts it, in the worst direction for each pose and constraint.
+    #[arg(long, value_name = "MM")]
+    pub tracker_shift_mm: Option<f64>,
 }
 
 pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
@@ -316,7 +321,7 @@ pub fn run_evaluate(a: &EvaluateArgs) -> anyhow::Result<()> {
         .into_iter()
         .map(|(_, q)| q)
         .collect();
-    let ev = evaluate_design(&cell, &design, a.collisions == "on")?;
+    let ev = evaluate_design(&cell, &design, a.collisions == "on", a.tracker_shift_mm)?;
     if a.json {
         println!("{}", ev.to_json()?);
         return Ok(());
@@ -353,7 +358,27 @@ pub fn run_evaluate(a: &EvaluateArgs) -> anyhow::Result<()> {
         (None, false) => println!("{} poses outside the joint limits", infeasible.len()),
     }
     print_margins(&ev.margins);
+    if let Some(t) = &ev.tracker_shift {
+        print_tracker_shift(t);
+    }
     Ok(())
+}
+
+/// How many poses stay measurable with the tracker displaced, and the ones that do not.
+fn print_tracker_shift(t: &TrackerShift) {
+    println!(
+        "tracker up to {} mm off (worst direction per pose): {} of {} poses stay measurable",
+        t.shift_mm, t.measurable, t.poses
+    );
+    if let Some((v, pose)) = t.incidence_margin_deg {
+        println!("  least incidence margin {v:.3} deg (pose {pose})");
+    }
+    if let Some((v, pose)) = t.line_of_sight_mm {
+        println!("  least line-of-sight clearance {v:.3} mm (pose {pose})");
+    }
+    for u in &t.unmeasurable {
+        println!("  {u}");
+    }
 }
 
 /// The least margin of each kind of constraint against what the cell's `[design]` asks.

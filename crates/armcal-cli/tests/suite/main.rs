@@ -12,6 +12,7 @@ mod compensate_cli;
 mod error_causes;
 mod estimate_checks;
 mod import_cli;
+mod margins_cli;
 mod measurable_cli;
 mod nongeometric_cli;
 mod outputs_cli;

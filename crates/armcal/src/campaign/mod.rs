@@ -440,16 +440,37 @@ pub fn step(
         let n = state.settings.budget.map_or(state.settings.batch, |b| {
             state.settings.batch.min(b - measured)
         });
-        // Planned with the instrument and targets where the latest converged fit (this
-        // step's, else an earlier one's; the nominal before any) puts them: the tracker's
-        // incidence, line of sight and the TCP variance in its frame are evaluated there.
+        // Planned with the instrument and targets where the latest converged fit with
+        // redundancy (this step's, else an earlier one's) puts them: the tracker's incidence,
+        // line of sight and the TCP variance in its frame are evaluated there. Before such a
+        // fit, where the cell puts them, with its `[design]` incidence and line-of-sight
+        // margins to cover the placement error: a fit without redundancy (the first batch of
+        // the fewest poses) interpolates its data exactly and can trade the tracker against
+        // the links far from where it stands, and the links stay nominal here (the capsules
+        // are drawn on them) — `campaign simulate --seed 3` on the paper cell with the
+        // default margins: 446 mm and 6.5° about z, and a pose planned at 28° there met the
+        // reflector at 32.4°. The predicted σ's use the latest converged fit (the nominal
+        // before any).
+        let converged = |f: &&FitSummary| f.status.is_converged();
         let latest = fit
             .as_ref()
-            .filter(|f| f.status.is_converged())
+            .filter(converged)
             .map(|f| f.params.as_slice())
             .or(state.warm_start());
+        let placed = fit
+            .iter()
+            .chain(state.steps.iter().rev().filter_map(|s| s.fit.as_ref()))
+            .find(|f| converged(f) && f.dof > 0)
+            .map(|f| f.params.as_slice());
         let at = cell_at(fit_cell, latest);
-        let qs = plan_batch(&at, &state.settings, &data.configurations, n, k, observer)?;
+        let qs = plan_batch(
+            &cell_at(fit_cell, placed),
+            &state.settings,
+            &data.configurations,
+            n,
+            k,
+            observer,
+        )?;
         let mut all = data.configurations.clone();
         all.extend(qs.iter().cloned());
         let s = fit.as_ref().map_or(1.0, |f| f.covariance_scale);

@@ -7,6 +7,7 @@
 use super::precision::tcp_position;
 use super::{start, step, CampaignSettings, CampaignState, Decision};
 use crate::cell::Cell;
+use crate::design::cell_constraints::unmeasurable_poses_at;
 use crate::identify::Estimate;
 use crate::progress::Observer;
 use crate::sim::{perturbed_truth, Perturbation, TruthRecord};
@@ -51,6 +52,9 @@ pub fn simulate(
 
 /// Measures the poses `state` asks for on the robot `truth` with the cell's instrument
 /// noise (batch `k` with noise seed `seed · 1000 + k`) and steps until the campaign stops;
+/// a batch with a pose the virtual instrument cannot measure there
+/// ([`unmeasurable_poses_at`]: incidence, line of sight or collision at the true robot and
+/// instrument) is an error naming the poses, as it would stop a real campaign;
 /// every step records the true TCP error at the working poses. `estimate`: the estimate of
 /// the state's last step, if any. Returns the final state and the last fit's estimate.
 pub fn measure_until_stopped(
@@ -66,6 +70,22 @@ pub fn measure_until_stopped(
     while state.decision == Decision::Measure {
         let k = state.steps.len() as u64 + 1;
         let qs: Vec<Vec<f64>> = state.next.iter().map(|p| p.q(model)).collect();
+        let poses: Vec<(String, Vec<f64>)> = state
+            .next
+            .iter()
+            .map(|p| p.id.clone())
+            .zip(qs.iter().cloned())
+            .collect();
+        let blocked = unmeasurable_poses_at(cell, truth, &poses)?;
+        if !blocked.is_empty() {
+            let list: Vec<String> = blocked.iter().map(|u| format!("  {u}")).collect();
+            return Err(Error::Input(format!(
+                "batch {k}: {} of {} poses cannot be measured on the virtual robot (its true geometry, the instrument where the simulation placed it):\n{}\nthe poses were planned too close to the limits: raise the cell's [design] incidence_margin_deg or line_of_sight_margin_mm",
+                blocked.len(),
+                poses.len(),
+                list.join("\n")
+            )));
+        }
         let mut batch = crate::sim::simulate(
             model,
             truth,

@@ -112,9 +112,11 @@ pub fn to_cell_toml(cell: &Cell, identified: &Model, spec: &ModelSpec) -> Result
     }
     let _ = writeln!(
         s.tail,
-        "\n[design]\nclearance_mm = {:?}\njoint_margin_deg = {:?}",
+        "\n[design]\nclearance_mm = {:?}\njoint_margin_deg = {:?}\nincidence_margin_deg = {:?}\nline_of_sight_margin_mm = {:?}",
         cell.design.clearance,
-        cell.design.joint_margin.to_degrees()
+        cell.design.joint_margin.to_degrees(),
+        cell.design.incidence_margin.to_degrees(),
+        cell.design.line_of_sight_margin
     );
     if let Some(d) = &cell.data_columns {
         let _ = writeln!(s.tail, "\n[data]\n{}", d.format.to_toml());

@@ -132,29 +132,62 @@ pub fn half_space_unit_normal(
 }
 
 /// The safety margins a planned pose keeps (`[design]` of the cell file): every distance
-/// constraint of the design (robot capsule to robot capsule, to an obstacle or half-space,
-/// the laser beam to either) at least `clearance`, every revolute joint at least
-/// `joint_margin` inside its limits.
+/// constraint of the design (robot capsule to robot capsule, to an obstacle or half-space)
+/// at least `clearance`, the laser beam at least `line_of_sight_margin` from robot and
+/// obstacle capsules, the reflector's incidence angle at least `incidence_margin` below the
+/// instrument's limit, every revolute joint at least `joint_margin` inside its limits.
 ///
-/// **Defaults: 5 mm and 1°.** A design is planned on the *nominal* model, and the real robot
-/// is not where the nominal model puts it: with armcal's default simulated robot (lengths off
-/// by σ = 0.5 mm, angles by σ = 0.1°, the size of an uncalibrated industrial robot's
-/// geometric error) the nominal model misses the paper robot's reflector by 2.8 mm RMS and
-/// 4.4 mm at most once the tracker is placed (README, held-out validation "nominal + frames
-/// fitted"). A robot point nearer the base moves less than the reflector, so 5 mm — the RMS
-/// error plus about 2 mm, above the largest miss — keeps a capsule that the nominal model
+/// **Defaults: 5 mm, 1°, 2° and 20 mm.** A design is planned on the *nominal* model, and the
+/// real robot is not where the nominal model puts it: with armcal's default simulated robot
+/// (lengths off by σ = 0.5 mm, angles by σ = 0.1°, the size of an uncalibrated industrial
+/// robot's geometric error) the nominal model misses the paper robot's reflector by 2.8 mm
+/// RMS and 4.4 mm at most once the tracker is placed (README, held-out validation "nominal +
+/// frames fitted"). A robot point nearer the base moves less than the reflector, so 5 mm — the
+/// RMS error plus about 2 mm, above the largest miss — keeps a capsule that the nominal model
 /// puts at the clearance off the obstacle. It does not cover obstacles placed wrongly in the
 /// cell: draw their capsules generously, or raise the clearance. 1° keeps a pose off the
 /// hard stops that a controller's soft limits (typically a degree or so inside the data-sheet
-/// limits) would refuse. Prismatic joints get no margin. The paper's cells set both to 0:
-/// the paper's constraints (eq. 24b) have no clearance.
+/// limits) would refuse. Prismatic joints get no margin.
+///
+/// The instrument is not where the cell says either: a tracker set up by tape measure and
+/// eye is some centimetres off. Its orientation does not matter to the incidence or the
+/// beam, its position does: moved by `D` at a distance `L` from the reflector, the beam turns
+/// by up to `asin(D/L)` — 1.43° for 50 mm at 2 m, the near end of a laser tracker's working
+/// range — and the flange's own orientation error (σ = 0.1° per angle over six joints) adds
+/// a few tenths: 2° of incidence margin keeps a planned pose measurable with the tracker 50 mm
+/// off at 2 m or more. A beam point a fraction `s` of the way from the reflector to the
+/// tracker moves by `s·D`: the robot capsules a beam passes are near the reflector (`s` below
+/// about 0.4 in a cell whose tracker stands 2 m or more away), so 20 mm covers 50 mm of
+/// tracker error there; an obstacle near the tracker needs more. `armcal evaluate
+/// --tracker-shift-mm D` checks a design exactly against a tracker `D` mm off in any
+/// direction ([`crate::design::cell_constraints::tracker_shift`]).
+///
+/// The paper's cells set all four to 0: the paper's constraints (eq. 4, eq. 24b) have no
+/// margin, and its Tables 6–8 are reproduced with none.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DesignClearance {
-    /// Least distance (mm) of every distance constraint; `[design] clearance_mm`.
+    /// Least distance (mm) of every robot and obstacle distance constraint;
+    /// `[design] clearance_mm`.
     pub clearance: f64,
     /// Least distance (rad) of every revolute joint from its limits;
     /// `[design] joint_margin_deg`.
     pub joint_margin: f64,
+    /// Least angle (rad) between the reflector's incidence angle and the instrument's
+    /// `max_incidence`; `[design] incidence_margin_deg`.
+    #[serde(default = "default_incidence_margin")]
+    pub incidence_margin: f64,
+    /// Least distance (mm) of the laser beam (a capsule of the beam radius) from every robot
+    /// and obstacle capsule it is checked against; `[design] line_of_sight_margin_mm`.
+    #[serde(default = "default_line_of_sight_margin")]
+    pub line_of_sight_margin: f64,
+}
+
+fn default_incidence_margin() -> f64 {
+    2f64.to_radians()
+}
+
+fn default_line_of_sight_margin() -> f64 {
+    20.0
 }
 
 impl Default for DesignClearance {
@@ -162,6 +195,8 @@ impl Default for DesignClearance {
         DesignClearance {
             clearance: 5.0,
             joint_margin: 1f64.to_radians(),
+            incidence_margin: default_incidence_margin(),
+            line_of_sight_margin: default_line_of_sight_margin(),
         }
     }
 }

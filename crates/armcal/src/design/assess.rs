@@ -4,6 +4,7 @@
 //! `armcal evaluate` ([`evaluate_design`]).
 
 use crate::cell::Cell;
+use crate::design::cell_constraints::{tracker_shift, TrackerShift};
 use crate::design::plan::{constraint_set, CellConstraints, DesignMargin};
 use crate::design::record::{kind_margins, KindMargin};
 use crate::design::{Criterion, DesignModel, DesignObjective, InformationWorkspace};
@@ -189,6 +190,10 @@ pub struct DesignEvaluation {
     /// The smallest margin of every kind of constraint against the cell's `[design]`
     /// clearance and joint margin ([`kind_margins`]).
     pub margins: Vec<KindMargin>,
+    /// The poses that stay measurable with the instrument displaced (`evaluate
+    /// --tracker-shift-mm D`, [`tracker_shift`]); absent unless asked for.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tracker_shift: Option<TrackerShift>,
 }
 
 impl DesignEvaluation {
@@ -200,11 +205,13 @@ impl DesignEvaluation {
 
 /// The assessment of `design` (internal units) for `cell`, its infeasible poses, its
 /// smallest margin and the margins per constraint kind, with or without the collision and
-/// line-of-sight constraints.
+/// line-of-sight constraints; with `tracker_shift_mm`, which poses stay measurable with the
+/// instrument that far off in any direction ([`tracker_shift`]).
 pub fn evaluate_design(
     cell: &Cell,
     design: &[Vec<f64>],
     collisions: bool,
+    tracker_shift_mm: Option<f64>,
 ) -> Result<DesignEvaluation, Error> {
     let assessment = assess(cell, design)?;
     let set = constraint_set(cell, collisions)?;
@@ -220,5 +227,8 @@ pub fn evaluate_design(
             .collect(),
         min_margin: cons.design_margin(design),
         margins: kind_margins(cell, design, collisions)?,
+        tracker_shift: tracker_shift_mm
+            .map(|d| tracker_shift(cell, design, d))
+            .transpose()?,
     })
 }

@@ -39,8 +39,9 @@ pub struct KindMargin {
     pub per_pose: usize,
     /// Smallest margin over the design (negative: violated).
     pub value: f64,
-    /// The least margin the cell's `[design]` asks for (clearance_mm for distances,
-    /// joint_margin_deg for revolute joints, 0 for the incidence and prismatic joints).
+    /// The least margin the cell's `[design]` asks for (incidence_margin_deg for the
+    /// incidence, line_of_sight_margin_mm for the beam, clearance_mm for the other distances,
+    /// joint_margin_deg for revolute joints, 0 for prismatic joints).
     pub required: f64,
     /// Whether every constraint of the kind keeps its required value (a distance no
     /// configuration changes, such as a base column standing on the floor, is exempt from
@@ -154,10 +155,10 @@ pub fn kind_margins(
                     .into(),
                     per_pose: set.count(kind),
                     value,
-                    required: if kind == ConstraintKind::Incidence {
-                        0.0
-                    } else {
-                        cell.design.clearance
+                    required: match kind {
+                        ConstraintKind::Incidence => cell.design.incidence_margin.to_degrees(),
+                        ConstraintKind::LineOfSight => cell.design.line_of_sight_margin,
+                        _ => cell.design.clearance,
                     },
                     meets: true,
                     constraint: set.name(i).to_string(),

@@ -5,6 +5,8 @@
 //!   distance w.r.t. the endpoints (Ericson §5.1.9; the paper's eq. 21 and 23);
 //! - [`box_distance`]: signed distance from a segment to a box, with its gradient (capsule
 //!   against a table, a fixture, a fence);
+//! - [`cone_distance`]: distance from a segment to the convex hull of a point and a ball
+//!   (the beam's reach when the tracker may stand anywhere in the ball);
 //! - [`fit`]: plane, circle and line through points, with the covariance of the fitted
 //!   axis (book §4.6).
 //!
@@ -12,8 +14,10 @@
 //! line of sight) is design work: [`crate::design::cell_constraints`].
 
 pub mod box_distance;
+pub mod cone_distance;
 pub mod fit;
 pub mod segment_distance;
 
 pub use box_distance::{segment_box_distance, Cuboid, SegmentBoxDistance};
+pub use cone_distance::segment_cone_distance;
 pub use segment_distance::{point_segment_distance, segment_distance, SegmentDistance};

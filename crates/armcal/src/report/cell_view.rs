@@ -90,7 +90,7 @@ struct PoseView {
     /// Joints outside their limits and violated constraints.
     violations: Vec<String>,
     /// Constraints met but closer than the cell's `[design]` asks (a distance under
-    /// `clearance_mm`, a joint within `joint_margin_deg` of a limit), each with its value.
+    /// `clearance_mm`, a joint within `joint_margin_deg` of a limit, …), each with its value.
     below_required: Vec<String>,
     /// Indices (into `robot`) of the capsules named in violated constraints.
     hit: Vec<usize>,
@@ -322,12 +322,7 @@ fn scene(cell: &Cell, designs: &[(&str, &[Vec<f64>])]) -> Result<Scene, Error> {
                     violations.push(name.to_string());
                     mark_named(name, &robot, cell, &mut hit, &mut hit_obstacles);
                 } else if *v < set.required(i) {
-                    below_required.push(format!(
-                        "{} {:.1} mm (clearance_mm {:.1})",
-                        set.name(i),
-                        mm(*v),
-                        mm(set.required(i))
-                    ));
+                    below_required.push(set.shortfall(i, *v));
                 }
             }
             hit.sort_unstable();

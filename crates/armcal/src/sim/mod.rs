@@ -7,7 +7,9 @@ use crate::model::pose::rot_axis;
 use crate::model::prior::{
     FixedPrior, FIXED_ANGLE_SIGMA_DEG, FIXED_LENGTH_SIGMA_MM, FIXED_UNITLESS_SIGMA,
 };
-use crate::model::{forward_kinematics, observed_pose, Data, Model, Observed, Pose, Unit};
+use crate::model::{
+    forward_kinematics, observed_pose, Data, Model, Observed, Pose, Segment, Unit,
+};
 use crate::Error;
 use nalgebra::Vector3;
 use rand::SeedableRng;
@@ -38,6 +40,13 @@ pub struct Perturbation {
     /// 5 µrad/(N·m) (a joint stiffness of 2·10⁵ N·m/rad).
     #[serde(default = "default_joint_compliance")]
     pub joint_compliance: f64,
+    /// Lengths of the instrument frame (mm: where the tracker stands); `None` (the default)
+    /// draws them with `length` like every other length. A tracker set up by tape measure
+    /// and eye stands centimetres, not tenths of a millimetre, from where its cell puts it:
+    /// `campaign simulate --instrument-offset-mm` (default 20 mm per axis) places the virtual
+    /// instrument so.
+    #[serde(default)]
+    pub instrument_length: Option<f64>,
     /// Perturb every parameter (`true`) or only the free ones (`false`, the default: the
     /// truth then lies in the identifiable set and identification can recover it exactly).
     pub all: bool,
@@ -58,6 +67,7 @@ impl Default for Perturbation {
             compliance: default_compliance(),
             periodic: default_periodic(),
             joint_compliance: default_joint_compliance(),
+            instrument_length: None,
             all: false,
             fixed: None,
         }
@@ -76,9 +86,10 @@ fn default_periodic() -> f64 {
     20.0 / Unit::Arcsec.display_factor()
 }
 
-/// The true parameters: nominal + N(0, σ_kind²) per parameter (free ones unless `all`); a
-/// fixed one nominal + N(0, σ²) of its stated prior if `p.fixed` is given (the same draw z
-/// per parameter whatever the statuses, so a seed's free parameters do not change).
+/// The true parameters: nominal + N(0, σ_kind²) per parameter (free ones unless `all`; the
+/// instrument frame's lengths with [`Perturbation::instrument_length`] if given); a fixed
+/// one nominal + N(0, σ²) of its stated prior if `p.fixed` is given (the same draw z per
+/// parameter whatever the statuses, so a seed's free parameters do not change).
 pub fn perturbed_truth(model: &Model, p: &Perturbation, seed: u64) -> Vec<f64> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let unit_normal = Normal::new(0.0, 1.0).expect("valid normal");
@@ -95,6 +106,9 @@ pub fn perturbed_truth(model: &Model, p: &Perturbation, seed: u64) -> Vec<f64> {
                 return par.nominal;
             }
             let s = match par.unit {
+                Unit::Mm if par.segment == Segment::Instrument => {
+                    p.instrument_length.unwrap_or(p.length)
+                }
                 Unit::Mm => p.length,
                 Unit::Rad => p.angle,
                 Unit::Unitless => p.unitless,

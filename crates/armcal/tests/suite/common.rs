@@ -227,6 +227,28 @@ pub fn example_cell(name: &str) -> Cell {
     .unwrap()
 }
 
+/// The built-in paper cell with the default `[design]` margins (its zero clearance and
+/// margins deleted): poses planned for it stay measurable on a simulated robot whose
+/// instrument is centimetres off, as a real campaign needs.
+pub fn paper_cell_with_default_margins() -> Cell {
+    let text: String = armcal::cell::builtin::PAPER_CELL
+        .lines()
+        .filter(|l| {
+            ![
+                "clearance_mm = 0",
+                "joint_margin_deg = 0",
+                "incidence_margin_deg = 0",
+                "line_of_sight_margin_mm = 0",
+            ]
+            .contains(l)
+        })
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let cell = Cell::from_toml(&text, "paper-cell.toml", Path::new(".")).unwrap();
+    assert_eq!(cell.design, armcal::cell::DesignClearance::default());
+    cell
+}
+
 /// The paper cell with its tracker "unplaced" (nominal pose: the robot base frame, 5.4 m
 /// and ~135° from where it is), and the true parameters of the placed cell with its free
 /// parameters perturbed (seed `seed`). With `frames_only` the free parameters are only the

@@ -47,6 +47,7 @@ mod design {
     mod measurable;
     mod nongeometric_design;
     mod paper_cell_geometry;
+    mod tracker_shift;
     mod working_paths;
 }
 mod compensate {

@@ -1,5 +1,6 @@
 //! `[design]`: the safety margins every planned pose keeps (`clearance_mm`,
-//! `joint_margin_deg`); the defaults of [`DesignClearance`] without the section.
+//! `joint_margin_deg`, `incidence_margin_deg`, `line_of_sight_margin_mm`); the defaults of
+//! [`DesignClearance`] for a field (or the section) left out.
 
 use super::fields::*;
 use super::*;
@@ -29,30 +30,72 @@ pub(super) fn design(
     let joint_margin = unit_value(t, "joint_margin", Unit::Rad, &mut used)
         .map_err(|e| err("design", e))?
         .unwrap_or(defaults.joint_margin);
+    let incidence_margin = unit_value(t, "incidence_margin", Unit::Rad, &mut used)
+        .map_err(|e| err("design", e))?
+        .unwrap_or(defaults.incidence_margin);
+    let line_of_sight_margin = unit_value(t, "line_of_sight_margin", Unit::Mm, &mut used)
+        .map_err(|e| err("design", e))?
+        .unwrap_or(defaults.line_of_sight_margin);
     let valid = [
         unit_spellings("clearance", Unit::Mm),
         unit_spellings("joint_margin", Unit::Rad),
+        unit_spellings("incidence_margin", Unit::Rad),
+        unit_spellings("line_of_sight_margin", Unit::Mm),
     ];
     check_unused(t, &used, &[], &valid).map_err(|e| err("design", e))?;
-    if !(0.0..=MAX_CLEARANCE_MM).contains(&clearance) {
-        return Err(err(
-            "design.clearance_mm",
-            format!("must lie in [0, {MAX_CLEARANCE_MM}] mm, got {clearance} mm"),
-        ));
+    for (field, v) in [
+        ("design.clearance_mm", clearance),
+        ("design.line_of_sight_margin_mm", line_of_sight_margin),
+    ] {
+        if !(0.0..=MAX_CLEARANCE_MM).contains(&v) {
+            return Err(err(
+                field,
+                format!("must lie in [0, {MAX_CLEARANCE_MM}] mm, got {v} mm"),
+            ));
+        }
     }
-    if !(0.0..=MAX_JOINT_MARGIN_DEG.to_radians()).contains(&joint_margin) {
-        return Err(err(
-            "design.joint_margin_deg",
-            format!(
-                "must lie in [0, {MAX_JOINT_MARGIN_DEG}]°, got {}°",
-                joint_margin.to_degrees()
-            ),
-        ));
+    for (field, v) in [
+        ("design.joint_margin_deg", joint_margin),
+        ("design.incidence_margin_deg", incidence_margin),
+    ] {
+        if !(0.0..=MAX_JOINT_MARGIN_DEG.to_radians()).contains(&v) {
+            return Err(err(
+                field,
+                format!(
+                    "must lie in [0, {MAX_JOINT_MARGIN_DEG}]°, got {}°",
+                    v.to_degrees()
+                ),
+            ));
+        }
     }
     Ok(DesignClearance {
         clearance,
         joint_margin,
+        incidence_margin,
+        line_of_sight_margin,
     })
+}
+
+/// The incidence margin must leave the reflector some cone: an error when it is not below
+/// the instrument's `max_incidence` (a cell without an incidence limit ignores it).
+pub(super) fn check_incidence_margin(
+    ctx: &Ctx,
+    section: Option<&Spanned<toml::Table>>,
+    design: &DesignClearance,
+    max_incidence: Option<f64>,
+) -> Result<(), Error> {
+    match max_incidence {
+        Some(max) if design.incidence_margin >= max => Err(ctx.err(
+            section.map_or(0..0, |s| s.span()),
+            "design.incidence_margin_deg",
+            format!(
+                "{}° below the instrument's max_incidence_deg = {}° leaves no incidence angle; use a smaller margin",
+                design.incidence_margin.to_degrees(),
+                max.to_degrees()
+            ),
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// The joint margin must leave every revolute joint some range: an error names the first

@@ -205,6 +205,12 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
     let obstacles = obstacles::obstacles(&ctx, &raw.obstacles)?;
     let design = design::design(&ctx, raw.design.as_ref())?;
     design::check_joint_margin(&ctx, raw.design.as_ref(), &design, &model)?;
+    design::check_incidence_margin(
+        &ctx,
+        raw.design.as_ref(),
+        &design,
+        instrument.as_ref().and_then(|i| i.max_incidence),
+    )?;
     let mut capsules = robot.capsules.clone();
     capsules.extend(tool_capsules);
     for (i, c) in capsules.iter().enumerate() {

@@ -68,39 +68,27 @@ pub fn unmeasurable_poses(
     cell: &Cell,
     poses: &[(String, Vec<f64>)],
 ) -> Result<Vec<Unmeasurable>, Error> {
+    unmeasurable_poses_at(cell, &cell.model.nominal(), poses)
+}
+
+/// As [`unmeasurable_poses`], with the robot and the instrument where the parameters
+/// `params` (internal units, the model's full vector) put them: what a virtual instrument
+/// can measure on a simulated robot.
+pub fn unmeasurable_poses_at(
+    cell: &Cell,
+    params: &[f64],
+    poses: &[(String, Vec<f64>)],
+) -> Result<Vec<Unmeasurable>, Error> {
     let set = ConstraintSet::new(cell, &ConstraintSettings::default())?;
-    let params = cell.model.nominal();
     let mut ws = set.workspace();
     let mut values = vec![0.0; set.len()];
-    // β_max in degrees as the cell gave it (30, not 30.000000000000004).
-    let beta_max = set
-        .max_incidence()
-        .map_or(0.0, |b| (b.to_degrees() * 1e9).round() / 1e9);
     let mut out = Vec::new();
     for (id, q) in poses {
         cell.model
             .check_joints(q)
             .map_err(|e| Error::Input(format!("pose {id}: {e}")))?;
-        set.evaluate(&mut ws, &params, q, &mut values, None);
-        let violations: Vec<Violation> = values
-            .iter()
-            .enumerate()
-            .filter(|(_, v)| **v < 0.0)
-            .map(|(i, v)| {
-                let kind = set.kind(i);
-                let (value, limit) = if kind == ConstraintKind::Incidence {
-                    (set.incidence_angle(*v).to_degrees(), beta_max)
-                } else {
-                    (*v, 0.0)
-                };
-                Violation {
-                    constraint: set.name(i).to_string(),
-                    kind,
-                    value,
-                    limit,
-                }
-            })
-            .collect();
+        set.evaluate(&mut ws, params, q, &mut values, None);
+        let violations = violations(&set, &values);
         if !violations.is_empty() {
             out.push(Unmeasurable {
                 id: id.clone(),
@@ -109,4 +97,31 @@ pub fn unmeasurable_poses(
         }
     }
     Ok(out)
+}
+
+/// The constraints of `set` whose `values` are negative, in display units.
+pub(super) fn violations(set: &ConstraintSet, values: &[f64]) -> Vec<Violation> {
+    // β_max in degrees as the cell gave it (30, not 30.000000000000004).
+    let beta_max = set
+        .max_incidence()
+        .map_or(0.0, |b| (b.to_degrees() * 1e9).round() / 1e9);
+    values
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| **v < 0.0)
+        .map(|(i, v)| {
+            let kind = set.kind(i);
+            let (value, limit) = if kind == ConstraintKind::Incidence {
+                (set.incidence_angle(*v).to_degrees(), beta_max)
+            } else {
+                (*v, 0.0)
+            };
+            Violation {
+                constraint: set.name(i).to_string(),
+                kind,
+                value,
+                limit,
+            }
+        })
+        .collect()
 }

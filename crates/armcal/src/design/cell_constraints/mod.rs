@@ -72,18 +72,19 @@
 //! [`ConstraintSettings::beam_radius`]. It is checked against every robot capsule and every
 //! obstacle capsule, except the robot capsules that carry the reflector: a capsule whose
 //! frame has at most one joint between it and the reflector is left out when the reflector
-//! point lies within its radius plus the beam radius (for a frame with one joint in between,
-//! at any of 16 values of that joint over its range, nominal parameters). In the paper cell
+//! point lies within its radius plus the beam radius and line-of-sight margin (for a frame
+//! with one joint in between, at any of 16 values of that joint, nominal parameters). In the paper cell
 //! that removes the reflector holder on `tool`; the wrist capsule on `j5` keeps its
 //! constraint because the reflector sits 339 mm beyond it.
 //!
 //! Constraints that need the tracker (incidence, line of sight) are left out when the model
 //! has no instrument frame; incidence also needs `instrument.max_incidence` in the cell.
 //!
-//! **Clearance and joint margin** (the cell's `[design]`, [`DesignClearance`]). A set built
-//! with [`ConstraintSettings::clearance`] `c` requires `g(q) ≥ c` of every distance
-//! constraint (self collision, obstacle, half-space, line of sight) and keeps every revolute
-//! joint [`ConstraintSettings::joint_margin`] inside its limits; [`ConstraintSet::evaluate`]
+//! **Clearance and margins** (the cell's `[design]`, [`DesignClearance`]; `required.rs`). A
+//! set requires `g(q) ≥` [`ConstraintSettings::clearance`] of every robot and obstacle
+//! distance, `≥` [`ConstraintSettings::line_of_sight_margin`] of the beam, `β ≤ β_max −`
+//! [`ConstraintSettings::incidence_margin`], and keeps every revolute joint
+//! [`ConstraintSettings::joint_margin`] inside its limits; [`ConstraintSet::evaluate`]
 //! still returns the distances themselves, [`ConstraintSet::required`] the least value each
 //! must keep. A distance that no configuration changes and that lies below the clearance (a
 //! base column standing on the floor: 0 mm for every q) is exempt — no design can widen it,
@@ -95,7 +96,7 @@
 //!
 //! This file assembles the set from a cell ([`ConstraintSet::new`]); `evaluate.rs` computes
 //! values and gradients at a configuration; `measurable.rs` lists what makes a pose
-//! unmeasurable.
+//! unmeasurable; `tracker_shift.rs` what does when the instrument stands up to `D` mm off.
 
 use crate::cell::{box_cuboid, half_space_unit_normal, Cell, DesignClearance, Obstacle};
 use crate::geometry::{point_segment_distance, segment_box_distance, segment_distance, Cuboid};
@@ -139,14 +140,21 @@ pub struct ConstraintSettings {
     pub clearance: f64,
     /// Distance (rad) every revolute joint keeps from its limits (0: the limits themselves).
     pub joint_margin: f64,
+    /// Angle (rad) the incidence keeps below the cell's limit, `β ≤ β_max − m` (0: eq. 4).
+    pub incidence_margin: f64,
+    /// Least value (mm) of every q-dependent line-of-sight constraint (0: may touch).
+    pub line_of_sight_margin: f64,
 }
 
 impl ConstraintSettings {
-    /// These settings with the cell's `[design]` clearance and joint margin.
+    /// These settings with the cell's `[design]` clearance, joint, incidence and
+    /// line-of-sight margins.
     pub fn with_clearance(self, design: &DesignClearance) -> Self {
         ConstraintSettings {
             clearance: design.clearance,
             joint_margin: design.joint_margin,
+            incidence_margin: design.incidence_margin,
+            line_of_sight_margin: design.line_of_sight_margin,
             ..self
         }
     }
@@ -162,6 +170,8 @@ impl Default for ConstraintSettings {
             reflector: None,
             clearance: 0.0,
             joint_margin: 0.0,
+            incidence_margin: 0.0,
+            line_of_sight_margin: 0.0,
         }
     }
 }
@@ -351,6 +361,8 @@ impl ConstraintSet {
         for (what, v) in [
             ("clearance", options.clearance),
             ("joint margin", options.joint_margin),
+            ("incidence margin", options.incidence_margin),
+            ("line-of-sight margin", options.line_of_sight_margin),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(Error::Input(format!(
@@ -468,7 +480,8 @@ impl ConstraintSet {
             }
         }
         if options.line_of_sight && has_tracker {
-            let carriers = reflector_carriers(&model, &capsules, reflector, options.beam_radius);
+            let reach = options.beam_radius + options.line_of_sight_margin;
+            let carriers = reflector_carriers(&model, &capsules, reflector, reach);
             for (i, c) in capsules.iter().enumerate() {
                 if !carriers[i] {
                     items.push(Item::BeamRobot { i });
@@ -530,16 +543,7 @@ impl ConstraintSet {
             .into_iter()
             .map(is_flat)
             .collect();
-        if options.clearance > 0.0 {
-            // Exempt from the clearance: constant over 256 samples and below it everywhere.
-            let dense = constraint_ranges(&set, 256);
-            for (i, r) in dense.into_iter().enumerate() {
-                let exempt = is_flat(r) && r.1 < options.clearance;
-                if set.kind(i) != ConstraintKind::Incidence && !exempt {
-                    set.required[i] = options.clearance;
-                }
-            }
-        }
+        required::set_required(&mut set, options, max_incidence)?;
         set.joint_tolerance = if options.joint_margin > 0.0 {
             JOINT_MARGIN_TOLERANCE
         } else {
@@ -646,9 +650,12 @@ fn reflector_carriers(
 
 mod evaluate;
 mod measurable;
+mod required;
+mod tracker_shift;
 pub use evaluate::JOINT_MARGIN_TOLERANCE;
 use evaluate::{constraint_ranges, drop_pairs_in_contact, is_flat};
 #[cfg(test)]
 mod tests;
 
-pub use measurable::{unmeasurable_poses, Unmeasurable, Violation};
+pub use measurable::{unmeasurable_poses, unmeasurable_poses_at, Unmeasurable, Violation};
+pub use tracker_shift::{tracker_shift, TrackerShift};

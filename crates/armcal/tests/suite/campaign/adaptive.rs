@@ -1,16 +1,19 @@
-//! The adaptive campaign (issue 16 item 1): a small simulated run on the paper cell
+//! The adaptive campaign (issue 16 item 1): a small simulated run on the paper cell (with the
+//! default `[design]` margins)
 //! (σ = 1 mm, target 0.7 mm) stops with every working pose's σ at or below the target from
 //! a converged fit, its state resumes, and a batch that is not the planned one is refused
 //! without changing the state.
 
 use armcal::campaign::{self, CampaignSettings, CampaignState, Decision};
-use armcal::cell::builtin::PAPER_CELL;
 use armcal::progress::Silent;
 use armcal::sim::Perturbation;
 use armcal::Cell;
 
+/// The paper cell with the default `[design]` margins: with the paper's zero margins, the
+/// poses a campaign plans sit on the 30° limit and the virtual instrument cannot measure some
+/// of them.
 fn paper_cell() -> Cell {
-    Cell::from_toml(PAPER_CELL, "paper-cell.toml", ".".as_ref()).unwrap()
+    crate::common::paper_cell_with_default_margins()
 }
 
 #[test]

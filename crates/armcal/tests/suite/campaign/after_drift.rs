@@ -16,7 +16,7 @@ use armcal::Cell;
 
 #[test]
 fn a_campaign_from_the_old_calibration_needs_only_what_moved() {
-    let cell = Cell::from_toml(PAPER_CELL, "paper-cell.toml", ".".as_ref()).unwrap();
+    let cell = crate::common::paper_cell_with_default_margins();
     let model = &cell.model;
     let truth = perturbed_truth(model, &Perturbation::default(), 7);
     // The old calibration: 120 random poses (σ = 1 mm).

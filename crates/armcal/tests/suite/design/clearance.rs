@@ -27,6 +27,11 @@ fn obstacle_cell_with(clearance: &str, margin: &str) -> Cell {
         .replace(
             "joint_margin_deg = 0\n",
             &format!("joint_margin_deg = {margin}\n"),
+        )
+        // The beam keeps the same distance (`line_of_sight_margin_mm`, its own field).
+        .replace(
+            "line_of_sight_margin_mm = 0\n",
+            &format!("line_of_sight_margin_mm = {clearance}\n"),
         );
     assert_ne!(text, armcal::cell::builtin::PAPER_CELL_OBSTACLES);
     Cell::from_toml(&text, "obstacles-10mm.toml", Path::new(".")).unwrap()
@@ -219,6 +224,22 @@ fn design_section_errors_name_file_and_field() {
             "joint_margin_deg = 0\njoint_margin_rad = 0\n",
             "twice",
         ),
+        // An incidence margin must leave an angle below the instrument's 30° limit.
+        (
+            "incidence_margin_deg = 0\n",
+            "incidence_margin_deg = 30\n",
+            "design.incidence_margin_deg",
+        ),
+        (
+            "incidence_margin_deg = 0\n",
+            "incidence_margin_deg = -1\n",
+            "design.incidence_margin_deg",
+        ),
+        (
+            "line_of_sight_margin_mm = 0\n",
+            "line_of_sight_margin_mm = 501\n",
+            "design.line_of_sight_margin_mm",
+        ),
     ] {
         let text = armcal::cell::builtin::PAPER_CELL_OBSTACLES.replace(from, to);
         let e = Cell::from_toml(&text, "c.toml", Path::new("."))
@@ -242,7 +263,11 @@ fn only_a_distance_no_pose_changes_is_exempt_from_the_clearance() {
     // clearance over 5 mm a design could keep.
     let text = armcal::cell::builtin::PAPER_CELL_OBSTACLES
         .replace("offset_mm = -450", "offset_mm = -225")
-        .replace("clearance_mm = 0\n", "clearance_mm = 10\n");
+        .replace("clearance_mm = 0\n", "clearance_mm = 10\n")
+        .replace(
+            "line_of_sight_margin_mm = 0\n",
+            "line_of_sight_margin_mm = 10\n",
+        );
     let cell = Cell::from_toml(&text, "wall-5mm.toml", Path::new(".")).unwrap();
     let set = armcal::design::plan::constraint_set(&cell, true).unwrap();
     let params = cell.model.nominal();
