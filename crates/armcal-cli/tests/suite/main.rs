@@ -3,12 +3,14 @@
 mod common;
 
 mod accuracy_cli;
+mod augment_cli;
 mod browser;
 mod campaign_cli;
 mod check_cli;
 mod cli;
 mod compensate_cli;
 mod error_causes;
+mod fitted_ranges_cli;
 mod estimate_checks;
 mod import_cli;
 mod measurable_cli;
