@@ -28,43 +28,48 @@ fn a_calibration_used_outside_its_fitted_joint_ranges_warns() {
     )
     .unwrap();
     let warning = "1 of 2 configurations lie outside the joint ranges the calibration was fitted on (`q3` fitted on [";
+    let inside = path("inside.csv");
+    std::fs::write(
+        &inside,
+        "pose_id,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg\ninside,0,-30,30,0,45,0\n",
+    )
+    .unwrap();
     for command in ["predict", "compensate"] {
-        let input = if command == "predict" { "--joints" } else { "--targets" };
+        let input = if command == "predict" {
+            "--joints"
+        } else {
+            "--targets"
+        };
         let out = path(&format!("{command}.csv"));
-        let (ok, _, err) = armcal(&[
-            command,
-            "--cell",
-            "examples/paper-cell.toml",
-            "--estimate",
-            &est,
-            input,
-            &joints,
-            "--out",
-            &out,
-        ]);
-        assert!(ok, "{command}: {err}");
+        let run = |configurations: &str| {
+            let (ok, _, err) = armcal(&[
+                command,
+                "--cell",
+                "examples/paper-cell.toml",
+                "--estimate",
+                &est,
+                input,
+                configurations,
+                "--out",
+                &out,
+                "--force",
+            ]);
+            assert!(ok, "{command}: {err}");
+            err
+        };
+        let err = run(&joints);
         assert!(err.contains(warning), "{command}: {err}");
+        let beyond = format!(
+            "{upper:.3}] deg, up to {:.3} deg beyond at `beyond`",
+            160.0 - upper
+        );
+        assert!(err.contains(&beyond), "{command}: {err}");
+        // Inside the ranges: no warning.
+        let err = run(&inside);
         assert!(
-            err.contains(&format!("{upper:.3}] deg, up to {:.3} deg beyond at `beyond`", 160.0 - upper)),
+            !err.contains("outside the joint ranges"),
             "{command}: {err}"
         );
-        // Inside the ranges: no warning.
-        let inside = path("inside.csv");
-        std::fs::write(&inside, "pose_id,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg\ninside,0,-30,30,0,45,0\n").unwrap();
-        let (ok, _, err) = armcal(&[
-            command,
-            "--cell",
-            "examples/paper-cell.toml",
-            "--estimate",
-            &est,
-            input,
-            &inside,
-            "--out",
-            &out,
-            "--force",
-        ]);
-        assert!(ok, "{command}: {err}");
-        assert!(!err.contains("outside the joint ranges"), "{command}: {err}");
     }
     // `check` on check poses measured where the calibration was not fitted.
     let check_data = path("check.csv");

@@ -2,7 +2,7 @@
 //! them: a calibration is proven only where it was measured, and its parameters (offsets,
 //! compliance, gear harmonics) extrapolate with no data to check them beyond.
 
-use crate::model::{Joint, Model};
+use crate::model::{Joint, JointKind, Model};
 use serde::{Deserialize, Serialize};
 
 /// The range of one joint over the configurations an estimate was fitted on (display units:
@@ -49,14 +49,28 @@ impl FittedRange {
     }
 
     /// How far the display value `v` lies outside the range (0 inside or within the slack).
-    fn beyond(&self, v: f64) -> f64 {
+    /// A revolute joint (`turn` = 360°) is the same joint a turn further: every term of the
+    /// model (the rotation, the gravity levers, the gear harmonics) is periodic in its angle,
+    /// so `v` is compared in the turn nearest the range, and a range a full turn wide holds
+    /// every angle.
+    fn beyond(&self, v: f64, turn: Option<f64>) -> f64 {
         let slack = SLACK * (self.upper - self.lower).max(1.0);
-        if v < self.lower - slack {
-            self.lower - v
-        } else if v > self.upper + slack {
-            v - self.upper
-        } else {
-            0.0
+        let outside = |v: f64| {
+            if v < self.lower - slack {
+                self.lower - v
+            } else if v > self.upper + slack {
+                v - self.upper
+            } else {
+                0.0
+            }
+        };
+        match turn {
+            Some(t) if self.upper - self.lower >= t => 0.0,
+            Some(t) => {
+                let middle = 0.5 * (self.lower + self.upper);
+                outside(v - t * ((v - middle) / t).round())
+            }
+            None => outside(v),
         }
     }
 }
@@ -77,10 +91,11 @@ pub fn outside_warning(
             continue;
         };
         let f = joint.kind.unit().display_factor();
+        let turn = (joint.kind == JointKind::Revolute).then_some(360.0);
         let worst = configurations
             .iter()
             .enumerate()
-            .map(|(k, (id, q))| (k, id, range.beyond(q[j] * f)))
+            .map(|(k, (id, q))| (k, id, range.beyond(q[j] * f, turn)))
             .filter(|(_, _, d)| *d > 0.0)
             .inspect(|(k, _, _)| outside[*k] = true)
             .max_by(|a, b| a.2.total_cmp(&b.2));

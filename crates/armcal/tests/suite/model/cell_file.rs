@@ -239,7 +239,11 @@ fn duplicate_names_and_an_unknown_instrument_kind_are_errors() {
     );
     expect_error(
         &twice("[[targets]]\nname = \"ball\"\nxyz_mm = [0, 0, 9]"),
-        &["targets[1]", "target name `ball` is used twice", "line 40"],
+        &[
+            "line 46",
+            "targets[1]",
+            "target name `ball` is used twice (first at line 30)",
+        ],
     );
     let bad = INLINE.replace("[instrument]\n", "[instrument]\nkind = \"laser-traker\"\n");
     expect_error(
