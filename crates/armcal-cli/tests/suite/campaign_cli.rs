@@ -87,7 +87,9 @@ fn a_campaign_steps_through_its_files_and_refuses_a_wrong_batch() {
         .map(|(i, l)| {
             let mut f: Vec<String> = l.split(',').map(String::from).collect();
             if i > 0 {
-                f[1] = format!("{}", f[1].parse::<f64>().unwrap() + 0.03);
+                // towards the inside of the joint range: a pose at a limit stays inside
+                let q1 = f[1].parse::<f64>().unwrap();
+                f[1] = format!("{}", q1 - 0.03 * q1.signum());
             }
             f.join(",")
         })
