@@ -216,9 +216,16 @@ pub fn records(text: &str) {
                         .enumerate()
                         .map(|(i, q)| (format!("p{i}"), q))
                         .collect();
+                    let _ = e.outside_fitted_ranges(&model, &poses);
                     for payload in std::iter::once(None).chain((0..model.payloads.len()).map(Some))
                     {
-                        let _ = armcal::sim::predict(&model, &params, &poses, payload);
+                        for measured in [
+                            armcal::model::identifiability::Measurement::Position,
+                            armcal::model::identifiability::Measurement::Pose,
+                        ] {
+                            let _ =
+                                armcal::sim::predict(&model, &params, &poses, payload, measured);
+                        }
                     }
                 }
             }
@@ -236,7 +243,7 @@ pub fn records(text: &str) {
                 let _ = prior.apply(&data_cells()[0]);
             }
         }
-        Document::Study(_) | Document::Demo(_) | Document::Truth(_) => {}
+        Document::Study(_) | Document::Demo(_) | Document::Truth(_) | Document::Check(_) => {}
     }
     let inputs = [Input {
         label: "fuzz".into(),

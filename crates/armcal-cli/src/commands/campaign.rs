@@ -98,6 +98,10 @@ pub struct StepArgs {
     /// The measured batch: a data file of the cell with the poses of DIR/next.csv.
     #[arg(long)]
     pub data: PathBuf,
+    /// How far a measured joint value may be from the planned one in DIR/next.csv (deg; mm
+    /// for a prismatic joint): the resolution the controller reports its joints with.
+    #[arg(long, default_value_t = campaign::JOINT_TOLERANCE)]
+    pub joint_tolerance_deg: f64,
     /// No progress display.
     #[arg(long)]
     pub quiet: bool,
@@ -271,7 +275,13 @@ fn run_step(a: &StepArgs) -> anyhow::Result<()> {
     )?;
     let cell = load_cell(&state.cell_source)?;
     let batch = load_data(&cell, &a.data)?;
-    let r = campaign::step(&cell, &state, &batch, &mut Progress::new(a.quiet))?;
+    let r = campaign::step_within(
+        &cell,
+        &state,
+        &batch,
+        a.joint_tolerance_deg,
+        &mut Progress::new(a.quiet),
+    )?;
     let written = step_files(&cell, &r, &files)?;
     let refs: Vec<(&Path, &str)> = written
         .iter()

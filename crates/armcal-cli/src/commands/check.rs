@@ -4,7 +4,8 @@
 
 use super::campaign::{print_last_step, step_files, Files};
 use super::output::{
-    load_cell, load_data, load_estimate, with_note, AcceptUnconverged, NoteStyle, Outputs,
+    load_cell, load_data, load_estimate, warn_outside_fitted_ranges, with_note, AcceptUnconverged,
+    NoteStyle, Outputs,
 };
 use armcal::campaign::drift::{check, CheckSettings, DriftVerdict};
 use armcal::campaign::prior::CampaignPrior;
@@ -72,6 +73,13 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let cell = load_cell(&a.cell)?;
     let (est, note) = load_estimate(&a.estimate, &a.accept, Some(&cell.model))?;
     let data = load_data(&cell, &a.data)?;
+    let poses: Vec<(String, Vec<f64>)> = data
+        .config_ids
+        .iter()
+        .cloned()
+        .zip(data.configurations.iter().cloned())
+        .collect();
+    warn_outside_fitted_ranges(&est, &cell.model, &poses);
     let c = check(&cell, &est, &data, &CheckSettings { alpha: a.alpha })?;
     let mut written = vec![(
         a.out.clone(),

@@ -3,7 +3,8 @@
 //! (book §5.4).
 
 use super::output::{
-    load_cell, load_data, load_estimate, with_note, AcceptUnconverged, NoteStyle, Outputs,
+    load_cell, load_data, load_estimate, warn_outside_fitted_ranges, with_note, AcceptUnconverged,
+    NoteStyle, Outputs,
 };
 use armcal::compensate::joint_change::JointChangeLimit;
 use armcal::compensate::nonparametric::{CorrectionInputs, ResidualCorrection};
@@ -88,6 +89,8 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         &a.targets.display().to_string(),
         model,
     )?;
+    // the rows' joints: the program, or the Cartesian targets' starting configurations
+    warn_outside_fitted_ranges(&est, model, &program.rows);
     let correction = match &a.nonparametric {
         Some(path) => {
             let data = load_data(&cell, path)?;

@@ -9,6 +9,7 @@
 //! the directories it made are removed again, so a failed command leaves no new file behind.
 
 use anyhow::{bail, Context};
+use armcal::identify::Estimate;
 use std::path::{Path, PathBuf};
 
 /// The files a command will write, checked before it computes anything.
@@ -296,7 +297,7 @@ pub fn load_params_at_payload(
     accept: &AcceptUnconverged,
     model: &armcal::model::Model,
     name: Option<&str>,
-) -> anyhow::Result<(Vec<f64>, Option<String>, PayloadChoice)> {
+) -> anyhow::Result<(Vec<f64>, Option<String>, PayloadChoice, Option<Estimate>)> {
     let quiet = name.is_none() && model.payloads.is_empty();
     match path {
         Some(p) => {
@@ -306,14 +307,27 @@ pub fn load_params_at_payload(
                 est.params_for(model)?,
                 note,
                 (payload, (!quiet).then_some(how)),
+                Some(est),
             ))
         }
         None => {
             let payload = model
                 .payload_index(name.unwrap_or("none"))
                 .map_err(|e| anyhow::anyhow!("--payload: {e}"))?;
-            Ok((model.nominal(), None, (payload, None)))
+            Ok((model.nominal(), None, (payload, None), None))
         }
+    }
+}
+
+/// Prints a warning when `configurations` (id, q) leave the joint ranges `est` was fitted on
+/// ([`Estimate::outside_fitted_ranges`]).
+pub fn warn_outside_fitted_ranges(
+    est: &Estimate,
+    model: &armcal::model::Model,
+    configurations: &[(String, Vec<f64>)],
+) {
+    if let Some(w) = est.outside_fitted_ranges(model, configurations) {
+        eprintln!("warning: {w}");
     }
 }
 

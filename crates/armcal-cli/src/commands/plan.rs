@@ -93,12 +93,11 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
     inputs.extend(a.pool.as_deref());
     let outputs = Outputs::plan(a.force, &inputs, &[&a.out, &report_path])?;
     let cell = load_cell(&a.cell)?;
-    let measured: Vec<Vec<f64>> = match &a.measured {
-        Some(p) => csv::read_configurations(p, &cell.model, None)?
+    let (measured_ids, measured): (Vec<String>, Vec<Vec<f64>>) = match &a.measured {
+        Some(p) => csv::read_configurations_with(p, &cell.model, &cell.data_format())?
             .into_iter()
-            .map(|(_, q)| q)
-            .collect(),
-        None => Vec::new(),
+            .unzip(),
+        None => Default::default(),
     };
     let criterion = Criterion::from_name(&a.criterion).expect("clap checked");
     let record = match &a.pool {
@@ -144,12 +143,35 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         print_pool(pool);
     }
     let rep = record.plan.as_ref().expect("a planned design");
+    // The new poses are numbered on from the measured ones, so both files can be measured
+    // into one data set.
+    let ids = csv::next_pose_ids(&measured_ids, rep.design.len());
+    let poses: Vec<(String, &[f64])> = ids
+        .iter()
+        .cloned()
+        .zip(rep.design.iter().map(Vec::as_slice))
+        .collect();
     outputs.commit(&[
-        (&a.out, &csv::write_configurations(&cell.model, &rep.design)),
+        (&a.out, &csv::write_poses(&cell.model, &poses)),
         (&report_path, &serde_json::to_string_pretty(&record)?),
     ])?;
+    let with_measured = match record.measured {
+        0 => String::new(),
+        m => format!(" with the {m} measured"),
+    };
+    if record.measured > 0 {
+        println!(
+            "the {} measured poses ({}) are augmented; the new poses are numbered {} to {}",
+            record.measured,
+            a.measured
+                .as_deref()
+                .map_or(String::new(), |p| p.display().to_string()),
+            ids.first().map_or("", String::as_str),
+            ids.last().map_or("", String::as_str),
+        );
+    }
     println!(
-        "{} poses for `{}`, criterion {}: value {} ({} {}; refinement {}) in {:.2} s",
+        "{} poses for `{}`, criterion {}{with_measured}: value {} ({} {}; refinement {}) in {:.2} s",
         rep.design.len(),
         cell.name,
         rep.criterion.words(),
@@ -209,7 +231,7 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
     print_margins(&record.margins);
     match rep.bound.as_ref().map(|b| (b, b.efficiency)) {
         Some((b, Some(e))) => println!(
-            "optimality bound: no {}-pose design can go below {}; this design's efficiency {e:.3}",
+            "optimality bound: no {}-pose design{with_measured} can go below {}; this design's efficiency {e:.3}",
             rep.design.len(),
             decimals_or_digits(b.lower_bound, 6)
         ),
@@ -221,7 +243,7 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
     }
     for t in &record.assessment.tcp {
         println!(
-            "(1/3) tr C_s at `{}`: {} mm²{}",
+            "(1/3) tr C_s at `{}`{with_measured}: {} mm²{}",
             t.name,
             decimals_or_digits(t.kpi, 5),
             floor_note(&record.assessment, &t.name)

@@ -1,7 +1,8 @@
 //! `armcal predict`: what the (nominal or identified) model says the instrument measures.
 
 use super::output::{
-    load_cell, load_params_at_payload, with_note, AcceptUnconverged, NoteStyle, Outputs,
+    load_cell, load_params_at_payload, warn_outside_fitted_ranges, with_note, AcceptUnconverged,
+    NoteStyle, Outputs,
 };
 use armcal::measure::csv;
 use armcal::sim::predict;
@@ -39,14 +40,17 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let outputs = Outputs::plan(a.force, &inputs, &[&a.out])?;
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
-    let (params, note, payload) = load_params_at_payload(
+    let (params, note, payload, est) = load_params_at_payload(
         a.estimate.as_deref(),
         &a.accept,
         model,
         a.payload.as_deref(),
     )?;
     let poses = csv::read_configurations_with(&a.joints, model, &cell.data_format())?;
-    let data = predict(model, &params, &poses, payload.0)?;
+    if let Some(est) = &est {
+        warn_outside_fitted_ranges(est, model, &poses);
+    }
+    let data = predict(model, &params, &poses, payload.0, cell.measurement)?;
     outputs.commit(&[(
         &a.out,
         &with_note(

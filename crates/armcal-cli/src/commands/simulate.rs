@@ -122,6 +122,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         model,
         &poses,
         payload,
+        cell.measurement,
         &pert,
         (!a.noise_free).then_some(&noise),
         a.seed,

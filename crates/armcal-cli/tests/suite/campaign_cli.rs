@@ -77,6 +77,63 @@ fn a_campaign_steps_through_its_files_and_refuses_a_wrong_batch() {
     assert_eq!(before, after, "a failed step changed the campaign");
     assert!(!c.join("estimate.json").exists());
 
+    // A controller that reports its joints to 0.05°: every q1 0.03° off the plan is refused
+    // with the default tolerance (0.01°, named with the flag) and taken with
+    // --joint-tolerance-deg 0.05 (in a copy of the campaign, which stays as it was).
+    assert!(text.starts_with("pose_id,q1_deg,"));
+    let moved: Vec<String> = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            let mut f: Vec<String> = l.split(',').map(String::from).collect();
+            if i > 0 {
+                // towards the inside of the joint range: a pose at a limit stays inside
+                let q1 = f[1].parse::<f64>().unwrap();
+                f[1] = format!("{}", q1 - 0.03 * q1.signum());
+            }
+            f.join(",")
+        })
+        .collect();
+    let moved_path = dir.join("moved.csv");
+    std::fs::write(&moved_path, moved.join("\n") + "\n").unwrap();
+    let moved_s = moved_path.to_str().unwrap();
+    let (ok, _, err) = armcal(&["campaign", "step", c_s, "--data", moved_s]);
+    assert!(!ok);
+    assert!(
+        err.contains("joint `q1` is 0.0300 from the planned value")
+            && err.contains("--joint-tolerance-deg"),
+        "{err}"
+    );
+    let copy = dir.join("c_copy");
+    std::fs::create_dir_all(&copy).unwrap();
+    for f in ["campaign.json", "next.csv"] {
+        std::fs::copy(c.join(f), copy.join(f)).unwrap();
+    }
+    let copy_s = copy.to_str().unwrap();
+    let (ok, out, err) = armcal(&[
+        "campaign",
+        "step",
+        copy_s,
+        "--data",
+        moved_s,
+        "--joint-tolerance-deg",
+        "0.05",
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("step 1: 9 poses measured"), "{out}");
+    let (ok, _, err) = armcal(&[
+        "campaign",
+        "step",
+        copy_s,
+        "--data",
+        moved_s,
+        "--joint-tolerance-deg=-1",
+    ]);
+    assert!(
+        !ok && err.contains("joint tolerance -1: give a number ≥ 0"),
+        "{err}"
+    );
+
     // The right batch: a step, a new next.csv of 5 poses numbered on from 10.
     let (ok, out, err) = armcal(&["campaign", "step", c_s, "--data", batch.to_str().unwrap()]);
     assert!(ok, "{err}");

@@ -3,6 +3,7 @@
 mod common;
 
 mod accuracy_cli;
+mod augment_cli;
 mod browser;
 mod campaign_cli;
 mod check_cli;
@@ -11,6 +12,7 @@ mod collision_model_cli;
 mod compensate_cli;
 mod error_causes;
 mod estimate_checks;
+mod fitted_ranges_cli;
 mod import_cli;
 mod margins_cli;
 mod measurable_cli;

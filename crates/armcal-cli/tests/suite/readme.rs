@@ -208,3 +208,54 @@ fn the_transcript_matcher_checks_what_it_should() {
         "v2 60 poses (<duration>), <duration>, 3 sweeps"
     );
 }
+
+/// The joint names README's non-geometric examples use (`compliance = ["q2", "q3"]`,
+/// `periodic = { joints = [...] }`, `"q2.compliance.elbow"`) are joints of a built-in robot:
+/// a user who copies an example into a cell of a built-in robot gets a cell that loads.
+#[test]
+fn readme_joint_names_are_real_joints() {
+    let readme =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../README.md"))
+            .expect("README.md");
+    let joints: Vec<String> = armcal::robots::list()
+        .into_iter()
+        .flat_map(|(name, _)| armcal::robots::robot(&name).expect("built-in").spec.links)
+        .filter_map(|l| l.joint.map(|j| j.name))
+        .collect();
+    // The quoted names inside `compliance = [...]` and `joints = [...]`, and the joint of every
+    // `"<joint>.compliance.…"` / `<joint>.periodic.…` term.
+    let mut named = Vec::new();
+    for (i, line) in readme.lines().enumerate() {
+        for key in ["compliance = [", "periodic = { joints = ["] {
+            for (_, rest) in line
+                .match_indices(key)
+                .map(|(k, _)| line.split_at(k + key.len()))
+            {
+                let list = rest.split(']').next().unwrap_or("");
+                named.extend(
+                    list.split(',')
+                        .map(|n| (i + 1, n.trim().trim_matches('"').to_string())),
+                );
+            }
+        }
+        for term in [".compliance.", ".periodic."] {
+            for (k, _) in line.match_indices(term) {
+                let start = line[..k]
+                    .rfind(|c: char| !(c.is_alphanumeric() || c == '_'))
+                    .map_or(0, |s| s + 1);
+                named.push((i + 1, line[start..k].to_string()));
+            }
+        }
+    }
+    named.retain(|(_, n)| !n.is_empty() && !n.contains('<') && !n.contains('…'));
+    assert!(named.len() >= 10, "README's examples were found: {named:?}");
+    let unknown: Vec<String> = named
+        .iter()
+        .filter(|(_, n)| !joints.contains(n))
+        .map(|(l, n)| format!("README.md line {l}: `{n}`"))
+        .collect();
+    assert!(
+        unknown.is_empty(),
+        "not a joint of any built-in robot: {unknown:?}"
+    );
+}

@@ -32,8 +32,9 @@ use crate::progress::Observer;
 use crate::Error;
 use precision::{poses_needed, predicted_sigmas, working_sigmas, WorkingSigma};
 
-/// Joint values of a measured pose may differ from the planned ones by this much (deg, mm
-/// for a prismatic joint): `next.csv` holds them to 1e-6, a controller reports its own.
+/// Joint values of a measured pose may differ from the planned ones by this much by default
+/// (deg, mm for a prismatic joint): `next.csv` holds them to 1e-6, a controller reports its
+/// own ([`step_within`] takes another tolerance).
 pub const JOINT_TOLERANCE: f64 = 0.01;
 
 /// The fewest poses that identify the cell's free set: ⌈n_p / rows per pose⌉.
@@ -253,8 +254,14 @@ pub struct StepResult {
 }
 
 /// Checks that `batch` measured exactly the poses of `state.next`: the same ids, joint
-/// values within [`JOINT_TOLERANCE`]. The error lists what is missing, extra or moved.
-fn check_batch(cell: &Cell, state: &CampaignState, batch: &Dataset) -> Result<(), Error> {
+/// values within `tolerance` (deg, mm for a prismatic joint). The error lists what is
+/// missing, extra or moved.
+fn check_batch(
+    cell: &Cell,
+    state: &CampaignState,
+    batch: &Dataset,
+    tolerance: f64,
+) -> Result<(), Error> {
     let mut problems = Vec::new();
     let missing: Vec<&str> = state
         .next
@@ -286,9 +293,9 @@ fn check_batch(cell: &Cell, state: &CampaignState, batch: &Dataset) -> Result<()
             .zip(&cell.model.joints)
             .map(|((a, b), j)| ((a - b).abs(), j.name.as_str()))
             .max_by(|a, b| a.0.total_cmp(&b.0));
-        if let Some((d, joint)) = worst.filter(|w| w.0 > JOINT_TOLERANCE) {
+        if let Some((d, joint)) = worst.filter(|w| w.0 > tolerance) {
             problems.push(format!(
-                "pose {id}: joint `{joint}` is {d:.4} from the planned value (more than {JOINT_TOLERANCE})"
+                "pose {id}: joint `{joint}` is {d:.4} from the planned value (more than the joint tolerance {tolerance}; `campaign step --joint-tolerance-deg` sets it)"
             ));
         }
     }
@@ -318,13 +325,32 @@ fn check_batch(cell: &Cell, state: &CampaignState, batch: &Dataset) -> Result<()
 /// working pose's σ is at or below the target and the fit converged (an unconverged fit
 /// never stops the campaign), stop when the budget is spent, or plan the next batch given
 /// everything measured. `state` itself is not changed: a step that fails leaves it as it
-/// was. `cell` must be the campaign's cell (its fingerprint is checked).
+/// was. `cell` must be the campaign's cell (its fingerprint is checked). The measured joint
+/// values may differ from the planned ones by [`JOINT_TOLERANCE`].
 pub fn step(
     cell: &Cell,
     state: &CampaignState,
     batch: &Dataset,
     observer: &mut dyn Observer,
 ) -> Result<StepResult, Error> {
+    step_within(cell, state, batch, JOINT_TOLERANCE, observer)
+}
+
+/// [`step`] with the measured joint values within `joint_tolerance` of the planned ones
+/// (deg, mm for a prismatic joint; a finite number ≥ 0): a controller that reports its
+/// joints to 0.05° needs 0.05.
+pub fn step_within(
+    cell: &Cell,
+    state: &CampaignState,
+    batch: &Dataset,
+    joint_tolerance: f64,
+    observer: &mut dyn Observer,
+) -> Result<StepResult, Error> {
+    if !(joint_tolerance.is_finite() && joint_tolerance >= 0.0) {
+        return Err(Error::Input(format!(
+            "joint tolerance {joint_tolerance}: give a number ≥ 0 (deg, mm for a prismatic joint)"
+        )));
+    }
     let differences = state.fingerprint.differences(&cell.model);
     if !differences.is_empty() {
         return Err(Error::Input(format!(
@@ -340,7 +366,7 @@ pub fn step(
             state.measured()
         )));
     }
-    check_batch(cell, state, batch)?;
+    check_batch(cell, state, batch, joint_tolerance)?;
     // a campaign from an earlier calibration fits the old free set with the old estimate
     // as prior (`prior`)
     let with_prior;

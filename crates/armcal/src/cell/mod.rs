@@ -21,7 +21,8 @@ use std::path::{Path, PathBuf};
 /// The measuring instrument.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Instrument {
-    /// Free-text instrument type from `[instrument] kind` (default `laser-tracker`).
+    /// Instrument type from `[instrument] kind` (default `laser-tracker`; one of the kinds the
+    /// cell parser accepts).
     pub kind: String,
     /// Measurement noise of the instrument (`[instrument.noise]`).
     pub noise: NoiseModel,

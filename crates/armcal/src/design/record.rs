@@ -73,8 +73,13 @@ pub struct DesignRecord {
     /// The planner's report (its `design` in internal units: rad, mm); absent for a design
     /// not planned by armcal.
     pub plan: Option<PlanResult>,
-    /// The predicted precision ([`assess`]).
+    /// The predicted precision ([`assess`]) of the poses already measured and the design
+    /// together: what the calibration will have once the design is measured too.
     pub assessment: DesignAssessment,
+    /// How many poses were already measured when the design was planned to augment them
+    /// (`plan --measured`); the assessment and the planner's criterion value include them.
+    #[serde(default)]
+    pub measured: usize,
     /// The smallest margin of every kind of constraint ([`kind_margins`]).
     pub margins: Vec<KindMargin>,
     /// For a design chosen from the user's pose pool: the pool file, its size, its
@@ -221,12 +226,27 @@ impl DesignRecord {
         plan: Option<PlanResult>,
         collisions: bool,
     ) -> Result<DesignRecord, Error> {
+        DesignRecord::augmenting(cell, cell_source, method, design, &[], plan, collisions)
+    }
+
+    /// The record of `design` planned to augment the `measured` poses: the assessment is of
+    /// both together (the design alone may not identify the free set), the margins of the
+    /// design (collisions and line of sight with `collisions`).
+    fn augmenting(
+        cell: &Cell,
+        cell_source: Option<&str>,
+        method: &str,
+        design: &[Vec<f64>],
+        measured: &[Vec<f64>],
+        plan: Option<PlanResult>,
+        collisions: bool,
+    ) -> Result<DesignRecord, Error> {
+        let all: Vec<Vec<f64>> = measured.iter().chain(design).cloned().collect();
         let units = joint_units(&cell.model);
         Ok(DesignRecord {
             cell: cell.name.clone(),
             cell_source: cell_source.map(String::from),
             method: method.into(),
-            collisions,
             joints: cell
                 .model
                 .joints
@@ -243,8 +263,10 @@ impl DesignRecord {
                 .iter()
                 .map(|q| q.iter().zip(&units).map(|(v, (f, _))| v * f).collect())
                 .collect(),
-            assessment: assess(cell, design)?,
+            assessment: assess(cell, &all)?,
+            measured: measured.len(),
             margins: kind_margins(cell, design, collisions)?,
+            collisions,
             plan,
             pool: None,
         })
@@ -272,11 +294,12 @@ impl DesignRecord {
             observer,
         )?;
         let design = planned.plan.design.clone();
-        let mut record = DesignRecord::new(
+        let mut record = DesignRecord::augmenting(
             cell,
             cell_source,
             method,
             &design,
+            measured,
             Some(planned.plan),
             settings.collisions,
         )?;
@@ -296,11 +319,12 @@ impl DesignRecord {
     ) -> Result<DesignRecord, Error> {
         let report = plan(cell, settings, measured, observer)?;
         let design = report.design.clone();
-        DesignRecord::new(
+        DesignRecord::augmenting(
             cell,
             cell_source,
             method,
             &design,
+            measured,
             Some(report),
             settings.collisions,
         )

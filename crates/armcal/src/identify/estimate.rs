@@ -247,6 +247,10 @@ pub struct Estimate {
     /// (then only the parameter names are checked, [`Estimate::check_model`]).
     #[serde(default)]
     pub fingerprint: Option<ModelFingerprint>,
+    /// The range of every joint over the configurations fitted on
+    /// ([`super::fitted_ranges`]); empty in files of an older armcal.
+    #[serde(default)]
+    pub fitted_ranges: Vec<super::fitted_ranges::FittedRange>,
     /// Set when this estimate is a frames refit (`identify` with
     /// [`IdentifySettings::refit`](super::IdentifySettings::refit)): the estimate whose robot
     /// parameters it kept.
@@ -281,6 +285,17 @@ pub struct Usability {
 }
 
 impl Estimate {
+    /// The warning for the configurations `(id, q)` of `model` outside the joint ranges this
+    /// estimate was fitted on ([`super::fitted_ranges::outside_warning`]); `None` when all
+    /// are inside.
+    pub fn outside_fitted_ranges(
+        &self,
+        model: &Model,
+        configurations: &[(String, Vec<f64>)],
+    ) -> Option<String> {
+        super::fitted_ranges::outside_warning(&self.fitted_ranges, &model.joints, configurations)
+    }
+
     /// Reads an `estimate.json`.
     pub fn from_file(path: &std::path::Path) -> Result<Estimate, Error> {
         let text =

@@ -7,6 +7,7 @@ pub mod circle_point;
 pub mod estimate;
 pub mod fingerprint;
 pub mod fit_checks;
+pub mod fitted_ranges;
 mod free_set;
 pub mod gauss_newton;
 pub mod held_out;
@@ -598,6 +599,7 @@ fn estimate_of_fit(
         validation,
         measurements: train.measurements.len(),
         configurations: train.configurations.len(),
+        fitted_ranges: fitted_ranges::FittedRange::of(model, &train.configurations),
         refit: opts.refit.as_ref().map(|r| refit::record(r, kept)),
     })
 }

@@ -48,6 +48,62 @@ fn err(file: &str, msg: String) -> Error {
     }
 }
 
+/// `e` (an error resolving `header`) with what a user needs to fix the header: the columns the
+/// reader found, and, when the header's first line (`header_line`) splits into more columns
+/// with another delimiter (`;`, tab or `,`) than with the format's `delimiter`, that
+/// delimiter and the `[data]` line that sets it. Errors not about the header pass unchanged.
+pub(crate) fn explain_header(
+    e: Error,
+    header: &[String],
+    header_line: &str,
+    delimiter: char,
+) -> Error {
+    const SHOWN: usize = 30;
+    let Error::File { file, message } = e else {
+        return e;
+    };
+    if !message.starts_with("header:") {
+        return Error::File { file, message };
+    }
+    let mut found: Vec<String> = header
+        .iter()
+        .take(SHOWN)
+        .map(|h| format!("`{h}`"))
+        .collect();
+    if header.len() > SHOWN {
+        found.push(format!("… ({} more)", header.len() - SHOWN));
+    }
+    let columns = |n: usize| if n == 1 { "column" } else { "columns" };
+    let mut message = format!(
+        "{message}; the header has {} {} with delimiter {}: {}",
+        header.len(),
+        columns(header.len()),
+        delimiter_text(delimiter).0,
+        found.join(", ")
+    );
+    let guess = [';', '\t', ',']
+        .into_iter()
+        .filter(|&d| d != delimiter)
+        .map(|d| (header_line.split(d).count(), d))
+        .max_by_key(|(n, _)| *n)
+        .filter(|(n, _)| *n > header.len().max(1));
+    if let Some((n, d)) = guess {
+        let (name, toml) = delimiter_text(d);
+        message.push_str(&format!(
+            "; the header splits into {n} columns with {name} — set `[data] delimiter = \"{toml}\"`"
+        ));
+    }
+    Error::File { file, message }
+}
+
+/// A delimiter as a message names it (`;`, tab) and as a TOML string holds it.
+fn delimiter_text(d: char) -> (String, String) {
+    match d {
+        '\t' => ("tab".into(), "\\t".into()),
+        d => (format!("`{d}`"), d.to_string()),
+    }
+}
+
 /// Splits `x_mm` into (`x`, `mm`), `sigma_x_m` into (`sigma_x`, `m`).
 fn split_unit(name: &str) -> (&str, &str) {
     for suffix in ["_mm", "_m", "_in", "_um", "_deg", "_rad"] {

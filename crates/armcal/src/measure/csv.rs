@@ -27,7 +27,7 @@
 //! Other columns are ignored and listed in [`ReadReport::ignored`]; a known column with an
 //! unknown unit suffix is an error.
 
-use crate::measure::columns::{Column, SigmaOf};
+use crate::measure::columns::{explain_header, Column, SigmaOf};
 use crate::measure::format::{clean, number, DataFormat, Decimal};
 use crate::measure::{Covariates, Dataset, Measurement, MeasurementKind};
 use crate::model::{Joint, JointKind, Model, Observed, Pose};
@@ -86,6 +86,13 @@ fn reader<'t>(text: &'t str, file: &str, format: &DataFormat) -> Result<Table<'t
         .map(|h| clean(h).to_string())
         .collect();
     Ok((rdr, header, lines))
+}
+
+/// The header line of `text`: its first line that is neither empty nor a comment.
+fn header_line(text: &str) -> &str {
+    text.lines()
+        .find(|l| !l.trim().is_empty() && !l.starts_with('#'))
+        .unwrap_or("")
 }
 
 /// The fields of one record, read with the file's header and decimal notation.
@@ -295,7 +302,10 @@ pub fn read_configurations_format_str(
     model: &Model,
     format: &DataFormat,
 ) -> Result<Vec<(String, Vec<f64>)>, Error> {
-    configurations(text, file, model, format, Limits::Unchecked)
+    mapped_or_own(format, |f| {
+        configurations(text, file, model, f, Limits::Unchecked)
+    })
+    .map(|(rows, _)| rows)
 }
 
 /// As [`read_configurations`] (armcal's joint columns), for poses the robot must take (a
@@ -320,7 +330,9 @@ fn configurations(
 ) -> Result<Vec<(String, Vec<f64>)>, Error> {
     let (mut rdr, header, lines) = reader(text, file, format)?;
     let mut used = vec![false; header.len()];
-    let joints = format.joint_layout(&header, model, file, &mut used)?;
+    let joints = format
+        .joint_layout(&header, model, file, &mut used)
+        .map_err(|e| explain_header(e, &header, header_line(text), format.delimiter))?;
     let id_col = header.iter().position(|h| h == "pose_id");
     let mut out = Vec::new();
     for (r, record) in rdr.records().enumerate() {
@@ -392,7 +404,34 @@ pub fn read_format_str(
     model: &Model,
     format: &DataFormat,
 ) -> Result<(Dataset, ReadReport), Error> {
-    read_rows(text, file, model, format, Limits::Checked)
+    let (read, own) = mapped_or_own(format, |f| read_rows(text, file, model, f, Limits::Checked))?;
+    let (data, mut report) = read;
+    if own {
+        report.warnings.insert(0, format!(
+            "{file}: the header has armcal's own columns (as `import`, `simulate` and `predict` write them), not the cell's [data] mapping; read as armcal's CSV"
+        ));
+    }
+    Ok((data, report))
+}
+
+/// `read` with `format`; when that fails on the header and `format` is a cell's mapping, the
+/// file may be armcal's own CSV (what `armcal import` made of the cell's files, or what
+/// `simulate`, `predict` and `plan` write), which every cell reads: then `read` with
+/// [`DataFormat::armcal`], and `true`. When that fails too, the error is the mapping's.
+fn mapped_or_own<T>(
+    format: &DataFormat,
+    read: impl Fn(&DataFormat) -> Result<T, Error>,
+) -> Result<(T, bool), Error> {
+    let own = DataFormat::armcal();
+    match read(format) {
+        Err(Error::File { file, message }) if message.starts_with("header:") && *format != own => {
+            match read(&own) {
+                Ok(t) => Ok((t, true)),
+                Err(_) => Err(Error::File { file, message }),
+            }
+        }
+        r => r.map(|t| (t, false)),
+    }
 }
 
 /// Cartesian targets in armcal's data format (a program of tool poses): the joint columns
@@ -417,7 +456,9 @@ fn read_rows(
     limits: Limits,
 ) -> Result<(Dataset, ReadReport), Error> {
     let (mut rdr, header, lines) = reader(text, file, format)?;
-    let layout = format.layout(&header, model, file)?;
+    let layout = format
+        .layout(&header, model, file)
+        .map_err(|e| explain_header(e, &header, header_line(text), format.delimiter))?;
     let mut data = Dataset {
         source: file.to_string(),
         ..Default::default()
@@ -727,6 +768,23 @@ pub fn write_configurations(model: &Model, qs: &[Vec<f64>]) -> String {
         .map(|(i, q)| ((i + 1).to_string(), q.as_slice()))
         .collect();
     write_poses(model, &numbered)
+}
+
+/// `n` new pose ids that continue `taken` (the ids of the poses already measured): on from
+/// the largest whole-number id (`61`, `62`, … after `1` … `60`), or from `taken.len()` when
+/// that is larger (ids that are not numbers), never an id already taken.
+pub fn next_pose_ids(taken: &[String], n: usize) -> Vec<String> {
+    let largest = taken
+        .iter()
+        .filter_map(|id| id.parse::<u64>().ok())
+        .max()
+        .unwrap_or(0)
+        .max(taken.len() as u64);
+    (largest + 1..)
+        .map(|k| k.to_string())
+        .filter(|id| !taken.contains(id))
+        .take(n)
+        .collect()
 }
 
 /// Writes joint configurations with their own `pose_id`s, in the format of

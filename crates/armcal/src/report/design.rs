@@ -39,8 +39,16 @@ pub fn design_section(id: &str, label: &str, d: &DesignRecord) -> Result<Section
         (
             "poses",
             format!(
-                "{} configurations; collision and line-of-sight constraints {}",
+                "{} configurations{}; collision and line-of-sight constraints {}",
                 d.poses.len(),
+                match d.measured {
+                    0 => String::new(),
+                    m => format!(
+                        " planned to augment {m} measured poses (the criterion and the \
+                         predicted precision are of all {} together)",
+                        m + d.poses.len()
+                    ),
+                },
                 if d.collisions { "on" } else { "off" }
             ),
         ),

@@ -1,8 +1,10 @@
 //! The inputs of a report: armcal's JSON files, recognised by their content — an estimate
 //! (`armcal identify`, `armcal demo`), a design (`armcal plan`, `armcal demo`), a study
 //! (`armcal study paper`), the demo's summary or a simulation's truth record (`armcal
-//! simulate`'s truth file) or a campaign's state (`armcal campaign`).
+//! simulate`'s truth file), a campaign's state (`armcal campaign`) or a drift check
+//! (`armcal check`).
 
+use crate::campaign::drift::DriftCheck;
 use crate::campaign::CampaignState;
 use crate::design::DesignRecord;
 use crate::identify::Estimate;
@@ -27,12 +29,14 @@ pub enum Document {
     Truth(TruthRecord),
     /// The state of an adaptive campaign (`campaign.json` of `armcal campaign`).
     Campaign(Box<CampaignState>),
+    /// A drift check (`check.json` of `armcal check`).
+    Check(Box<DriftCheck>),
 }
 
 const EXPECTED: &str = "expected an armcal estimate (from `armcal identify`), design (the .json \
     `armcal plan` writes beside the design CSV), study result (`armcal study paper`), demo \
-    summary (`armcal demo`), truth record (the truth file of `armcal simulate`) or campaign \
-    state (the campaign.json of `armcal campaign`)";
+    summary (`armcal demo`), truth record (the truth file of `armcal simulate`), campaign \
+    state (the campaign.json of `armcal campaign`) or drift check (`armcal check`)";
 
 impl Document {
     /// Recognises and reads an armcal JSON document; `file` names it in errors.
@@ -65,6 +69,11 @@ impl Document {
         if obj.get("campaign").and_then(|c| c.as_str()) == Some("adaptive") {
             return Ok(Document::Campaign(Box::new(
                 serde_json::from_value(value).map_err(read("campaign state"))?,
+            )));
+        }
+        if has(&["calibrated_on", "chi2", "p_value", "groups"]) {
+            return Ok(Document::Check(Box::new(
+                serde_json::from_value(value).map_err(read("drift check"))?,
             )));
         }
         if has(&["parameters", "solver", "uncertainty", "model"]) {
@@ -127,6 +136,7 @@ impl Document {
             Document::Demo(_) => "demo summary",
             Document::Truth(_) => "truth",
             Document::Campaign(_) => "campaign",
+            Document::Check(_) => "drift check",
         }
     }
 }

@@ -10,6 +10,7 @@
 
 pub mod campaign;
 pub mod cell_view;
+pub mod check;
 pub mod compensation;
 pub mod decimate;
 pub mod demo_summary;
@@ -103,6 +104,12 @@ fn inputs_section(inputs: &[Input], notes: &[String]) -> Section {
                     c.measured(),
                     c.steps.len(),
                     escape(c.decision.words())
+                ),
+                Document::Check(c) => format!(
+                    "drift check of cell <em>{}</em>, {} poses, {}",
+                    escape(&c.cell),
+                    c.poses,
+                    escape(c.verdict.words())
                 ),
             };
             vec![
@@ -227,14 +234,17 @@ pub fn page(c: &ReportContent) -> Result<Page, Error> {
     }
     let mut items = Vec::new();
     for i in c.inputs {
-        let (tcp, predicted, floor) = match &i.document {
-            Document::Design(d) => (d.assessment.tcp.first(), true, &d.assessment.model_floor),
-            Document::Estimate(e) => (e.tcp.first(), false, &e.model_floor),
-            Document::Study(_) | Document::Demo(_) | Document::Truth(_) | Document::Campaign(_) => {
-                (None, false, &None)
-            }
+        let (tcp, predicted, floor): (&[_], bool, _) = match &i.document {
+            Document::Design(d) => (&d.assessment.tcp, true, &d.assessment.model_floor),
+            Document::Estimate(e) => (&e.tcp, false, &e.model_floor),
+            Document::Study(_)
+            | Document::Demo(_)
+            | Document::Truth(_)
+            | Document::Campaign(_)
+            | Document::Check(_) => (&[], false, &None),
         };
-        if let Some(t) = tcp {
+        // every working pose, not only the first
+        for t in tcp {
             items.push(TcpItem {
                 label: i.label.clone(),
                 predicted,
@@ -284,6 +294,15 @@ pub fn page(c: &ReportContent) -> Result<Page, Error> {
                 campaign::campaign_section(&format!("campaign-{}", k + 1), &i.label, st)
                     .map_err(of(i))?,
             );
+        }
+    }
+    for (k, i) in c.inputs.iter().enumerate() {
+        if let Document::Check(d) = &i.document {
+            sections.push(check::check_section(
+                &format!("check-{}", k + 1),
+                &i.label,
+                d,
+            ));
         }
     }
     let studies: Vec<(String, &StudyRecord)> = c

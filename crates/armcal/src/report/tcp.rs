@@ -38,7 +38,7 @@ pub fn tcp_section(id: &str, items: &[TcpItem]) -> Result<Option<Section>, Error
         return Ok(None);
     }
     let k = confidence_scale(3, CONFIDENCE)?;
-    let mut s = Section::new(id, "TCP precision at the working pose");
+    let mut s = Section::new(id, "TCP precision at the working poses");
     s.html(format!(
         "<p class=\"note\">C_s is the covariance of the tool centre point at the working pose: predicted from the design before anything is measured (paper eq. 19 / appendix, C_s = G C_p Gᵀ), and from the identification afterwards. The figures show the projections of the {:.0} % confidence ellipsoid δᵀ C_s⁻¹ δ ≤ k² with k = √χ²₃({}) = {} onto the coordinate planes of the instrument frame, centred on the TCP (mm): dashed outlines are design predictions, solid ones identifications. The model floor C_floor is what the parameters held fixed add at their stated prior (the cell's <code>fixed_prior</code>); the outlines labelled \u{201c}C_s + model floor\u{201d} (dashed, instrument frame) are the ellipsoid of C_s + C_floor, the one the TCP's true error lies in.</p>\n",
         100.0 * CONFIDENCE,
@@ -89,6 +89,41 @@ pub fn tcp_section(id: &str, items: &[TcpItem]) -> Result<Option<Section>, Error
         &rows,
         &[3, 4, 5, 6, 7, 8, 9, 10],
     ));
+    // One block of figures per working pose (in the order the inputs name them), each
+    // comparing every input at that pose.
+    let mut poses: Vec<&str> = Vec::new();
+    for t in items {
+        if !poses.contains(&t.working.as_str()) {
+            poses.push(&t.working);
+        }
+    }
+    for (g, pose) in poses.iter().enumerate() {
+        let at: Vec<&TcpItem> = items.iter().filter(|t| t.working == *pose).collect();
+        if poses.len() > 1 {
+            s.html(format!(
+                "<h3>Working pose <code>{}</code></h3>\n",
+                escape(pose)
+            ));
+        }
+        let gid = if g == 0 {
+            id.to_string()
+        } else {
+            format!("{id}-{}", g + 1)
+        };
+        pose_figures(&mut s, &gid, pose, &at, k)?;
+    }
+    Ok(Some(s))
+}
+
+/// The ellipse figures of `items` (all at the working pose `pose`) in `s`: the instrument
+/// frame, and with a pure-CSS toggle (radio buttons named after `id`) the robot base frame.
+fn pose_figures(
+    s: &mut Section,
+    id: &str,
+    pose: &str,
+    items: &[&TcpItem],
+    k: f64,
+) -> Result<(), Error> {
     let series_of = |base: bool| -> Vec<EllipseSeries> {
         // C_s + C_floor, with its own legend entry; the floor is stated in the instrument
         // frame, so only in the instrument view
@@ -140,7 +175,7 @@ pub fn tcp_section(id: &str, items: &[TcpItem]) -> Result<Option<Section>, Error
                         if base { "ellipse-base" } else { "ellipse-instrument" },
                     ),
                     caption: format!(
-                        "{a}{b} projection, {frame}, of the {:.0} % confidence ellipsoid of the TCP (δ{a}, δ{b} in mm).",
+                        "{a}{b} projection, {frame}, of the {:.0} % confidence ellipsoid of the TCP at `{pose}` (δ{a}, δ{b} in mm).",
                         100.0 * CONFIDENCE
                     ),
                 })
@@ -160,5 +195,5 @@ pub fn tcp_section(id: &str, items: &[TcpItem]) -> Result<Option<Section>, Error
         s.html("<p class=\"note\">Instrument frame only: a record of an older armcal holds no base-frame C_s.</p>\n");
         s.figure_row(figures(false)?);
     }
-    Ok(Some(s))
+    Ok(())
 }

@@ -3,6 +3,7 @@
 //! The same seed gives the same truth and the same measurements.
 
 use crate::measure::{Dataset, Measurement, MeasurementKind, NoiseModel};
+use crate::model::identifiability::Measurement as Measured;
 use crate::model::pose::rot_axis;
 use crate::model::prior::{
     FixedPrior, FIXED_ANGLE_SIGMA_DEG, FIXED_LENGTH_SIGMA_MM, FIXED_UNITLESS_SIGMA,
@@ -145,6 +146,30 @@ pub fn simulate_carrying(
     noise: Option<&NoiseModel>,
     seed: u64,
 ) -> Result<Dataset, Error> {
+    simulate_measuring(
+        model,
+        truth,
+        configurations,
+        payloads,
+        Measured::Position,
+        noise,
+        seed,
+    )
+}
+
+/// As [`simulate_carrying`], measuring what `measured` says of a model without targets:
+/// the tool frame's full pose for [`Measured::Pose`] (a full-pose cell, paper eq. 3 with
+/// the orientation), else the tool origin's position. Frame targets are measured in pose
+/// and point targets in position either way.
+fn simulate_measuring(
+    model: &Model,
+    truth: &[f64],
+    configurations: &[Vec<f64>],
+    payloads: &[Option<usize>],
+    measured: Measured,
+    noise: Option<&NoiseModel>,
+    seed: u64,
+) -> Result<Dataset, Error> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let unit_normal = Normal::new(0.0, 1.0).expect("valid normal");
     let mut data = Dataset {
@@ -166,7 +191,10 @@ pub fn simulate_carrying(
         let config = data.push_configuration(format!("{}", c + 1), q.clone());
         data.set_payload(config, fk.payload.map(|k| model.payloads[k].name.as_str()));
         for &obs in &observed {
-            let is_frame = matches!(obs, Observed::Target(k) if model.target_is_frame(k));
+            let is_frame = match obs {
+                Observed::Target(k) => model.target_is_frame(k),
+                Observed::Tool => measured == Measured::Pose,
+            };
             let pose = observed_pose(&fk, obs);
             let mut m = Measurement {
                 config,
@@ -277,12 +305,16 @@ pub struct Simulation {
 /// Measures the poses `(id, q)` on a robot perturbed from `model` ([`perturbed_truth`] with
 /// `seed`), with the instrument's `noise` (seed `seed + 0x5eed`; noise-free if `None`);
 /// configurations keep their ids, and every one carries `payload` (an index into
-/// [`Model::payloads`]; `None`: none). `cell` names the model in the truth record.
+/// [`Model::payloads`]; `None`: none). `measured`: what the cell's instrument measures (a
+/// full-pose cell without targets measures the tool frame's pose). `cell` names the model in
+/// the truth record.
+#[allow(clippy::too_many_arguments)]
 pub fn simulate_poses(
     cell: &str,
     model: &Model,
     poses: &[(String, Vec<f64>)],
     payload: Option<usize>,
+    measured: Measured,
     perturbation: &Perturbation,
     noise: Option<&NoiseModel>,
     seed: u64,
@@ -292,7 +324,7 @@ pub fn simulate_poses(
         model,
         &truth,
         poses,
-        payload,
+        (payload, measured),
         noise,
         seed.wrapping_add(0x5eed),
     )?;
@@ -304,31 +336,33 @@ pub fn simulate_poses(
 
 /// What the instrument measures at the poses `(id, q)` according to the model with
 /// parameters `params` with the robot carrying `payload` (an index into [`Model::payloads`];
-/// `None`: none), without noise; the data's source is "prediction".
+/// `None`: none), without noise; `measured` as in [`simulate_poses`]; the data's source is
+/// "prediction".
 pub fn predict(
     model: &Model,
     params: &[f64],
     poses: &[(String, Vec<f64>)],
     payload: Option<usize>,
+    measured: Measured,
 ) -> Result<Dataset, Error> {
-    let mut data = simulate_with_ids(model, params, poses, payload, None, 0)?;
+    let mut data = simulate_with_ids(model, params, poses, (payload, measured), None, 0)?;
     data.source = "prediction".into();
     Ok(data)
 }
 
-/// [`simulate_carrying`] at the configurations of `poses`, which keep their ids, each
-/// carrying `payload`.
+/// [`simulate_measuring`] at the configurations of `poses`, which keep their ids, each
+/// carrying the payload of `(payload, measured)` and measuring what it says.
 fn simulate_with_ids(
     model: &Model,
     params: &[f64],
     poses: &[(String, Vec<f64>)],
-    payload: Option<usize>,
+    (payload, measured): (Option<usize>, Measured),
     noise: Option<&NoiseModel>,
     seed: u64,
 ) -> Result<Dataset, Error> {
     let qs: Vec<Vec<f64>> = poses.iter().map(|(_, q)| q.clone()).collect();
     let payloads = vec![payload; qs.len()];
-    let mut data = simulate_carrying(model, params, &qs, &payloads, noise, seed)?;
+    let mut data = simulate_measuring(model, params, &qs, &payloads, measured, noise, seed)?;
     for (k, (id, _)) in poses.iter().enumerate() {
         data.config_ids[k] = id.clone();
     }

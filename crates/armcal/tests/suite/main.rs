@@ -17,6 +17,7 @@ mod identify {
     mod compliance;
     mod estimate_branch;
     mod estimate_checks;
+    mod fitted_ranges;
     mod frames_refit;
     mod honest_free_set;
     mod identification;

@@ -75,8 +75,10 @@ pub(super) fn unit_value(
 pub(super) fn sole_unit_value(t: &toml::Table, key: &str, unit: Unit) -> Result<f64, String> {
     let mut used = Vec::new();
     let spellings = unit_spellings(key, unit);
-    let v = unit_value(t, key, unit, &mut used)?.ok_or_else(|| format!("missing `{spellings}`"))?;
-    check_unused(t, &used, &[], &[spellings])?;
+    let valid = [spellings];
+    let v = unit_value(t, key, unit, &mut used)?
+        .ok_or_else(|| missing(t, &[], &valid, format!("missing `{}`", valid[0])))?;
+    check_unused(t, &used, &[], &valid)?;
     Ok(v)
 }
 
@@ -126,6 +128,44 @@ pub(super) fn check_unused(
     Ok(())
 }
 
+/// The error for a required field missing from `t`. A key of `t` that is no valid spelling
+/// here (`d_in`, `alpah_deg`) is the likely cause, so the error names it as unknown
+/// ([`check_unused`]'s message, which lists what is valid); otherwise the error is `missing`.
+pub(super) fn missing(
+    t: &toml::Table,
+    allowed: &[&str],
+    valid: &[String],
+    missing: impl Into<String>,
+) -> String {
+    let spellings: Vec<&str> = valid.iter().flat_map(|v| v.split('|')).collect();
+    let known: Vec<String> = t
+        .keys()
+        .filter(|k| spellings.contains(&k.as_str()))
+        .cloned()
+        .collect();
+    match check_unused(t, &known, allowed, valid) {
+        Err(unknown) => unknown,
+        Ok(()) => missing.into(),
+    }
+}
+
+/// Records `name` (of a `what`, at `line`) in `seen`; an error when an earlier entry has it
+/// already (records, reports and the constraint margins name entries by it).
+pub(super) fn unique_name(
+    seen: &mut Vec<(String, usize)>,
+    name: &str,
+    line: usize,
+    what: &str,
+) -> Result<(), String> {
+    if let Some((_, first)) = seen.iter().find(|(n, _)| n == name) {
+        return Err(format!(
+            "the {what} name `{name}` is used twice (first at line {first}); give each {what} its own name"
+        ));
+    }
+    seen.push((name.to_string(), line));
+    Ok(())
+}
+
 /// The spellings of a field with its unit suffixes: `theta_deg|theta_rad`.
 pub(super) fn unit_spellings(field: &str, unit: Unit) -> String {
     match unit {
@@ -163,9 +203,13 @@ pub(super) fn string_field<'a>(t: &'a toml::Table, key: &str) -> Result<Option<&
 
 pub(super) fn capsule(t: &toml::Table, frame_required: bool) -> Result<Capsule, String> {
     let mut used = Vec::new();
-    let a = unit_triple(t, "a", Unit::Mm, &mut used)?.ok_or("missing `a_mm`")?;
-    let b = unit_triple(t, "b", Unit::Mm, &mut used)?.ok_or("missing `b_mm`")?;
-    let radius = unit_value(t, "radius", Unit::Mm, &mut used)?.ok_or("missing `radius_mm`")?;
+    let valid = ["a", "b", "radius"].map(|k| unit_spellings(k, Unit::Mm));
+    let allowed = ["frame", "name", "kind"];
+    let absent = |what: &str| missing(t, &allowed, &valid, format!("missing `{what}`"));
+    let a = unit_triple(t, "a", Unit::Mm, &mut used)?.ok_or_else(|| absent("a_mm"))?;
+    let b = unit_triple(t, "b", Unit::Mm, &mut used)?.ok_or_else(|| absent("b_mm"))?;
+    let radius =
+        unit_value(t, "radius", Unit::Mm, &mut used)?.ok_or_else(|| absent("radius_mm"))?;
     if radius < 0.0 {
         return Err("`radius_mm` must be ≥ 0".into());
     }
@@ -173,8 +217,7 @@ pub(super) fn capsule(t: &toml::Table, frame_required: bool) -> Result<Capsule, 
     if frame_required && frame.is_none() {
         return Err("missing `frame` (the chain frame the capsule moves with)".into());
     }
-    let valid = ["a", "b", "radius"].map(|k| unit_spellings(k, Unit::Mm));
-    check_unused(t, &used, &["frame", "name", "kind"], &valid)?;
+    check_unused(t, &used, &allowed, &valid)?;
     Ok(Capsule {
         frame: frame.unwrap_or("tool").to_string(),
         a,

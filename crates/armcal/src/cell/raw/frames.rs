@@ -24,6 +24,7 @@ pub(super) fn base_and_tool(
 /// default.
 pub(super) fn targets(ctx: &Ctx, tables: &[Spanned<toml::Table>]) -> Result<Vec<LinkSpec>, Error> {
     let mut targets = Vec::new();
+    let mut seen = Vec::new();
     for (i, t) in tables.iter().enumerate() {
         let tt = t.get_ref();
         let field = format!("targets[{i}]");
@@ -31,16 +32,18 @@ pub(super) fn targets(ctx: &Ctx, tables: &[Spanned<toml::Table>]) -> Result<Vec<
             .map_err(|e| ctx.err(t.span(), &field, e))?
             .map(str::to_string)
             .unwrap_or_else(|| format!("smr{}", i + 1));
+        unique_name(&mut seen, &name, ctx.line(t.span()), "target")
+            .map_err(|e| ctx.err(t.span(), &field, e))?;
         let is_frame = tt.keys().any(|k| k.starts_with("rpy"));
         let geometry = if is_frame {
             frame(tt, &["name"]).map_err(|e| ctx.err(t.span(), &field, e))?
         } else {
             let mut used = vec!["name".to_string()];
+            let valid = [unit_spellings("xyz", Unit::Mm)];
             let xyz = unit_triple(tt, "xyz", Unit::Mm, &mut used)
-                .and_then(|v| v.ok_or_else(|| "missing `xyz_mm`".to_string()))
+                .and_then(|v| v.ok_or_else(|| missing(tt, &["name"], &valid, "missing `xyz_mm`")))
                 .map_err(|e| ctx.err(t.span(), &field, e))?;
-            check_unused(tt, &used, &[], &[unit_spellings("xyz", Unit::Mm)])
-                .map_err(|e| ctx.err(t.span(), &field, e))?;
+            check_unused(tt, &used, &[], &valid).map_err(|e| ctx.err(t.span(), &field, e))?;
             LinkGeometry::point(xyz)
         };
         targets.push(LinkSpec {

@@ -3,6 +3,11 @@
 use super::fields::*;
 use super::*;
 
+/// The instrument kinds `[instrument] kind` accepts. The kind is a label (records and exports
+/// carry it; what the instrument measures is `[parameters] measurement`), but a misspelt one
+/// is an error rather than a silent new kind.
+const KINDS: [&str; 4] = ["laser-tracker", "optical-tracker", "cmm", "ballbar"];
+
 /// The instrument of `[instrument]`, its frame's geometry and its name (`tracker` by
 /// default); no instrument without the section.
 pub(super) fn instrument(
@@ -32,6 +37,13 @@ pub(super) fn instrument(
                     ))
                 }
             };
+            if let Some(k) = ri.kind.as_deref().filter(|k| !KINDS.contains(k)) {
+                return Err(ctx.err(
+                    span,
+                    "instrument.kind",
+                    format!("unknown instrument kind `{k}`; use {}", KINDS.join(", ")),
+                ));
+            }
             let frame = LinkSpec {
                 name: ri.name.as_deref().unwrap_or("tracker").into(),
                 geometry: LinkGeometry::frame6(xyz, rpy),
@@ -84,10 +96,17 @@ fn noise(t: &toml::Table) -> Result<NoiseModel, String> {
                 .iter()
                 .any(|k| t.get(*k).map(|v| v.is_array()).unwrap_or(false));
             let s = if is_array {
-                unit_triple(t, "sigma", Unit::Mm, &mut used)?.ok_or("missing `sigma_mm`")?
+                unit_triple(t, "sigma", Unit::Mm, &mut used)?
+                    .ok_or_else(|| missing(t, &["model"], &valid, "missing `sigma_mm`"))?
             } else {
-                [unit_value(t, "sigma", Unit::Mm, &mut used)?
-                    .ok_or("missing `sigma_mm` (a number or 3 numbers)")?; 3]
+                [unit_value(t, "sigma", Unit::Mm, &mut used)?.ok_or_else(|| {
+                    missing(
+                        t,
+                        &["model"],
+                        &valid,
+                        "missing `sigma_mm` (a number or 3 numbers)",
+                    )
+                })?; 3]
             };
             if s.iter().any(|x| *x <= 0.0) {
                 return Err("`sigma_mm` must be positive".into());
@@ -102,11 +121,16 @@ fn noise(t: &toml::Table) -> Result<NoiseModel, String> {
             }
         }
         Some("range") => {
-            let a = unit_value(t, "a", Unit::Mm, &mut used)?.ok_or("missing `a_mm`")?;
-            let b = t
-                .get("b_um_per_m")
-                .and_then(number)
-                .ok_or("missing `b_um_per_m` (µm per metre of range)")?;
+            let a = unit_value(t, "a", Unit::Mm, &mut used)?
+                .ok_or_else(|| missing(t, &["model"], &valid, "missing `a_mm`"))?;
+            let b = t.get("b_um_per_m").and_then(number).ok_or_else(|| {
+                missing(
+                    t,
+                    &["model"],
+                    &valid,
+                    "missing `b_um_per_m` (µm per metre of range)",
+                )
+            })?;
             used.push("b_um_per_m".into());
             if a <= 0.0 || b < 0.0 {
                 return Err("need `a_mm` > 0 and `b_um_per_m` ≥ 0".into());

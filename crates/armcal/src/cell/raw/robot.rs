@@ -350,6 +350,22 @@ fn inline_link(t: &toml::Table, index: usize) -> Result<LinkSpec, String> {
             ))
         }
     };
+    let mut valid: Vec<String> = convention
+        .fields(kind)
+        .iter()
+        .map(|(f, u)| unit_spellings(f, *u))
+        .collect();
+    if convention == Convention::Mdh {
+        valid.push(unit_spellings("beta", Unit::Rad));
+    }
+    let allowed = [
+        "name",
+        "convention",
+        "joint",
+        "limits",
+        "axis",
+        "joint_name",
+    ];
     let mut used = Vec::new();
     let mut values = Vec::new();
     for (field, unit) in convention.fields(kind) {
@@ -359,16 +375,13 @@ fn inline_link(t: &toml::Table, index: usize) -> Result<LinkSpec, String> {
             Some(v) => v,
             None if default_zero => 0.0,
             None => {
-                let hint = match unit {
-                    Unit::Mm => "_mm",
-                    Unit::Rad => "_deg",
-                    Unit::Unitless => "",
-                    Unit::RadPerMm => "_urad_per_m",
-                    Unit::RadPerNmm => "_urad_per_Nm",
-                    Unit::Arcsec => "_arcsec",
-                };
-                return Err(format!(
-                    "missing `{field}{hint}` for convention {convention}"
+                let first = unit_spellings(field, *unit);
+                let first = first.split('|').next().unwrap_or(field);
+                return Err(missing(
+                    t,
+                    &allowed,
+                    &valid,
+                    format!("missing `{first}` for convention {convention}"),
                 ));
             }
         });
@@ -412,27 +425,7 @@ fn inline_link(t: &toml::Table, index: usize) -> Result<LinkSpec, String> {
             Some(joint)
         }
     };
-    let mut valid: Vec<String> = convention
-        .fields(kind)
-        .iter()
-        .map(|(f, u)| unit_spellings(f, *u))
-        .collect();
-    if convention == Convention::Mdh {
-        valid.push(unit_spellings("beta", Unit::Rad));
-    }
-    check_unused(
-        t,
-        &used,
-        &[
-            "name",
-            "convention",
-            "joint",
-            "limits",
-            "axis",
-            "joint_name",
-        ],
-        &valid,
-    )?;
+    check_unused(t, &used, &allowed, &valid)?;
     Ok(LinkSpec {
         name,
         geometry,

@@ -16,10 +16,13 @@ pub(super) fn working(
     let file = ctx.file;
     let mut warnings = Vec::new();
     let mut working = Vec::new();
+    let mut seen = Vec::new();
     for (i, w) in tables.iter().enumerate() {
         let field = format!("working[{i}]");
         let t = w.get_ref();
-        let name = name_field(ctx, w, &field, || format!("work{}", i + 1))?;
+        let name = name_field(ctx, w, &field, &mut seen, "working pose", || {
+            format!("work{}", i + 1)
+        })?;
         let (key, f) = joints_key(t);
         let arr = match t.get(key) {
             None => return Err(ctx.err(
@@ -63,10 +66,13 @@ pub(super) fn working_paths(
 ) -> Result<(Vec<WorkingPath>, Vec<String>), Error> {
     let mut warnings = Vec::new();
     let mut paths = Vec::new();
+    let mut seen = Vec::new();
     for (i, w) in tables.iter().enumerate() {
         let field = format!("working_path[{i}]");
         let t = w.get_ref();
-        let name = name_field(ctx, w, &field, || format!("path{}", i + 1))?;
+        let name = name_field(ctx, w, &field, &mut seen, "working path", || {
+            format!("path{}", i + 1)
+        })?;
         let (key, f) = joints_key(t);
         let (used, points) = match (t.get("file"), t.get(key)) {
             (Some(_), Some(_)) => {
@@ -143,17 +149,22 @@ pub(super) fn working_paths(
     Ok((paths, warnings))
 }
 
-/// `name`, or `default()` when the table has none.
+/// `name`, or `default()` when the table has none; an error when an earlier `what` of the
+/// section (in `seen`) has the same name.
 fn name_field(
     ctx: &Ctx,
     w: &Spanned<toml::Table>,
     field: &str,
+    seen: &mut Vec<(String, usize)>,
+    what: &str,
     default: impl FnOnce() -> String,
 ) -> Result<String, Error> {
-    Ok(string_field(w.get_ref(), "name")
+    let name = string_field(w.get_ref(), "name")
         .map_err(|e| ctx.err(w.span(), field, e))?
         .map(str::to_string)
-        .unwrap_or_else(default))
+        .unwrap_or_else(default);
+    unique_name(seen, &name, ctx.line(w.span()), what).map_err(|e| ctx.err(w.span(), field, e))?;
+    Ok(name)
 }
 
 /// The joint key the table uses and its factor to radians (revolute joints).

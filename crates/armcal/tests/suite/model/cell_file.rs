@@ -187,3 +187,78 @@ fn a_cell_can_use_a_urdf_robot() {
         "{e}"
     );
 }
+
+#[test]
+fn a_misspelt_key_is_named_as_unknown_not_as_a_missing_field() {
+    // A wrong unit suffix or a typo in a required field: the error names the key the user
+    // wrote (the missing field is its consequence), at the link's line.
+    for (from, to, unknown) in [
+        ("d_mm = 400", "d_in = 400", "`d_in`"),
+        (
+            "alpha_deg = 0\n[[robot.links]]",
+            "alpah_deg = 0\n[[robot.links]]",
+            "`alpah_deg`",
+        ),
+        ("xyz_mm = [0, 0, 50]", "xyz_cm = [0, 0, 5]", "`xyz_cm`"),
+        ("offset_mm = -100", "offset_in = -4", "`offset_in`"),
+        ("a_mm = 0.015", "a_um = 15", "`a_um`"),
+        ("sigma_deg = 0.1", "sigma_arcmin = 6", "`sigma_arcmin`"),
+    ] {
+        assert!(INLINE.contains(from), "{from}");
+        let bad = INLINE.replacen(from, to, 1);
+        expect_error(&bad, &["cell.toml", "unknown field", unknown, "valid here"]);
+    }
+    // Without a stray key, a missing field is still reported as missing.
+    let bad = INLINE.replace("d_mm = 400\n", "");
+    expect_error(&bad, &["line 6", "robot.links[0]", "missing `d_mm`"]);
+}
+
+#[test]
+fn duplicate_names_and_an_unknown_instrument_kind_are_errors() {
+    let twice = |section: &str| format!("{INLINE}\n{section}\n{section}\n");
+    expect_error(
+        &twice("[[working]]\nname = \"w\"\njoints_deg = [0, 10]"),
+        &[
+            "working[2]",
+            "working pose name `w` is used twice",
+            "first at line",
+        ],
+    );
+    expect_error(
+        &twice("[[working_path]]\nname = \"p\"\njoints_deg = [[0, 10]]"),
+        &["working_path[1]", "working path name `p` is used twice"],
+    );
+    expect_error(
+        &twice("[[obstacles]]\nname = \"wall\"\nkind = \"half-space\"\nnormal = [1, 0, 0]\noffset_mm = -900"),
+        &["obstacles[2]", "obstacle name `wall` is used twice"],
+    );
+    // The unnamed default names count too: `obstacle1` is the first obstacle's.
+    expect_error(
+        &twice("[[obstacles]]\nname = \"obstacle1\"\nkind = \"half-space\"\nnormal = [1, 0, 0]\noffset_mm = -900"),
+        &["obstacles[1]", "obstacle name `obstacle1` is used twice"],
+    );
+    expect_error(
+        &twice("[[targets]]\nname = \"ball\"\nxyz_mm = [0, 0, 9]"),
+        &[
+            "line 46",
+            "targets[1]",
+            "target name `ball` is used twice (first at line 30)",
+        ],
+    );
+    let bad = INLINE.replace("[instrument]\n", "[instrument]\nkind = \"laser-traker\"\n");
+    expect_error(
+        &bad,
+        &[
+            "instrument.kind",
+            "unknown instrument kind `laser-traker`",
+            "laser-tracker",
+        ],
+    );
+    for kind in ["laser-tracker", "cmm"] {
+        let good = INLINE.replace(
+            "[instrument]\n",
+            &format!("[instrument]\nkind = \"{kind}\"\n"),
+        );
+        assert_eq!(parse(&good).unwrap().instrument.unwrap().kind, kind);
+    }
+}

@@ -555,3 +555,117 @@ fn an_estimate_without_degrees_of_freedom_reads_back() {
         _ => panic!("not an estimate"),
     }
 }
+
+/// The report shows every working pose of a design and an estimate (a table row and its
+/// own ellipse figures each), not only the first.
+#[test]
+fn the_tcp_section_shows_every_working_pose() {
+    let (_, design, est) = fixtures();
+    let (mut design, mut est) = (design.clone(), est.clone());
+    let second = |t: &armcal::identify::uncertainty::TcpCovariance| {
+        let mut t = t.clone();
+        t.name = "q_second".into();
+        t.covariance *= 2.0;
+        t.kpi *= 2.0;
+        t
+    };
+    design
+        .assessment
+        .tcp
+        .push(second(&design.assessment.tcp[0]));
+    est.tcp.push(second(&est.tcp[0]));
+    let inputs = vec![
+        Input {
+            label: "planned".into(),
+            source: "design.json".into(),
+            document: Document::Design(Box::new(design)),
+        },
+        Input {
+            label: "fitted".into(),
+            source: "estimate.json".into(),
+            document: Document::Estimate(Box::new(est)),
+        },
+    ];
+    let page = report::page(&ReportContent {
+        title: "t",
+        subtitle: "s",
+        inputs: &inputs,
+        ..Default::default()
+    })
+    .unwrap();
+    let html = page.render();
+    let first = &fixtures().2.tcp[0].name;
+    for pose in [first.as_str(), "q_second"] {
+        assert!(
+            html.contains(&format!("<h3>Working pose <code>{pose}</code></h3>")),
+            "{pose}"
+        );
+        assert!(html.contains(&format!("at `{pose}`")), "{pose}: no figure");
+    }
+    // Two inputs × two poses in the table; six ellipse figures (3 planes, 2 frames) per pose.
+    assert_eq!(count(&html, "<td>q_second</td>"), 2);
+    assert_eq!(count(&html, "data-figure=\"ellipse-instrument\""), 6);
+    assert_eq!(count(&html, "data-figure=\"ellipse-base\""), 6);
+}
+
+/// A drift check record (`armcal check`) is recognised and gets its section: the χ² test,
+/// the verdict and the groups' score tests with the likeliest mover marked.
+#[test]
+fn a_drift_check_record_is_a_report_input() {
+    use armcal::campaign::drift::{DriftCheck, DriftVerdict, GroupScore};
+    let check = DriftCheck {
+        cell: "paper-650-600".into(),
+        calibrated_on: "data.csv".into(),
+        data: "check.csv".into(),
+        poses: 10,
+        dof: 30,
+        chi2: 95.5,
+        p_value: 1.2e-8,
+        alpha: 0.01,
+        verdict: DriftVerdict::Drifted,
+        rms_position_mm: 0.25,
+        chi2_without_prediction: 101.0,
+        covariance_rule: "C_p scaled by max(1, σ̂₀²)".into(),
+        calibration_variance_factor: Some(1.1),
+        groups: vec![
+            GroupScore {
+                group: "j2".into(),
+                parameters: vec!["j2.theta".into(), "j2.beta".into()],
+                rank: 2,
+                statistic: 60.0,
+                p_value: 1e-12,
+            },
+            GroupScore {
+                group: "tool".into(),
+                parameters: vec!["tool.x".into()],
+                rank: 1,
+                statistic: 0.5,
+                p_value: 0.48,
+            },
+        ],
+    };
+    let document = Document::from_json(&check.to_json().unwrap(), "check.json").unwrap();
+    assert_eq!(document.kind(), "drift check");
+    let inputs = vec![Input {
+        label: "after the crash".into(),
+        source: "check.json".into(),
+        document,
+    }];
+    let html = report::page(&ReportContent {
+        title: "t",
+        subtitle: "s",
+        inputs: &inputs,
+        ..Default::default()
+    })
+    .unwrap()
+    .render();
+    for needle in [
+        "Drift check: after the crash",
+        "10 check poses of cell <em>paper-650-600</em>",
+        "drifted: the robot or the cell changed since the calibration",
+        "<td>tool</td>",
+        "drift check of cell <em>paper-650-600</em>, 10 poses, drifted",
+    ] {
+        assert!(html.contains(needle), "{needle}");
+    }
+}
