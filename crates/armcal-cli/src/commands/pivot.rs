@@ -39,7 +39,8 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let outputs = Outputs::plan(a.force, &inputs, &[a.out.as_path()])?;
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
-    let (params, note, _) = load_params_at_payload(a.estimate.as_deref(), &a.accept, model, None)?;
+    let (params, note, _, _) =
+        load_params_at_payload(a.estimate.as_deref(), &a.accept, model, None)?;
     let poses: Vec<Vec<f64>> = csv::read_configurations(&a.poses, model, None)?
         .into_iter()
         .map(|(_, q)| q)

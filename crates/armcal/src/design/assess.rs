@@ -157,7 +157,7 @@ pub fn design_floor(cell: &Cell, design: &[Vec<f64>]) -> Result<Option<ModelFloo
         .map(|(i, q)| ((i + 1).to_string(), q.clone()))
         .collect();
     let params = cell.model.nominal();
-    let data = crate::sim::predict(&cell.model, &params, &poses, None)?;
+    let data = crate::sim::predict(&cell.model, &params, &poses, None, cell.measurement)?;
     let problem = Problem::new(&cell.model, &data, &cell.noise())?;
     let (_, j) = problem.residual_and_jacobian(&params);
     let cp =

@@ -8,9 +8,7 @@ use crate::model::pose::rot_axis;
 use crate::model::prior::{
     FixedPrior, FIXED_ANGLE_SIGMA_DEG, FIXED_LENGTH_SIGMA_MM, FIXED_UNITLESS_SIGMA,
 };
-use crate::model::{
-    forward_kinematics, observed_pose, Data, Model, Observed, Pose, Segment, Unit,
-};
+use crate::model::{forward_kinematics, observed_pose, Data, Model, Observed, Pose, Segment, Unit};
 use crate::Error;
 use nalgebra::Vector3;
 use rand::SeedableRng;
