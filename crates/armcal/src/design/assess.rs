@@ -169,6 +169,7 @@ pub fn design_floor(cell: &Cell, design: &[Vec<f64>]) -> Result<Option<ModelFloo
         &cp,
         &cell.working,
         &cell.fixed_prior,
+        &[],
     )))
 }
 

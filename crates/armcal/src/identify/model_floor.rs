@@ -31,6 +31,7 @@
 //! nonlinear fits on robots perturbed by the prior (`tests/suite/identify/model_floor.rs`).
 
 use crate::cell::WorkingPose;
+use crate::identify::robust::{kept_rows, Outlier};
 use crate::identify::uncertainty::tcp_jacobian;
 use crate::identify::Problem;
 use crate::model::prior::FixedPrior;
@@ -88,6 +89,7 @@ pub fn model_floor(
     cp: &DMatrix<f64>,
     working: &[WorkingPose],
     prior: &FixedPrior,
+    outliers: &[Outlier],
 ) -> ModelFloor {
     let model = problem.model;
     let fixed_all: Vec<usize> = (0..model.param_count())
@@ -109,7 +111,7 @@ pub fn model_floor(
         .filter(|&i| prior.sigma(model.registry.get(i)) > 0.0)
         .collect();
     let qs: Vec<Vec<f64>> = working.iter().map(|w| w.q.clone()).collect();
-    let k = bias_matrix(problem, params, jacobian, cp, &fixed, &qs);
+    let k = bias_matrix(problem, params, jacobian, cp, &fixed, &qs, outliers);
     let sigma = DVector::from_iterator(
         fixed.len(),
         fixed.iter().map(|&i| prior.sigma(model.registry.get(i))),
@@ -151,7 +153,9 @@ pub fn model_floor(
 }
 
 /// `K = G_f − G C_p Fᵀ F_f` (module notes): 3 rows per working configuration `qs`, one
-/// column per parameter of `fixed` (registry indices).
+/// column per parameter of `fixed` (registry indices). `jacobian` is the fit's (its data
+/// rows those of the measurements a robust fit kept, with weight 1, then its prior rows);
+/// `F_f` is taken over the same data rows.
 pub fn bias_matrix(
     problem: &Problem,
     params: &[f64],
@@ -159,19 +163,20 @@ pub fn bias_matrix(
     cp: &DMatrix<f64>,
     fixed: &[usize],
     qs: &[Vec<f64>],
+    outliers: &[Outlier],
 ) -> DMatrix<f64> {
     let model = problem.model;
     let g = tcp_jacobian(model, params, &problem.free, qs);
     let g_fixed = tcp_jacobian(model, params, fixed, qs);
     // The data rows' Jacobian over the fixed columns: the same problem with those columns
-    // free and no prior rows (a fixed parameter has none), so the whitening and the robust
-    // row weights are the fit's.
+    // free and no prior rows (a fixed parameter has none), over the rows the fit's Jacobian
+    // holds (the kept measurements, weight 1), so the whitening is the fit's.
     let mut at_fixed = problem.clone();
     at_fixed.free = fixed.to_vec();
     at_fixed.prior_rows = DMatrix::zeros(0, fixed.len());
     at_fixed.prior_offset = DVector::zeros(0);
-    let (_, f_fixed) = at_fixed.residual_and_jacobian(params);
-    let data_rows = problem.data_rows();
+    let (_, f_fixed) = kept_rows(&mut at_fixed, params, outliers);
+    let data_rows = f_fixed.nrows();
     let absorbed = jacobian.rows(0, data_rows).transpose() * f_fixed.rows(0, data_rows);
     g_fixed - g * (cp * absorbed)
 }

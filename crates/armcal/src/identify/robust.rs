@@ -180,7 +180,7 @@ pub fn robust_fit(
 }
 
 /// Unweighted whitened residual and Jacobian at `params` without the rows of `outliers`.
-fn kept_rows(
+pub(crate) fn kept_rows(
     problem: &mut Problem,
     params: &[f64],
     outliers: &[Outlier],

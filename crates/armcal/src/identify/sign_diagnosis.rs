@@ -17,7 +17,9 @@
 //! Motoman left-arm data, 31.6 mm as read against 0.11 mm with `e` shifted by +90°, while
 //! the full calibration leaves 0.07 mm).
 
-use super::{frames_only, levenberg_marquardt, LmSettings, Problem, ToleranceSettings};
+use super::{
+    frames_model, frames_only, levenberg_marquardt, LmSettings, Problem, ToleranceSettings,
+};
 use crate::measure::{Dataset, NoiseModel};
 use crate::model::{JointKind, Model, Status};
 use crate::progress::Silent;
@@ -152,7 +154,7 @@ fn quick_model(model: &Model, data: &Dataset) -> Result<Model, Error> {
             .registry
             .set_status(l.first_param + field, Status::Free);
     }
-    let (quick, _) = super::frames_model(&quick, data, &quick.nominal())?;
+    let (quick, _) = frames_model(&quick, data, &quick.nominal())?;
     Ok(quick)
 }
 

@@ -67,6 +67,7 @@ fn mahalanobis(cell: &Cell, runs: u64) -> Vec<(f64, f64)> {
                 &cp,
                 &cell.working[..1],
                 &cell.fixed_prior,
+                &[],
             );
             let cf: Matrix3<f64> = floor.tcp[0].covariance;
             let e = tcp(&sol.params) - tcp(&truth);
