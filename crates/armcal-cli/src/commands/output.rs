@@ -286,6 +286,10 @@ pub fn load_estimate(
 /// model has no payloads and none was asked for, the sentence saying how.
 pub type PayloadChoice = (Option<usize>, Option<String>);
 
+/// What [`load_params_at_payload`] returns: the parameters, the note every output made with
+/// them carries, the payload choice and the estimate they came from (`None`: nominal).
+pub type ParamsAtPayload = (Vec<f64>, Option<String>, PayloadChoice, Option<Estimate>);
+
 /// The parameters of the estimate at `path` for `model` ([`load_estimate`]), or the nominal
 /// ones without an estimate, with the line every output made with them must carry, and the
 /// payload the robot carries: `name` checked against the
@@ -297,7 +301,7 @@ pub fn load_params_at_payload(
     accept: &AcceptUnconverged,
     model: &armcal::model::Model,
     name: Option<&str>,
-) -> anyhow::Result<(Vec<f64>, Option<String>, PayloadChoice, Option<Estimate>)> {
+) -> anyhow::Result<ParamsAtPayload> {
     let quiet = name.is_none() && model.payloads.is_empty();
     match path {
         Some(p) => {

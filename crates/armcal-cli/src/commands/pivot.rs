@@ -1,7 +1,8 @@
 //! `armcal pivot`: TCP (tool-tip) calibration from poses touching one fixed point.
 
 use super::output::{
-    load_cell, load_params_at_payload, with_note, AcceptUnconverged, NoteStyle, Outputs,
+    load_cell, load_params_at_payload, warn_outside_fitted_ranges, with_note, AcceptUnconverged,
+    NoteStyle, Outputs,
 };
 use armcal::identify::pivot::{pivot_calibration, PivotSettings};
 use armcal::measure::csv;
@@ -39,12 +40,13 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let outputs = Outputs::plan(a.force, &inputs, &[a.out.as_path()])?;
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
-    let (params, note, _, _) =
+    let (params, note, _, est) =
         load_params_at_payload(a.estimate.as_deref(), &a.accept, model, None)?;
-    let poses: Vec<Vec<f64>> = csv::read_configurations(&a.poses, model, None)?
-        .into_iter()
-        .map(|(_, q)| q)
-        .collect();
+    let configurations = csv::read_configurations(&a.poses, model, None)?;
+    if let Some(est) = &est {
+        warn_outside_fitted_ranges(est, model, &configurations);
+    }
+    let poses: Vec<Vec<f64>> = configurations.into_iter().map(|(_, q)| q).collect();
     let settings = PivotSettings {
         max_condition: a.max_condition,
     };

@@ -43,7 +43,13 @@ fn plan_measured_prints_the_combined_precision_and_continues_the_pose_ids() {
             .find(|l| l.contains(prefix))
             .unwrap_or_else(|| panic!("{s}"));
         let at = line.find(prefix).unwrap() + prefix.len();
-        line[at..].trim_end_matches(" mm²").trim().parse().unwrap()
+        line[at..]
+            .split(" mm²")
+            .next()
+            .unwrap()
+            .trim()
+            .parse()
+            .unwrap()
     };
     let planned = kpi(&stdout, "(1/3) tr C_s at `q_work` with the 60 measured: ");
     // The same figure from `evaluate` on the measured and the new poses in one file.
