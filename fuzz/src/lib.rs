@@ -54,7 +54,7 @@ pub fn cell(text: &str) {
     ];
     let _ = analyze_model(&cell, &settings, forms[text.len() % forms.len()]);
     let design = random_configurations(&cell.model, POSES, 1);
-    let _ = evaluate_design(&cell, &design, true);
+    let _ = evaluate_design(&cell, &design, true, Some(50.0));
     let formats = ["dh", "mdh", "zrp", "cell", "json", "urdf"];
     let format = ExportFormat::from_name(formats[text.len() / 4 % formats.len()]).expect("known");
     let Ok(exported) = export_model(&cell.model.spec(), Some(&cell), format) else {
@@ -234,7 +234,7 @@ pub fn records(text: &str) {
         Document::Design(d) => {
             let cell = &data_cells()[0];
             if let Ok(design) = d.design_for(&cell.model) {
-                let _ = evaluate_design(cell, &design, true);
+                let _ = evaluate_design(cell, &design, true, Some(50.0));
             }
         }
         Document::Campaign(state) => {
