@@ -163,9 +163,19 @@ fn configurations(cell: &Cell, text: &str) {
 
 /// URDF → model → forward kinematics → URDF → model: the same tool pose.
 pub fn urdf(text: &str) {
-    let Ok(spec) = armcal::model::urdf::from_urdf_str(text, None) else {
+    let Ok((spec, shapes)) = armcal::model::urdf::from_urdf_str_with_collisions(text, None) else {
         return;
     };
+    // Every collision shape read is bounded by a capsule of finite ends and radius ≥ 0.
+    for shape in &shapes {
+        if let Some(c) = armcal::robots::bounding::bounding_capsule(shape) {
+            assert!(
+                c.radius >= 0.0 && c.radius.is_finite() && c.a.iter().chain(&c.b).all(|v| v.is_finite()),
+                "a collision shape of link `{}` was bounded by {c:?}",
+                shape.link
+            );
+        }
+    }
     let Ok(model) = Model::from_spec(&spec) else {
         return;
     };

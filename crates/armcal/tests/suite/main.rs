@@ -82,6 +82,7 @@ mod hostile {
     mod input_size;
     mod report_ranges;
     mod stations;
+    mod urdf_collision_values;
     mod urdf_depth;
     mod urdf_parser_panic;
 }

@@ -240,13 +240,13 @@ pub(super) fn collision_model(
         String::new()
     } else {
         format!(
-            "{} capsules bounding the URDF's <collision> shapes; on the other frames, ",
-            bounded.len()
+            "{} bounding the URDF's <collision> shapes; on the other frames, ",
+            capsule_count(bounded.len())
         )
     };
     text += &format!(
-        "skeleton: {} capsules between successive joint origins, radius {} mm ({how})",
-        capsules.len(),
+        "skeleton: {} between successive joint origins, radius {} mm ({how})",
+        capsule_count(capsules.len()),
         default
     );
     for (frame, r) in &per_frame {
@@ -256,6 +256,11 @@ pub(super) fn collision_model(
     robot.capsules = bounded;
     robot.collision = text;
     Ok(warnings)
+}
+
+/// "1 capsule", "3 capsules".
+pub(crate) fn capsule_count(n: usize) -> String {
+    format!("{n} capsule{}", if n == 1 { "" } else { "s" })
 }
 
 /// A joint's lower limit is not above its upper one (equal limits lock the joint); the error

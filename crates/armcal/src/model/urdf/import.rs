@@ -45,6 +45,15 @@ pub fn from_urdf_str(xml: &str, tip: Option<&str>) -> Result<ModelSpec, Error> {
     parse(xml, tip).map(|(spec, _)| spec)
 }
 
+/// [`from_urdf_str`], with the `<collision>` shapes of the chain's links (see
+/// [`read_urdf_with_collisions`]).
+pub fn from_urdf_str_with_collisions(
+    xml: &str,
+    tip: Option<&str>,
+) -> Result<(ModelSpec, Vec<CollisionShape>), Error> {
+    parse(xml, tip)
+}
+
 /// The chain of `xml` and its links' collision shapes.
 fn parse(xml: &str, tip: Option<&str>) -> Result<(ModelSpec, Vec<CollisionShape>), Error> {
     super::depth::check_depth(xml)?;
@@ -70,7 +79,8 @@ fn parse(xml: &str, tip: Option<&str>) -> Result<(ModelSpec, Vec<CollisionShape>
     })?;
     let robot = parsed.map_err(|e| Error::Input(format!("not a valid URDF document: {e}")))?;
     let (spec, frames) = import(&robot, tip)?;
-    Ok((spec, collision_shapes(&robot, &frames)))
+    let shapes = collision_shapes(&robot, &frames)?;
+    Ok((spec, shapes))
 }
 
 /// A `<collision>` shape of a chain link, in armcal's units.
@@ -102,36 +112,66 @@ pub enum CollisionGeometry {
     Mesh(String),
 }
 
-/// The collision shapes of the chain's URDF links (`frames`: URDF link → chain frame).
-fn collision_shapes(robot: &urdf_rs::Robot, frames: &[(String, String)]) -> Vec<CollisionShape> {
+/// The collision shapes of the chain's URDF links (`frames`: URDF link → chain frame). A
+/// dimension that is not a finite length ≥ 0, or an origin that is not finite, is an error
+/// naming the link: a negative radius would otherwise become a capsule that shrinks its
+/// neighbours' clearance (silent garbage, issue 30).
+fn collision_shapes(
+    robot: &urdf_rs::Robot,
+    frames: &[(String, String)],
+) -> Result<Vec<CollisionShape>, Error> {
     use urdf_rs::Geometry as G;
-    let mm = |v: f64| v / M_PER_MM;
     let mut out = Vec::new();
     for (link, frame) in frames {
         let Some(l) = robot.links.iter().find(|l| l.name == *link) else {
             continue;
         };
         for c in &l.collision {
+            let mm = |what: &str, v: f64| {
+                if v.is_finite() && v >= 0.0 {
+                    Ok(v / M_PER_MM)
+                } else {
+                    Err(Error::Input(format!(
+                        "URDF robot `{}`, link `{link}`: the <collision> {what} is {v} m, not a \
+                         length ≥ 0; fix the URDF (lengths in metres)",
+                        robot.name
+                    )))
+                }
+            };
             let geometry = match &c.geometry {
-                G::Box { size } => CollisionGeometry::Box(size.0.map(mm)),
-                G::Cylinder { radius, length } => {
-                    CollisionGeometry::Cylinder(mm(*radius), mm(*length))
-                }
-                G::Capsule { radius, length } => {
-                    CollisionGeometry::Capsule(mm(*radius), mm(*length))
-                }
-                G::Sphere { radius } => CollisionGeometry::Sphere(mm(*radius)),
+                G::Box { size } => CollisionGeometry::Box([
+                    mm("box size x", size.0[0])?,
+                    mm("box size y", size.0[1])?,
+                    mm("box size z", size.0[2])?,
+                ]),
+                G::Cylinder { radius, length } => CollisionGeometry::Cylinder(
+                    mm("cylinder radius", *radius)?,
+                    mm("cylinder length", *length)?,
+                ),
+                G::Capsule { radius, length } => CollisionGeometry::Capsule(
+                    mm("capsule radius", *radius)?,
+                    mm("capsule length", *length)?,
+                ),
+                G::Sphere { radius } => CollisionGeometry::Sphere(mm("sphere radius", *radius)?),
                 G::Mesh { filename, .. } => CollisionGeometry::Mesh(filename.clone()),
             };
+            let (xyz, rpy) = (c.origin.xyz.0, c.origin.rpy.0);
+            if xyz.iter().chain(&rpy).any(|v| !v.is_finite()) {
+                return Err(Error::Input(format!(
+                    "URDF robot `{}`, link `{link}`: the <collision> origin (xyz {xyz:?}, rpy \
+                     {rpy:?}) is not finite; fix the URDF",
+                    robot.name
+                )));
+            }
             out.push(CollisionShape {
                 frame: frame.clone(),
                 link: link.clone(),
-                origin: crate::model::Pose::from_xyz_rpy(c.origin.xyz.0.map(mm), c.origin.rpy.0),
+                origin: crate::model::Pose::from_xyz_rpy(xyz.map(|v| v / M_PER_MM), rpy),
                 geometry,
             });
         }
     }
-    out
+    Ok(out)
 }
 
 /// Imports the serial chain of a parsed URDF robot from its root link to `tip` (default: the

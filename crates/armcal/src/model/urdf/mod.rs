@@ -41,8 +41,8 @@ pub mod import;
 
 pub use export::to_urdf;
 pub use import::{
-    from_urdf_robot, from_urdf_str, read_urdf, read_urdf_with_collisions, CollisionGeometry,
-    CollisionShape,
+    from_urdf_robot, from_urdf_str, from_urdf_str_with_collisions, read_urdf,
+    read_urdf_with_collisions, CollisionGeometry, CollisionShape,
 };
 
 use std::collections::HashSet;
