@@ -102,6 +102,11 @@ pub struct StepArgs {
     /// for a prismatic joint): the resolution the controller reports its joints with.
     #[arg(long, default_value_t = campaign::JOINT_TOLERANCE)]
     pub joint_tolerance_deg: f64,
+    /// Poses of DIR/next.csv the instrument could not measure (ids, comma-separated: the
+    /// beam blocked, the reflector turned too far): the data file lacks them, the state
+    /// records them and the campaign goes on without them.
+    #[arg(long, value_delimiter = ',')]
+    pub unmeasurable: Vec<String>,
     /// No progress display.
     #[arg(long)]
     pub quiet: bool,
@@ -275,11 +280,15 @@ fn run_step(a: &StepArgs) -> anyhow::Result<()> {
     )?;
     let cell = load_cell(&state.cell_source)?;
     let batch = load_data(&cell, &a.data)?;
-    let r = campaign::step_within(
+    let settings = campaign::StepSettings {
+        joint_tolerance: a.joint_tolerance_deg,
+        unmeasurable: a.unmeasurable.clone(),
+    };
+    let r = campaign::step_with(
         &cell,
         &state,
         &batch,
-        a.joint_tolerance_deg,
+        &settings,
         &mut Progress::new(a.quiet),
     )?;
     let written = step_files(&cell, &r, &files)?;
@@ -348,6 +357,14 @@ fn print_step(k: usize, s: &CampaignStep) {
         s.measured,
         s.poses.len()
     );
+    if !s.unmeasurable.is_empty() {
+        let ids: Vec<&str> = s.unmeasurable.iter().map(|p| p.id.as_str()).collect();
+        println!(
+            "  not measured (the instrument could not): pose{} {}",
+            if ids.len() == 1 { "" } else { "s" },
+            ids.join(", ")
+        );
+    }
     for w in &s.working {
         println!(
             "  `{}`: σ = {:.4} mm (axes {:.4}, {:.4}, {:.4}; 95 % ellipsoid semi-axes {:.3}, {:.3}, {:.3} mm){}",

@@ -1,7 +1,7 @@
 //! `armcal campaign start | step | status` on the paper cell: a step takes exactly the
-//! poses of next.csv (a batch with a pose missing or extra is refused, naming them, and the
-//! campaign's files stay as they were), rewrites the state and next.csv, and `status`
-//! prints where the campaign stands.
+//! poses of next.csv but those declared unmeasurable (a batch with a pose missing or extra
+//! is refused, naming them, and the campaign's files stay as they were), rewrites the state
+//! and next.csv, and `status` prints where the campaign stands.
 
 use crate::common::{armcal, scratch};
 
@@ -156,4 +156,60 @@ fn a_campaign_steps_through_its_files_and_refuses_a_wrong_batch() {
     assert!(ok, "{err}");
     assert!(out.contains("9 poses measured in 1 steps"), "{out}");
     assert!(out.contains("predicted poses still needed: about"), "{out}");
+
+    // Poses 12 and 13 could not be measured: the batch without them is refused until they
+    // are declared (an id not in next.csv is refused too), then taken; the next batch is
+    // numbered on after 14, not after the 12 poses measured.
+    let b2 = dir.join("b2.csv");
+    simulate(&next, &b2);
+    let partial: String = std::fs::read_to_string(&b2)
+        .unwrap()
+        .lines()
+        .filter(|l| !l.starts_with("12,") && !l.starts_with("13,"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let partial_path = dir.join("partial.csv");
+    std::fs::write(&partial_path, partial).unwrap();
+    let partial_s = partial_path.to_str().unwrap();
+    let (ok, _, err) = armcal(&["campaign", "step", c_s, "--data", partial_s]);
+    assert!(!ok);
+    assert!(
+        err.contains("missing poses 12, 13") && err.contains("--unmeasurable"),
+        "{err}"
+    );
+    let (ok, _, err) = armcal(&[
+        "campaign",
+        "step",
+        c_s,
+        "--data",
+        partial_s,
+        "--unmeasurable",
+        "12,13,77",
+    ]);
+    assert!(
+        !ok && err.contains("declared unmeasurable but not in next.csv: 77"),
+        "{err}"
+    );
+    let (ok, out, err) = armcal(&[
+        "campaign",
+        "step",
+        c_s,
+        "--data",
+        partial_s,
+        "--unmeasurable",
+        "12,13",
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("step 2: 12 poses measured (+3)"), "{out}");
+    assert!(
+        out.contains("not measured (the instrument could not): poses 12, 13"),
+        "{out}"
+    );
+    let ids: Vec<String> = std::fs::read_to_string(&next)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap().to_string())
+        .collect();
+    assert_eq!(ids, ["15", "16", "17", "18", "19"]);
 }

@@ -34,7 +34,7 @@ use precision::{poses_needed, predicted_sigmas, working_sigmas, WorkingSigma};
 
 /// Joint values of a measured pose may differ from the planned ones by this much by default
 /// (deg, mm for a prismatic joint): `next.csv` holds them to 1e-6, a controller reports its
-/// own ([`step_within`] takes another tolerance).
+/// own ([`step_with`] takes another tolerance).
 pub const JOINT_TOLERANCE: f64 = 0.01;
 
 /// The fewest poses that identify the cell's free set: ⌈n_p / rows per pose⌉.
@@ -253,24 +253,54 @@ pub struct StepResult {
     pub estimate: Option<Estimate>,
 }
 
-/// Checks that `batch` measured exactly the poses of `state.next`: the same ids, joint
-/// values within `tolerance` (deg, mm for a prismatic joint). The error lists what is
-/// missing, extra or moved.
+/// Checks that `batch` measured exactly the poses of `state.next` but those `settings`
+/// declares unmeasurable: the same ids, joint values within the joint tolerance (deg, mm for
+/// a prismatic joint). The error lists what is missing, extra, declared wrongly or moved.
 fn check_batch(
     cell: &Cell,
     state: &CampaignState,
     batch: &Dataset,
-    tolerance: f64,
+    settings: &StepSettings,
 ) -> Result<(), Error> {
+    let tolerance = settings.joint_tolerance;
+    let declared = |id: &str| settings.unmeasurable.iter().any(|u| u == id);
     let mut problems = Vec::new();
     let missing: Vec<&str> = state
         .next
         .iter()
-        .filter(|p| !batch.config_ids.contains(&p.id))
+        .filter(|p| !batch.config_ids.contains(&p.id) && !declared(&p.id))
         .map(|p| p.id.as_str())
         .collect();
     if !missing.is_empty() {
-        problems.push(format!("missing poses {}", missing.join(", ")));
+        problems.push(format!(
+            "missing poses {} (measure them, or declare the ones the instrument cannot \
+             measure with `campaign step --unmeasurable`)",
+            missing.join(", ")
+        ));
+    }
+    let unknown: Vec<&str> = settings
+        .unmeasurable
+        .iter()
+        .filter(|id| !state.next.iter().any(|p| &p.id == *id))
+        .map(String::as_str)
+        .collect();
+    if !unknown.is_empty() {
+        problems.push(format!(
+            "poses declared unmeasurable but not in next.csv: {}",
+            unknown.join(", ")
+        ));
+    }
+    let both: Vec<&str> = settings
+        .unmeasurable
+        .iter()
+        .filter(|id| batch.config_ids.contains(id))
+        .map(String::as_str)
+        .collect();
+    if !both.is_empty() {
+        problems.push(format!(
+            "poses both measured and declared unmeasurable: {}",
+            both.join(", ")
+        ));
     }
     let extra: Vec<&str> = batch
         .config_ids
@@ -306,7 +336,7 @@ fn check_batch(
         return Ok(());
     }
     Err(Error::Input(format!(
-        "{}: not the batch of next.csv ({} poses, ids {}): {}; measure exactly the poses of next.csv",
+        "{}: not the batch of next.csv ({} poses, ids {}): {}; measure exactly the poses of next.csv but those declared unmeasurable",
         batch.source,
         state.next.len(),
         state
@@ -333,19 +363,41 @@ pub fn step(
     batch: &Dataset,
     observer: &mut dyn Observer,
 ) -> Result<StepResult, Error> {
-    step_within(cell, state, batch, JOINT_TOLERANCE, observer)
+    step_with(cell, state, batch, &StepSettings::default(), observer)
 }
 
-/// [`step`] with the measured joint values within `joint_tolerance` of the planned ones
-/// (deg, mm for a prismatic joint; a finite number ≥ 0): a controller that reports its
-/// joints to 0.05° needs 0.05.
-pub fn step_within(
+/// How [`step_with`] takes a batch.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StepSettings {
+    /// The measured joint values may differ from the planned ones by this (deg, mm for a
+    /// prismatic joint; a finite number ≥ 0): a controller that reports its joints to 0.05°
+    /// needs 0.05. Default [`JOINT_TOLERANCE`].
+    pub joint_tolerance: f64,
+    /// Ids of `next.csv` poses the instrument could not measure (the beam blocked, the
+    /// reflector turned past its acceptance angle on the real cell): the batch lacks them,
+    /// the step records them ([`CampaignStep::unmeasurable`]) and the campaign goes on
+    /// without them. At least one pose of the batch must be measured.
+    pub unmeasurable: Vec<String>,
+}
+
+impl Default for StepSettings {
+    fn default() -> Self {
+        StepSettings {
+            joint_tolerance: JOINT_TOLERANCE,
+            unmeasurable: Vec::new(),
+        }
+    }
+}
+
+/// [`step`] with the joint tolerance and the unmeasurable poses of `settings`.
+pub fn step_with(
     cell: &Cell,
     state: &CampaignState,
     batch: &Dataset,
-    joint_tolerance: f64,
+    settings: &StepSettings,
     observer: &mut dyn Observer,
 ) -> Result<StepResult, Error> {
+    let joint_tolerance = settings.joint_tolerance;
     if !(joint_tolerance.is_finite() && joint_tolerance >= 0.0) {
         return Err(Error::Input(format!(
             "joint tolerance {joint_tolerance}: give a number ≥ 0 (deg, mm for a prismatic joint)"
@@ -366,7 +418,7 @@ pub fn step_within(
             state.measured()
         )));
     }
-    check_batch(cell, state, batch, joint_tolerance)?;
+    check_batch(cell, state, batch, settings)?;
     // a campaign from an earlier calibration fits the old free set with the old estimate
     // as prior (`prior`)
     let with_prior;
@@ -388,32 +440,33 @@ pub fn step_within(
         .warm_start()
         .or(state.settings.prior.as_ref().map(|p| p.params.as_slice()))
         .map(<[f64]>::to_vec);
-    let settings = IdentifySettings {
+    let fit_settings = IdentifySettings {
         start: warm.clone(),
         ..IdentifySettings::default()
     };
-    let (estimate, fit, fit_error, working) = match identify(fit_cell, &data, &settings, observer) {
-        Ok(mut e) => {
-            // the estimate is of the campaign's cell, whatever prior the fit had
-            e.fingerprint = Some(ModelFingerprint::of(&cell.model));
-            let s = precision::scale(&e);
-            let params = e.params_for(&cell.model)?;
-            let fit = FitSummary {
-                status: e.solver.status.clone(),
-                iterations: e.solver.iterations,
-                warm_start: warm.is_some(),
-                free: e.free.len(),
-                variance_factor: Some(e.uncertainty.variance_factor).filter(|v| v.is_finite()),
-                dof: e.uncertainty.dof,
-                p_value: Some(e.uncertainty.p_value).filter(|v| v.is_finite()),
-                covariance_scale: s,
-                params,
-            };
-            let working = working_sigmas(&e, s);
-            (Some(e), Some(fit), None, working)
-        }
-        Err(e) => (None, None, Some(e.to_string()), Vec::new()),
-    };
+    let (estimate, fit, fit_error, working) =
+        match identify(fit_cell, &data, &fit_settings, observer) {
+            Ok(mut e) => {
+                // the estimate is of the campaign's cell, whatever prior the fit had
+                e.fingerprint = Some(ModelFingerprint::of(&cell.model));
+                let s = precision::scale(&e);
+                let params = e.params_for(&cell.model)?;
+                let fit = FitSummary {
+                    status: e.solver.status.clone(),
+                    iterations: e.solver.iterations,
+                    warm_start: warm.is_some(),
+                    free: e.free.len(),
+                    variance_factor: Some(e.uncertainty.variance_factor).filter(|v| v.is_finite()),
+                    dof: e.uncertainty.dof,
+                    p_value: Some(e.uncertainty.p_value).filter(|v| v.is_finite()),
+                    covariance_scale: s,
+                    params,
+                };
+                let working = working_sigmas(&e, s);
+                (Some(e), Some(fit), None, working)
+            }
+            Err(e) => (None, None, Some(e.to_string()), Vec::new()),
+        };
     let mut next_state = state.clone();
     let measured = data.configurations.len();
     let target = state.settings.target_sigma_mm;
@@ -503,7 +556,15 @@ pub fn step_within(
         let predicted = predicted_sigmas(&at, &all, s)?;
         let largest = predicted.iter().copied().fold(0.0, f64::max);
         let total = poses_needed(all.len(), largest, target);
-        (numbered(cell, &qs, measured), predicted, Some(total))
+        // ids continue after every pose issued, the unmeasurable ones included
+        let issued = measured
+            + settings.unmeasurable.len()
+            + state
+                .steps
+                .iter()
+                .map(|s| s.unmeasurable.len())
+                .sum::<usize>();
+        (numbered(cell, &qs, issued), predicted, Some(total))
     } else {
         (Vec::new(), Vec::new(), None)
     };
@@ -516,6 +577,12 @@ pub fn step_within(
             .map(|(id, q)| CampaignPose::of(&cell.model, id.clone(), q))
             .collect(),
         data: batch.clone(),
+        unmeasurable: state
+            .next
+            .iter()
+            .filter(|p| settings.unmeasurable.contains(&p.id))
+            .cloned()
+            .collect(),
         measured,
         fit,
         fit_error,

@@ -5,9 +5,9 @@
 //! error and whether it lies in the stated 95 % ellipsoid.
 
 use super::precision::tcp_position;
-use super::{start, step, CampaignSettings, CampaignState, Decision};
+use super::{start, step_with, CampaignSettings, CampaignState, Decision, StepSettings};
 use crate::cell::Cell;
-use crate::design::cell_constraints::unmeasurable_poses_at;
+use crate::design::cell_constraints::{unmeasurable_poses_at, ConstraintKind, Unmeasurable};
 use crate::identify::Estimate;
 use crate::progress::Observer;
 use crate::sim::{perturbed_truth, Perturbation, TruthRecord};
@@ -51,11 +51,13 @@ pub fn simulate(
 }
 
 /// Measures the poses `state` asks for on the robot `truth` with the cell's instrument
-/// noise (batch `k` with noise seed `seed · 1000 + k`) and steps until the campaign stops;
-/// a batch with a pose the virtual instrument cannot measure there
-/// ([`unmeasurable_poses_at`]: incidence, line of sight or collision at the true robot and
-/// instrument) is an error naming the poses, as it would stop a real campaign;
-/// every step records the true TCP error at the working poses. `estimate`: the estimate of
+/// noise (batch `k` with noise seed `seed · 1000 + k`) and steps until the campaign stops.
+/// A pose the virtual instrument cannot measure there ([`unmeasurable_poses_at`] at the true
+/// robot and instrument) only for its incidence or line of sight is left out and declared
+/// unmeasurable ([`StepSettings::unmeasurable`]), as an operator whose tracker loses the
+/// beam goes on without it; a pose in collision at the true robot, or a batch with no
+/// measurable pose, is an error naming the poses, as it would stop a real campaign.
+/// Every step records the true TCP error at the working poses. `estimate`: the estimate of
 /// the state's last step, if any. Returns the final state and the last fit's estimate.
 pub fn measure_until_stopped(
     cell: &Cell,
@@ -77,15 +79,33 @@ pub fn measure_until_stopped(
             .zip(qs.iter().cloned())
             .collect();
         let blocked = unmeasurable_poses_at(cell, truth, &poses)?;
-        if !blocked.is_empty() {
+        let beam_only = |u: &Unmeasurable| {
+            u.violations.iter().all(|v| {
+                matches!(
+                    v.kind,
+                    ConstraintKind::Incidence | ConstraintKind::LineOfSight
+                )
+            })
+        };
+        if blocked.len() == poses.len() || !blocked.iter().all(beam_only) {
             let list: Vec<String> = blocked.iter().map(|u| format!("  {u}")).collect();
             return Err(Error::Input(format!(
-                "batch {k}: {} of {} poses cannot be measured on the virtual robot (its true geometry, the instrument where the simulation placed it):\n{}\nthe poses were planned too close to the limits: raise the cell's [design] incidence_margin_deg or line_of_sight_margin_mm",
+                "batch {k}: {} of {} poses cannot be measured on the virtual robot (its true geometry, the instrument where the simulation placed it){}:\n{}\nthe poses were planned too close to the limits: raise the cell's [design] incidence_margin_deg, line_of_sight_margin_mm or clearance_mm",
                 blocked.len(),
                 poses.len(),
+                if blocked.len() == poses.len() { ", none of the batch" } else { ", some in collision" },
                 list.join("\n")
             )));
         }
+        let settings = StepSettings {
+            unmeasurable: blocked.into_iter().map(|u| u.id).collect(),
+            ..StepSettings::default()
+        };
+        let (qs, ids): (Vec<Vec<f64>>, Vec<String>) = qs
+            .into_iter()
+            .zip(state.next.iter().map(|p| p.id.clone()))
+            .filter(|(_, id)| !settings.unmeasurable.contains(id))
+            .unzip();
         let mut batch = crate::sim::simulate(
             model,
             truth,
@@ -93,9 +113,9 @@ pub fn measure_until_stopped(
             Some(&noise),
             seed.wrapping_mul(1000).wrapping_add(k),
         )?;
-        batch.config_ids = state.next.iter().map(|p| p.id.clone()).collect();
+        batch.config_ids = ids;
         batch.source = format!("simulation (seed {seed}, batch {k})");
-        let r = step(cell, &state, &batch, observer)?;
+        let r = step_with(cell, &state, &batch, &settings, observer)?;
         state = r.state;
         if let (Some(e), Some(last)) = (&r.estimate, state.steps.last_mut()) {
             let params = e.params_for(model)?;

@@ -143,6 +143,10 @@ pub struct CampaignStep {
     /// The batch's measurements, as read (internal units); every step's data together are
     /// what the campaign has measured.
     pub data: Dataset,
+    /// The poses of the batch the instrument could not measure (planned ids and joints;
+    /// [`super::StepSettings::unmeasurable`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub unmeasurable: Vec<CampaignPose>,
     /// Poses measured in all, this batch included.
     pub measured: usize,
     /// The fit on everything measured; `None` when it failed (`fit_error`).
