@@ -6,6 +6,7 @@ mod accuracy_cli;
 mod augment_cli;
 mod browser;
 mod campaign_cli;
+mod campaign_prediction_cli;
 mod check_cli;
 mod cli;
 mod collision_model_cli;
