@@ -3,7 +3,7 @@
 //! where a campaign stands, `simulate` runs the loop against a virtual robot, `study`
 //! compares it with one-shot and random designs over seeded runs.
 
-use super::output::{load_cell, load_data, with_note, NoteStyle, Outputs};
+use super::output::{load_cell, load_cell_to_measure, load_data, with_note, NoteStyle, Outputs};
 use super::progress::Progress;
 use anyhow::Context;
 use armcal::campaign::study::{coverage, coverage_with_floor, poses_summary, StudySettings};
@@ -223,7 +223,7 @@ fn run_start(a: &StartArgs) -> anyhow::Result<()> {
         &[Path::new(&a.target.cell)],
         &[&files.state, &files.next],
     )?;
-    let cell = load_cell(&a.target.cell)?;
+    let cell = load_cell_to_measure(&a.target.cell)?;
     let state = campaign::start(
         &cell,
         &a.target.source(),
@@ -471,7 +471,7 @@ fn run_simulate(a: &SimulateArgs) -> anyhow::Result<()> {
             a.instrument_offset_mm
         );
     }
-    let cell = load_cell(&a.target.cell)?;
+    let cell = load_cell_to_measure(&a.target.cell)?;
     let sim = campaign::simulate(
         &cell,
         &a.target.source(),

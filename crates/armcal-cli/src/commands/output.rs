@@ -167,6 +167,18 @@ pub fn load_cell(name_or_path: &str) -> anyhow::Result<armcal::cell::Cell> {
     Ok(cell)
 }
 
+/// Loads a cell whose poses a command checks for measurability (plan, evaluate, simulate,
+/// campaign) and notes on stderr when its line of sight and incidence go unchecked because
+/// the cell does not place its instrument
+/// ([`armcal::design::cell_constraints::unplaced_instrument`]).
+pub fn load_cell_to_measure(name_or_path: &str) -> anyhow::Result<armcal::cell::Cell> {
+    let cell = load_cell(name_or_path)?;
+    if let Some(note) = armcal::design::cell_constraints::unplaced_instrument(&cell) {
+        eprintln!("note: {note}");
+    }
+    Ok(cell)
+}
+
 /// Reads a data file for a cell (its `[data]` column mapping), with the reader's remarks
 /// ([`print_read_report`]) and a note when the cell's noise model does not use the σ columns.
 pub fn load_data(

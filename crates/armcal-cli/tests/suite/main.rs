@@ -21,6 +21,7 @@ mod nongeometric_cli;
 mod outputs_cli;
 mod pool_cli;
 mod readme;
+mod real_poses_measurable_cli;
 mod refit_cli;
 mod scale;
 mod units_signs_cli;
