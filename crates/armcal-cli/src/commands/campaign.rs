@@ -3,7 +3,7 @@
 //! where a campaign stands, `simulate` runs the loop against a virtual robot, `study`
 //! compares it with one-shot and random designs over seeded runs.
 
-use super::output::{load_cell, load_data, with_note, NoteStyle, Outputs};
+use super::output::{load_cell, load_cell_to_measure, load_data, with_note, NoteStyle, Outputs};
 use super::progress::Progress;
 use anyhow::Context;
 use armcal::campaign::study::{coverage, coverage_with_floor, poses_summary, StudySettings};
@@ -228,7 +228,7 @@ fn run_start(a: &StartArgs) -> anyhow::Result<()> {
         &[Path::new(&a.target.cell)],
         &[&files.state, &files.next],
     )?;
-    let cell = load_cell(&a.target.cell)?;
+    let cell = load_cell_to_measure(&a.target.cell)?;
     let state = campaign::start(
         &cell,
         &a.target.source(),
@@ -240,12 +240,11 @@ fn run_start(a: &StartArgs) -> anyhow::Result<()> {
         (&files.next, &next_csv(&cell, &state)),
     ])?;
     println!(
-        "campaign on `{}`: target TCP σ ≤ {} mm at {}; first batch: {} poses (the fewest that identify the free set), predicted σ {} mm",
+        "campaign on `{}`: target TCP σ ≤ {} mm at {}; {}",
         cell.name,
         state.settings.target_sigma_mm,
         state.working.join(", "),
-        state.first_batch,
-        mm_list(&state.first_predicted_sigma_mm)
+        first_batch(&state)
     );
     println!(
         "measure {} → then `armcal campaign step {} --data MEASURED.csv`",
@@ -253,6 +252,18 @@ fn run_start(a: &StartArgs) -> anyhow::Result<()> {
         a.out.display()
     );
     Ok(())
+}
+
+/// The first batch and the σ predicted once it is measured, with what the prediction
+/// depends on: the planner's seed (another seed plans another first batch, and a minimal
+/// batch's σ varies several-fold between seeds) and the model it is evaluated at.
+fn first_batch(state: &CampaignState) -> String {
+    format!(
+        "first batch: {} poses (the fewest that identify the free set; planner seed {}), predicted σ {} mm (at the nominal model, the stated instrument σ)",
+        state.first_batch,
+        state.settings.seed,
+        mm_list(&state.first_predicted_sigma_mm)
+    )
 }
 
 fn read_state(dir: &Path) -> anyhow::Result<CampaignState> {
@@ -477,7 +488,7 @@ fn run_simulate(a: &SimulateArgs) -> anyhow::Result<()> {
             a.instrument_offset_mm
         );
     }
-    let cell = load_cell(&a.target.cell)?;
+    let cell = load_cell_to_measure(&a.target.cell)?;
     let sim = campaign::simulate(
         &cell,
         &a.target.source(),
@@ -504,8 +515,11 @@ fn run_simulate(a: &SimulateArgs) -> anyhow::Result<()> {
     written.extend(estimate.as_deref().map(|e| (files.estimate.as_path(), e)));
     outputs.commit(&written)?;
     println!(
-        "simulated campaign on `{}` (virtual robot seed {}), target TCP σ ≤ {} mm",
-        cell.name, a.seed, a.target.target_sigma_mm
+        "simulated campaign on `{}` (virtual robot seed {}), target TCP σ ≤ {} mm; {}",
+        cell.name,
+        a.seed,
+        a.target.target_sigma_mm,
+        first_batch(&sim.state)
     );
     for (k, s) in sim.state.steps.iter().enumerate() {
         print_step(k + 1, s);

@@ -4,8 +4,7 @@
 
 use super::campaign::{print_last_step, step_files, Files};
 use super::output::{
-    load_cell, load_data, load_estimate, warn_outside_fitted_ranges, with_note, AcceptUnconverged,
-    NoteStyle, Outputs,
+    load_cell, load_data, warn_outside_fitted_ranges, with_note, Calibration, NoteStyle, Outputs,
 };
 use armcal::campaign::drift::{check, CheckSettings, DriftVerdict};
 use armcal::campaign::prior::CampaignPrior;
@@ -21,9 +20,8 @@ pub struct Args {
     /// Cell file or built-in robot.
     #[arg(long)]
     pub cell: String,
-    /// The calibration (estimate.json).
-    #[arg(long)]
-    pub estimate: PathBuf,
+    #[command(flatten)]
+    pub calibration: Calibration,
     /// The check measurements: a data file of the cell, measured after the calibration.
     #[arg(long)]
     pub data: PathBuf,
@@ -36,8 +34,6 @@ pub struct Args {
     /// Overwrite an existing output file (never an input file).
     #[arg(long)]
     pub force: bool,
-    #[command(flatten)]
-    pub accept: AcceptUnconverged,
     /// When the check says "drifted", start a re-identification campaign in DIR: the old
     /// estimate is the prior, the groups that moved are released from it, and the check
     /// poses are its first step (writes DIR/campaign.json, DIR/next.csv,
@@ -67,11 +63,11 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     }
     let outputs = Outputs::plan(
         a.force,
-        &[Path::new(&a.cell), &a.estimate, &a.data],
+        &[Path::new(&a.cell), &a.calibration.estimate, &a.data],
         &planned,
     )?;
     let cell = load_cell(&a.cell)?;
-    let (est, note) = load_estimate(&a.estimate, &a.accept, Some(&cell.model))?;
+    let (est, note) = a.calibration.load(Some(&cell.model))?;
     let data = load_data(&cell, &a.data)?;
     let poses: Vec<(String, Vec<f64>)> = data
         .config_ids
@@ -92,7 +88,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
             } else {
                 a.release.clone()
             };
-            let source = a.estimate.display().to_string();
+            let source = a.calibration.estimate.display().to_string();
             let settings = CampaignSettings {
                 target_sigma_mm: target,
                 batch: a.batch,
@@ -121,7 +117,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         "check of {} poses ({} residual components) against {}",
         c.poses,
         c.dof,
-        a.estimate.display()
+        a.calibration.estimate.display()
     );
     println!(
         "  χ² = {:.2} with {} dof, p = {} (α = {}): {}",
@@ -156,7 +152,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         (Some((state, release)), Some(f)) => {
             println!(
                 "campaign from {} (prior: its estimate and covariance; released: {}), the check poses its first step:",
-                a.estimate.display(),
+                a.calibration.estimate.display(),
                 release.join(", ")
             );
             print_last_step(state, f);

@@ -3,8 +3,7 @@
 //! (book §5.4).
 
 use super::output::{
-    load_cell, load_data, load_estimate, warn_outside_fitted_ranges, with_note, AcceptUnconverged,
-    NoteStyle, Outputs,
+    load_cell, load_data, warn_outside_fitted_ranges, with_note, Calibration, NoteStyle, Outputs,
 };
 use armcal::compensate::joint_change::JointChangeLimit;
 use armcal::compensate::nonparametric::{CorrectionInputs, ResidualCorrection};
@@ -17,9 +16,8 @@ pub struct Args {
     /// Cell file or built-in robot.
     #[arg(long)]
     pub cell: String,
-    /// Identified parameters (estimate.json).
-    #[arg(long)]
-    pub estimate: PathBuf,
+    #[command(flatten)]
+    pub calibration: Calibration,
     /// Targets (CSV). Joint columns only: a nominal joint program, corrected so that the real
     /// robot reaches what the nominal model meant. With `x_mm … yaw_deg` too: Cartesian tool
     /// targets (world frame), corrected for a controller that keeps its nominal model; the
@@ -63,8 +61,6 @@ pub struct Args {
     /// error), `joints` (all joints) or `position` (TCP position, world frame).
     #[arg(long, default_value = "arm-joints", value_parser = ["arm-joints", "joints", "position"], requires = "nonparametric")]
     pub nonparametric_inputs: String,
-    #[command(flatten)]
-    pub accept: AcceptUnconverged,
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
@@ -76,12 +72,12 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
             anyhow::bail!("{flag} {v}: the joint-change limit must be a positive number");
         }
     }
-    let mut inputs = vec![Path::new(&a.cell), &a.estimate, &a.targets];
+    let mut inputs = vec![Path::new(&a.cell), &a.calibration.estimate, &a.targets];
     inputs.extend(a.nonparametric.as_deref());
     let outputs = Outputs::plan(a.force, &inputs, &[&a.out])?;
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
-    let (est, note) = load_estimate(&a.estimate, &a.accept, Some(model))?;
+    let (est, note) = a.calibration.load(Some(model))?;
     let calibrated = est.params_for(model)?;
     let (payload, payload_how) = est.payload_for(model, a.payload.as_deref())?;
     let program = ProgramFile::read(

@@ -1,15 +1,14 @@
 //! `armcal export`: the calibrated model as a cell file (DH, modified-DH or zero-reference
 //! links), a parameter table, JSON or URDF.
 
-use super::output::{load_estimate, with_note, AcceptUnconverged, NoteStyle, Outputs};
+use super::output::{with_note, Calibration, NoteStyle, Outputs};
 use armcal::cell::export::{export_model, ExportFormat};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Identified parameters (estimate.json).
-    #[arg(long)]
-    pub estimate: PathBuf,
+    #[command(flatten)]
+    pub calibration: Calibration,
     /// Output format.
     #[arg(long, value_parser = ["dh", "mdh", "zrp", "json", "urdf", "cell"])]
     pub format: String,
@@ -25,8 +24,6 @@ pub struct Args {
     /// Overwrite existing output files (never an input file).
     #[arg(long)]
     pub force: bool,
-    #[command(flatten)]
-    pub accept: AcceptUnconverged,
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
@@ -36,7 +33,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     if matches!(format, ExportFormat::Cell(_)) {
         outs.push(&table);
     }
-    let mut inputs = vec![a.estimate.as_path()];
+    let mut inputs = vec![a.calibration.estimate.as_path()];
     inputs.extend(a.cell.as_deref().map(Path::new));
     let outputs = Outputs::plan(a.force, &inputs, &outs)?;
     let cell = a
@@ -44,7 +41,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         .as_deref()
         .map(super::output::load_cell)
         .transpose()?;
-    let (est, note) = load_estimate(&a.estimate, &a.accept, cell.as_ref().map(|c| &c.model))?;
+    let (est, note) = a.calibration.load(cell.as_ref().map(|c| &c.model))?;
     let note = note.as_deref();
     let exported = export_model(&est.model, cell.as_ref(), format)?;
     for w in &exported.warnings {

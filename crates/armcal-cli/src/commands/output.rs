@@ -167,6 +167,18 @@ pub fn load_cell(name_or_path: &str) -> anyhow::Result<armcal::cell::Cell> {
     Ok(cell)
 }
 
+/// Loads a cell whose poses a command checks for measurability (plan, evaluate, simulate,
+/// campaign) and notes on stderr when its line of sight and incidence go unchecked because
+/// the cell does not place its instrument
+/// ([`armcal::design::cell_constraints::unplaced_instrument`]).
+pub fn load_cell_to_measure(name_or_path: &str) -> anyhow::Result<armcal::cell::Cell> {
+    let cell = load_cell(name_or_path)?;
+    if let Some(note) = armcal::design::cell_constraints::unplaced_instrument(&cell) {
+        eprintln!("note: {note}");
+    }
+    Ok(cell)
+}
+
 /// Reads a data file for a cell (its `[data]` column mapping), with the reader's remarks
 /// ([`print_read_report`]) and a note when the cell's noise model does not use the σ columns.
 pub fn load_data(
@@ -286,39 +298,72 @@ pub fn load_estimate(
 /// model has no payloads and none was asked for, the sentence saying how.
 pub type PayloadChoice = (Option<usize>, Option<String>);
 
-/// What [`load_params_at_payload`] returns: the parameters, the note every output made with
-/// them carries, the payload choice and the estimate they came from (`None`: nominal).
+/// What [`CalibrationOrNominal::load_at_payload`] returns: the parameters, the note every
+/// output made with them carries, the payload choice and the estimate they came from
+/// (`None`: nominal).
 pub type ParamsAtPayload = (Vec<f64>, Option<String>, PayloadChoice, Option<Estimate>);
 
-/// The parameters of the estimate at `path` for `model` ([`load_estimate`]), or the nominal
-/// ones without an estimate, with the line every output made with them must carry, and the
-/// payload the robot carries: `name` checked against the
-/// estimate ([`armcal::identify::Estimate::payload_for`]) — the payload index and the
-/// sentence saying how it is predicted (`None` for a model without payloads and no
-/// `--payload`). Without an estimate, the nominal model at payload `name`.
-pub fn load_params_at_payload(
-    path: Option<&Path>,
-    accept: &AcceptUnconverged,
-    model: &armcal::model::Model,
-    name: Option<&str>,
-) -> anyhow::Result<ParamsAtPayload> {
-    let quiet = name.is_none() && model.payloads.is_empty();
-    match path {
-        Some(p) => {
-            let (est, note) = load_estimate(p, accept, Some(model))?;
-            let (payload, how) = est.payload_for(model, name)?;
-            Ok((
-                est.params_for(model)?,
-                note,
-                (payload, (!quiet).then_some(how)),
-                Some(est),
-            ))
-        }
-        None => {
-            let payload = model
-                .payload_index(name.unwrap_or("none"))
-                .map_err(|e| anyhow::anyhow!("--payload: {e}"))?;
-            Ok((model.nominal(), None, (payload, None), None))
+/// `--estimate` (required) and `--accept-unconverged`: the calibration a command applies.
+#[derive(clap::Args)]
+pub struct Calibration {
+    /// Identified parameters (estimate.json).
+    #[arg(long)]
+    pub estimate: PathBuf,
+    #[command(flatten)]
+    pub accept: AcceptUnconverged,
+}
+
+impl Calibration {
+    /// The estimate, checked against `model` ([`load_estimate`]), with the line every output
+    /// made with it must carry.
+    pub fn load(
+        &self,
+        model: Option<&armcal::model::Model>,
+    ) -> anyhow::Result<(Estimate, Option<String>)> {
+        load_estimate(&self.estimate, &self.accept, model)
+    }
+}
+
+/// `--estimate` (optional: the nominal model without it) and `--accept-unconverged`.
+#[derive(clap::Args)]
+pub struct CalibrationOrNominal {
+    /// Identified parameters (estimate.json); nominal if absent.
+    #[arg(long)]
+    pub estimate: Option<PathBuf>,
+    #[command(flatten)]
+    pub accept: AcceptUnconverged,
+}
+
+impl CalibrationOrNominal {
+    /// The parameters of the estimate for `model` ([`load_estimate`]), or the nominal ones
+    /// without an estimate, with the line every output made with them must carry, and the
+    /// payload the robot carries: `name` checked against the estimate
+    /// ([`armcal::identify::Estimate::payload_for`]) — the payload index and the sentence
+    /// saying how it is predicted (`None` for a model without payloads and no `--payload`).
+    /// Without an estimate, the nominal model at payload `name`.
+    pub fn load_at_payload(
+        &self,
+        model: &armcal::model::Model,
+        name: Option<&str>,
+    ) -> anyhow::Result<ParamsAtPayload> {
+        let quiet = name.is_none() && model.payloads.is_empty();
+        match &self.estimate {
+            Some(p) => {
+                let (est, note) = load_estimate(p, &self.accept, Some(model))?;
+                let (payload, how) = est.payload_for(model, name)?;
+                Ok((
+                    est.params_for(model)?,
+                    note,
+                    (payload, (!quiet).then_some(how)),
+                    Some(est),
+                ))
+            }
+            None => {
+                let payload = model
+                    .payload_index(name.unwrap_or("none"))
+                    .map_err(|e| anyhow::anyhow!("--payload: {e}"))?;
+                Ok((model.nominal(), None, (payload, None), None))
+            }
         }
     }
 }

@@ -1,8 +1,7 @@
 //! `armcal pivot`: TCP (tool-tip) calibration from poses touching one fixed point.
 
 use super::output::{
-    load_cell, load_params_at_payload, warn_outside_fitted_ranges, with_note, AcceptUnconverged,
-    NoteStyle, Outputs,
+    load_cell, warn_outside_fitted_ranges, with_note, CalibrationOrNominal, NoteStyle, Outputs,
 };
 use armcal::identify::pivot::{pivot_calibration, PivotSettings};
 use armcal::measure::csv;
@@ -17,10 +16,8 @@ pub struct Args {
     /// tilted about at least two different axes.
     #[arg(long)]
     pub poses: PathBuf,
-    /// The calibrated robot (estimate.json) to take the flange poses from; default the
-    /// nominal model.
-    #[arg(long)]
-    pub estimate: Option<PathBuf>,
+    #[command(flatten)]
+    pub calibration: CalibrationOrNominal,
     /// Largest accepted condition number of the pivot design matrix [R_i −I] (unit-free).
     #[arg(long, default_value_t = PivotSettings::default().max_condition)]
     pub max_condition: f64,
@@ -30,18 +27,15 @@ pub struct Args {
     /// Overwrite existing output files.
     #[arg(long)]
     pub force: bool,
-    #[command(flatten)]
-    pub accept: AcceptUnconverged,
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let mut inputs = vec![Path::new(&a.cell), a.poses.as_path()];
-    inputs.extend(a.estimate.as_deref());
+    inputs.extend(a.calibration.estimate.as_deref());
     let outputs = Outputs::plan(a.force, &inputs, &[a.out.as_path()])?;
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
-    let (params, note, _, est) =
-        load_params_at_payload(a.estimate.as_deref(), &a.accept, model, None)?;
+    let (params, note, _, est) = a.calibration.load_at_payload(model, None)?;
     let configurations = csv::read_configurations(&a.poses, model, None)?;
     if let Some(est) = &est {
         warn_outside_fitted_ranges(est, model, &configurations);

@@ -2,7 +2,7 @@
 //! (including a hand-made one) gives.
 
 use super::digits::decimals_or_digits;
-use super::output::{load_cell, Outputs};
+use super::output::{load_cell_to_measure, Outputs};
 use super::progress::Progress;
 use anyhow::bail;
 use armcal::design::assess::{evaluate_design, PathPrecision};
@@ -92,7 +92,7 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
     inputs.extend(a.measured.as_deref());
     inputs.extend(a.pool.as_deref());
     let outputs = Outputs::plan(a.force, &inputs, &[&a.out, &report_path])?;
-    let cell = load_cell(&a.cell)?;
+    let cell = load_cell_to_measure(&a.cell)?;
     let (measured_ids, measured): (Vec<String>, Vec<Vec<f64>>) = match &a.measured {
         Some(p) => csv::read_configurations_with(p, &cell.model, &cell.data_format())?
             .into_iter()
@@ -338,7 +338,7 @@ fn print_pool(pool: &PoolReport) {
 }
 
 pub fn run_evaluate(a: &EvaluateArgs) -> anyhow::Result<()> {
-    let cell = load_cell(&a.cell)?;
+    let cell = load_cell_to_measure(&a.cell)?;
     let design: Vec<Vec<f64>> = csv::read_configurations(Path::new(&a.design), &cell.model, None)?
         .into_iter()
         .map(|(_, q)| q)

@@ -1,8 +1,7 @@
 //! `armcal predict`: what the (nominal or identified) model says the instrument measures.
 
 use super::output::{
-    load_cell, load_params_at_payload, warn_outside_fitted_ranges, with_note, AcceptUnconverged,
-    NoteStyle, Outputs,
+    load_cell, warn_outside_fitted_ranges, with_note, CalibrationOrNominal, NoteStyle, Outputs,
 };
 use armcal::measure::csv;
 use armcal::sim::predict;
@@ -13,9 +12,8 @@ pub struct Args {
     /// Cell file or built-in robot.
     #[arg(long)]
     pub cell: String,
-    /// Identified parameters (estimate.json); nominal if absent.
-    #[arg(long)]
-    pub estimate: Option<PathBuf>,
+    #[command(flatten)]
+    pub calibration: CalibrationOrNominal,
     /// Joint configurations (CSV).
     #[arg(long)]
     pub joints: PathBuf,
@@ -30,22 +28,16 @@ pub struct Args {
     /// Overwrite existing output files (never an input file).
     #[arg(long)]
     pub force: bool,
-    #[command(flatten)]
-    pub accept: AcceptUnconverged,
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let mut inputs = vec![Path::new(&a.cell), &a.joints];
-    inputs.extend(a.estimate.as_deref());
+    inputs.extend(a.calibration.estimate.as_deref());
     let outputs = Outputs::plan(a.force, &inputs, &[&a.out])?;
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
-    let (params, note, payload, est) = load_params_at_payload(
-        a.estimate.as_deref(),
-        &a.accept,
-        model,
-        a.payload.as_deref(),
-    )?;
+    let (params, note, payload, est) =
+        a.calibration.load_at_payload(model, a.payload.as_deref())?;
     let poses = csv::read_configurations_with(&a.joints, model, &cell.data_format())?;
     if let Some(est) = &est {
         warn_outside_fitted_ranges(est, model, &poses);
@@ -63,7 +55,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         "predicted {} measurements at {} configurations with the {} model → {}",
         data.measurements.len(),
         poses.len(),
-        if a.estimate.is_some() {
+        if a.calibration.estimate.is_some() {
             "identified"
         } else {
             "nominal"

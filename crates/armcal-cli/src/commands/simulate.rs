@@ -1,6 +1,6 @@
 //! `armcal simulate`: measure joint configurations on a perturbed virtual robot.
 
-use super::output::{load_cell, Outputs};
+use super::output::{load_cell_to_measure, Outputs};
 use anyhow::bail;
 use armcal::design::cell_constraints::unmeasurable_poses;
 use armcal::measure::csv;
@@ -83,7 +83,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
             bail!("{flag} {v}: give a magnitude ≥ 0");
         }
     }
-    let cell = load_cell(&a.cell)?;
+    let cell = load_cell_to_measure(&a.cell)?;
     let model = &cell.model;
     let payload = model
         .payload_index(a.payload.as_deref().unwrap_or("none"))

@@ -2,17 +2,14 @@
 //! robot whose tracker moved 5 mm are "drifted" with the tracker first; the record is
 //! written; a bad check file is refused with its file and line.
 
-use crate::common::{armcal, identify_paper_cell, scratch, simulate_paper_cell};
+use crate::common::{armcal, paper_estimate, scratch};
 
 #[test]
 fn check_prints_its_verdict_writes_its_record_and_refuses_a_bad_file() {
     let dir = scratch("check-cli");
     let p = |n: &str| dir.join(n).to_str().unwrap().to_string();
-    let (data, est, record) = (p("data.csv"), p("estimate.json"), p("check.json"));
-    let (ok, _, err) = armcal(&simulate_paper_cell("3", &data));
-    assert!(ok, "{err}");
-    let (ok, _, err) = armcal(&identify_paper_cell(&data, &[], &est));
-    assert!(ok, "{err}");
+    let (_, est) = paper_estimate();
+    let record = p("check.json");
     // Check poses: 10 new KPI poses, measured on the same robot (seed-3 truth).
     let (check_data, poses) = (p("check.csv"), p("check-poses.csv"));
     let (ok, _, err) = armcal(&[
@@ -46,7 +43,7 @@ fn check_prints_its_verdict_writes_its_record_and_refuses_a_bad_file() {
             "--cell",
             "examples/paper-cell.toml",
             "--estimate",
-            &est,
+            est,
             "--data",
             data,
             "--out",

@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::sync::OnceLock;
 
 /// Runs `armcal` with `args`; returns (success, stdout, stderr).
 pub fn armcal(args: &[&str]) -> (bool, String, String) {
@@ -44,14 +45,54 @@ pub fn simulate_paper_cell<'a>(seed: &'a str, out: &'a str) -> [&'a str; 9] {
 
 /// `armcal identify` of the paper cell from `data` with the `options`, written to `out`.
 pub fn identify_paper_cell<'a>(data: &'a str, options: &[&'a str], out: &'a str) -> Vec<&'a str> {
-    let mut args = vec![
-        "identify",
-        "--cell",
-        "examples/paper-cell.toml",
-        "--data",
-        data,
-    ];
+    identify_cell("examples/paper-cell.toml", data, options, out)
+}
+
+/// `armcal identify` of `cell` from `data` with the `options`, written to `out`.
+pub fn identify_cell<'a>(
+    cell: &'a str,
+    data: &'a str,
+    options: &[&'a str],
+    out: &'a str,
+) -> Vec<&'a str> {
+    let mut args = vec!["identify", "--cell", cell, "--data", data];
     args.extend_from_slice(options);
     args.extend(["--out", out]);
     args
+}
+
+/// The paper cell simulated at its 60 planned poses with seed 3 ([`simulate_paper_cell`])
+/// and the estimate `identify` fits to them at the defaults: (data, estimate) paths, made
+/// once per test run in the scratch directory `paper-seed-3`. Tests only read them.
+pub fn paper_estimate() -> &'static (String, String) {
+    static MADE: OnceLock<(String, String)> = OnceLock::new();
+    MADE.get_or_init(|| {
+        let dir = scratch("paper-seed-3");
+        let path = |f: &str| dir.join(f).to_str().unwrap().to_string();
+        let (data, est) = (path("data.csv"), path("estimate.json"));
+        let (ok, _, err) = armcal(&simulate_paper_cell("3", &data));
+        assert!(ok, "{err}");
+        let (ok, _, err) = armcal(&identify_paper_cell(&data, &[], &est));
+        assert!(ok, "{err}");
+        (data, est)
+    })
+}
+
+/// `examples/paper-cell.toml` without its zero incidence and line-of-sight margins (the
+/// defaults apply), written to `dir`.
+pub fn cell_with_default_margins(dir: &Path) -> PathBuf {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
+    let text = std::fs::read_to_string(Path::new(root).join("examples/paper-cell.toml")).unwrap();
+    let kept: Vec<&str> = text
+        .lines()
+        .filter(|l| *l != "incidence_margin_deg = 0" && *l != "line_of_sight_margin_mm = 0")
+        .collect();
+    assert_eq!(
+        kept.len() + 2,
+        text.lines().count(),
+        "the paper cell's margins"
+    );
+    let path = dir.join("real-cell.toml");
+    std::fs::write(&path, kept.join("\n") + "\n").unwrap();
+    path
 }

@@ -2,7 +2,7 @@
 //! targets, an estimate of another robot) and with the nonparametric correction.
 
 use crate::common;
-use common::{armcal, identify_paper_cell, scratch, simulate_paper_cell};
+use common::{armcal, paper_estimate, scratch};
 use std::path::Path;
 
 /// The data rows of `text` whose `pose_id` is `id`.
@@ -12,15 +12,29 @@ fn row<'a>(text: &'a str, id: &str) -> &'a str {
         .unwrap_or_else(|| panic!("no row {id} in\n{text}"))
 }
 
+/// `armcal compensate` of the paper cell with the shared estimate ([`paper_estimate`]):
+/// `targets` to `out` (overwritten) with the `extra` options.
+fn compensate(targets: &Path, out: &Path, extra: &[&str]) -> (bool, String, String) {
+    let mut args = vec![
+        "compensate",
+        "--cell",
+        "examples/paper-cell.toml",
+        "--estimate",
+        &paper_estimate().1,
+        "--targets",
+        targets.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--force",
+    ];
+    args.extend_from_slice(extra);
+    armcal(&args)
+}
+
 #[test]
 fn compensate_reports_bad_rows_and_applies_the_nonparametric_correction() {
     let dir = scratch("compensate-cli");
-    let s = |p: &Path| p.to_str().unwrap().to_string();
-    let (data, est) = (dir.join("data.csv"), dir.join("est.json"));
-    let (ok, _, err) = armcal(&simulate_paper_cell("3", &s(&data)));
-    assert!(ok, "{err}");
-    let (ok, _, err) = armcal(&identify_paper_cell(&s(&data), &[], &s(&est)));
-    assert!(ok, "{err}");
+    let (data, est) = paper_estimate();
 
     // A joint program: one good row, one with q5 = 100° beyond its 87° limit.
     let program = dir.join("program.csv");
@@ -32,23 +46,6 @@ fn compensate_reports_bad_rows_and_applies_the_nonparametric_correction() {
     )
     .unwrap();
     let out_file = dir.join("program-out.csv");
-    let compensate = |targets: &Path, out: &Path, extra: &[&str]| {
-        let mut args = vec![
-            "compensate".to_string(),
-            "--cell".into(),
-            "examples/paper-cell.toml".into(),
-            "--estimate".into(),
-            s(&est),
-            "--targets".into(),
-            s(targets),
-            "--out".into(),
-            s(out),
-            "--force".into(),
-        ];
-        args.extend(extra.iter().map(|a| a.to_string()));
-        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
-        armcal(&refs)
-    };
     let (ok, stdout, err) = compensate(&program, &out_file, &[]);
     assert!(ok, "{err}");
     assert!(stdout.contains("1 not converged"), "{stdout}");
@@ -90,11 +87,11 @@ fn compensate_reports_bad_rows_and_applies_the_nonparametric_correction() {
         "--cell",
         "examples/motoman-right-cell.toml",
         "--estimate",
-        &s(&est),
+        est,
         "--targets",
         "examples/paper-poses-random-60.csv",
         "--out",
-        &s(&dir.join("x.csv")),
+        dir.join("x.csv").to_str().unwrap(),
     ]);
     assert!(!ok && err.contains("does not belong to model"), "{err}");
 
@@ -103,7 +100,7 @@ fn compensate_reports_bad_rows_and_applies_the_nonparametric_correction() {
     let (ok, stdout, err) = compensate(
         &program,
         &out_file,
-        &["--nonparametric", &s(&data), "--degree", "2"],
+        &["--nonparametric", data, "--degree", "2"],
     );
     assert!(ok, "{err}");
     assert!(
@@ -134,12 +131,6 @@ fn compensate_reports_bad_rows_and_applies_the_nonparametric_correction() {
 #[test]
 fn compensation_never_whips_the_wrist() {
     let dir = scratch("compensate-whip");
-    let s = |p: &Path| p.to_str().unwrap().to_string();
-    let (data, est) = (dir.join("data.csv"), dir.join("est.json"));
-    let (ok, _, err) = armcal(&simulate_paper_cell("3", &s(&data)));
-    assert!(ok, "{err}");
-    let (ok, _, err) = armcal(&identify_paper_cell(&s(&data), &[], &s(&est)));
-    assert!(ok, "{err}");
     let path = [
         2.0, 1.0, 0.5, 0.2, 0.1, 0.0, -0.1, -0.2, -0.5, -1.0, -2.0, -5.0,
     ];
@@ -152,20 +143,7 @@ fn compensation_never_whips_the_wrist() {
     std::fs::write(&program_file, &program).unwrap();
     let out_file = dir.join("path-out.csv");
     let run = |extra: &[&str]| {
-        let mut args = vec![
-            "compensate",
-            "--cell",
-            "examples/paper-cell.toml",
-            "--estimate",
-            est.to_str().unwrap(),
-            "--targets",
-            program_file.to_str().unwrap(),
-            "--out",
-            out_file.to_str().unwrap(),
-            "--force",
-        ];
-        args.extend_from_slice(extra);
-        let (ok, stdout, err) = armcal(&args);
+        let (ok, stdout, err) = compensate(&program_file, &out_file, extra);
         assert!(ok, "{err}");
         (stdout, std::fs::read_to_string(&out_file).unwrap())
     };
@@ -275,23 +253,12 @@ fn compensation_never_whips_the_wrist() {
     }
 
     // A limit that is not a positive number is refused.
-    let (ok, _, err) = armcal(&[
-        "compensate",
-        "--cell",
-        "examples/paper-cell.toml",
-        "--estimate",
-        est.to_str().unwrap(),
-        "--targets",
-        program_file.to_str().unwrap(),
-        "--out",
-        dir.join("never.csv").to_str().unwrap(),
-        "--max-joint-change-deg",
-        "0",
-    ]);
+    let never = dir.join("never.csv");
+    let (ok, _, err) = compensate(&program_file, &never, &["--max-joint-change-deg", "0"]);
     assert!(
         !ok && err
             .contains("--max-joint-change-deg 0: the joint-change limit must be a positive number"),
         "{err}"
     );
-    assert!(!dir.join("never.csv").exists());
+    assert!(!never.exists());
 }

@@ -4,27 +4,7 @@
 //! (`evaluate --tracker-shift-mm 50`), where the paper's own zero-margin design loses most of
 //! its poses; and README's loop `campaign start → simulate → campaign step …` runs to its stop.
 
-use crate::common::{armcal, scratch};
-use std::path::{Path, PathBuf};
-
-/// `examples/paper-cell.toml` without its zero incidence and line-of-sight margins (the
-/// defaults apply), written to `dir`.
-fn cell_with_default_margins(dir: &Path) -> PathBuf {
-    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
-    let text = std::fs::read_to_string(Path::new(root).join("examples/paper-cell.toml")).unwrap();
-    let kept: Vec<&str> = text
-        .lines()
-        .filter(|l| *l != "incidence_margin_deg = 0" && *l != "line_of_sight_margin_mm = 0")
-        .collect();
-    assert_eq!(
-        kept.len() + 2,
-        text.lines().count(),
-        "the paper cell's margins"
-    );
-    let path = dir.join("real-cell.toml");
-    std::fs::write(&path, kept.join("\n") + "\n").unwrap();
-    path
-}
+use crate::common::{armcal, cell_with_default_margins, scratch};
 
 /// The count line of `evaluate --tracker-shift-mm`: (measurable, poses).
 fn measurable_count(stdout: &str) -> (usize, usize) {

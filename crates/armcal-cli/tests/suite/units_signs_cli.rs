@@ -7,7 +7,7 @@
 //! raise none of these warnings.
 
 use crate::common;
-use common::{armcal, identify_paper_cell, scratch, simulate_paper_cell};
+use common::{armcal, identify_cell, identify_paper_cell, scratch, simulate_paper_cell};
 use std::path::Path;
 
 fn s(p: &Path) -> String {
@@ -211,16 +211,7 @@ fn model_units_are_named_and_refused() {
     let good = dir.join("inline.toml");
     std::fs::write(&good, inline_cell("d_mm = -600")).unwrap();
     let est = dir.join("good.json");
-    let (ok, out, err) = armcal(&[
-        "identify",
-        "--cell",
-        &s(&good),
-        "--data",
-        &data,
-        "--quiet",
-        "--out",
-        &s(&est),
-    ]);
+    let (ok, out, err) = armcal(&identify_cell(&s(&good), &data, &["--quiet"], &s(&est)));
     assert!(ok, "{err}");
     assert!(
         ALARMS.iter().all(|a| !out.contains(a) && !err.contains(a)),
@@ -230,16 +221,7 @@ fn model_units_are_named_and_refused() {
     let dm = dir.join("dm.toml");
     std::fs::write(&dm, inline_cell("d_m = -600")).unwrap();
     let bad = dir.join("bad.json");
-    let (ok, _, err) = armcal(&[
-        "identify",
-        "--cell",
-        &s(&dm),
-        "--data",
-        &data,
-        "--quiet",
-        "--out",
-        &s(&bad),
-    ]);
+    let (ok, _, err) = armcal(&identify_cell(&s(&dm), &data, &["--quiet"], &s(&bad)));
     assert!(
         !ok && err.contains("`j4.d` was fitted to")
             && err.contains("millimetres written where metres are meant"),
@@ -276,16 +258,7 @@ fn model_units_are_named_and_refused() {
     std::fs::write(dir.join("mm.urdf"), scaled).unwrap();
     let cell = dir.join("urdf-mm.toml");
     std::fs::write(&cell, paper_cell_with("urdf = \"mm.urdf\"\n")).unwrap();
-    let (ok, _, err) = armcal(&[
-        "identify",
-        "--cell",
-        &s(&cell),
-        "--data",
-        &data,
-        "--quiet",
-        "--out",
-        &s(&bad),
-    ]);
+    let (ok, _, err) = armcal(&identify_cell(&s(&cell), &data, &["--quiet"], &s(&bad)));
     assert!(
         !ok && err
             .contains("the model's lengths are likely millimetres written where metres are meant")

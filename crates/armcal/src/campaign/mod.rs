@@ -164,7 +164,8 @@ fn check_settings(cell: &Cell, settings: &CampaignSettings) -> Result<(), Error>
 }
 
 /// `cell` with the instrument and target frames of its model at `params` (every parameter
-/// of the model, internal units), or `cell` itself without them. The links stay nominal:
+/// of the model, internal units), or `cell` itself without them; an instrument the fit
+/// estimated is placed there ([`crate::cell::Instrument::placed`]). The links stay nominal:
 /// the cell's capsules are drawn on the nominal links, and the estimate of a minimal set
 /// may move a frame whose effect another parameter absorbs (a link offset traded against
 /// the next link's), which would put the capsules where no link is.
@@ -173,13 +174,16 @@ fn cell_at<'a>(cell: &'a Cell, params: Option<&[f64]>) -> std::borrow::Cow<'a, C
         return std::borrow::Cow::Borrowed(cell);
     };
     let mut at = cell.clone();
+    let mut placed = false;
     for (i, &v) in params.iter().enumerate() {
-        if matches!(
-            at.model.registry.get(i).segment,
-            Segment::Instrument | Segment::Target(_)
-        ) {
+        let p = at.model.registry.get(i);
+        placed |= p.segment == Segment::Instrument && p.status.is_free();
+        if matches!(p.segment, Segment::Instrument | Segment::Target(_)) {
             at.model.registry.set_nominal(i, v);
         }
+    }
+    if let Some(instrument) = at.instrument.as_mut() {
+        instrument.placed |= placed;
     }
     std::borrow::Cow::Owned(at)
 }

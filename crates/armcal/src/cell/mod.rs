@@ -29,6 +29,17 @@ pub struct Instrument {
     /// Largest angle between the target's z axis and the beam to the instrument (rad;
     /// paper eq. 4), if the targets are reflectors with a limited acceptance angle.
     pub max_incidence: Option<f64>,
+    /// Whether the cell places the instrument (`[instrument] xyz_mm`). Without a position the
+    /// instrument stands where a fit will put it (its frame starts at the world origin, inside
+    /// the robot's base): the line of sight and the incidence cannot be evaluated, and
+    /// [`crate::design::cell_constraints::ConstraintSet`] leaves them out.
+    #[serde(default = "placed_by_default")]
+    pub placed: bool,
+}
+
+/// Records written before [`Instrument::placed`] existed evaluated every instrument as placed.
+fn placed_by_default() -> bool {
+    true
 }
 
 /// A configuration at which the robot works; the pose-design KPI is the TCP there.

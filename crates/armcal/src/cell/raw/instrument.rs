@@ -19,6 +19,7 @@ pub(super) fn instrument(
         Some(ri) => {
             let span = ri.span();
             let ri = ri.into_inner();
+            let placed = ri.xyz_mm.is_some() || ri.xyz_m.is_some();
             let xyz = match (ri.xyz_mm, ri.xyz_m) {
                 (Some(v), None) => v,
                 (None, Some(v)) => v.map(|x| x * 1000.0),
@@ -70,6 +71,7 @@ pub(super) fn instrument(
                     kind: ri.kind.unwrap_or_else(|| "laser-tracker".into()),
                     noise,
                     max_incidence: ri.max_incidence_deg.map(f64::to_radians),
+                    placed,
                 }),
                 Some(LinkGeometry::frame6(xyz, rpy)),
                 ri.name.unwrap_or_else(|| "tracker".into()),

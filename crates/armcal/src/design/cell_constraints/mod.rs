@@ -78,7 +78,10 @@
 //! constraint because the reflector sits 339 mm beyond it.
 //!
 //! Constraints that need the tracker (incidence, line of sight) are left out when the model
-//! has no instrument frame; incidence also needs `instrument.max_incidence` in the cell.
+//! has no instrument frame, or when the cell does not place it (no `[instrument] xyz_mm`:
+//! its frame stands at the world origin, inside the robot's base, until a fit places it, and
+//! every beam from there would be called blocked by the arm; [`unplaced_instrument`] says
+//! so); incidence also needs `instrument.max_incidence` in the cell.
 //!
 //! **Clearance and margins** (the cell's `[design]`, [`DesignClearance`]; `required.rs`). A
 //! set requires `g(q) ≥` [`ConstraintSettings::clearance`] of every robot and obstacle
@@ -430,7 +433,7 @@ impl ConstraintSet {
                 None if !model.targets.is_empty() => Reflector::Target(0),
                 None => Reflector::Tool,
             };
-        let has_tracker = model.instrument.is_some();
+        let has_tracker = model.instrument.is_some() && unplaced_instrument(cell).is_none();
         let max_incidence = cell.instrument.as_ref().and_then(|i| i.max_incidence);
 
         let mut items = Vec::new();
@@ -601,6 +604,17 @@ impl ConstraintSet {
     pub fn kind(&self, i: usize) -> ConstraintKind {
         self.items[i].kind()
     }
+}
+
+/// Why the cell's line of sight and incidence are not checked, if that is why: the cell has
+/// an instrument but does not place it (`[instrument] xyz_mm`; module documentation).
+pub fn unplaced_instrument(cell: &Cell) -> Option<String> {
+    cell.instrument.as_ref().filter(|i| !i.placed).map(|_| {
+        format!(
+            "cell `{}` does not place its instrument (no `[instrument] xyz_mm`): the line of sight and the incidence are not checked; give where the instrument stands, or place it where a calibration puts it (`armcal export --cell … --format cell`)",
+            cell.name
+        )
+    })
 }
 
 /// Robot capsules that carry the reflector (see the module documentation): at most one joint
