@@ -99,3 +99,36 @@ fn an_obstacle_over_the_tracker_gives_a_clear_report_and_the_best_design() {
     assert!(rep.blocking[0].1 > 0.99);
     assert!(rep.min_margin.unwrap().value < 0.0);
 }
+
+/// A design of the fewest poses that identify the free set (a campaign's first batch, 9
+/// poses for the paper cell's 27 parameters) does not depend on the seed's luck: with the
+/// default 2 starts, seeds 1, 5 and 7 kept an exchange design of KPI 48–109 mm² (TCP σ
+/// 7–10 mm) whose refinement was rejected, where the other seeds refined to 2.4–2.8 mm²;
+/// when no start's refinement is accepted the planner now runs more starts, and every seed
+/// of 1–8 lands within a factor 1.5 of the best.
+#[test]
+fn a_minimal_design_does_not_depend_on_the_seeds_luck() {
+    let c = crate::common::paper_cell_with_default_margins();
+    let values: Vec<f64> = (1..=8u64)
+        .map(|seed| {
+            let r = plan(
+                &c,
+                &PlanSettings {
+                    poses: 9,
+                    seed,
+                    ..PlanSettings::default()
+                },
+                &[],
+                &mut Silent,
+            )
+            .unwrap();
+            assert!(r.feasible, "seed {seed}");
+            r.value
+        })
+        .collect();
+    let best = values.iter().copied().fold(f64::INFINITY, f64::min);
+    assert!(
+        values.iter().all(|&v| v <= 1.5 * best),
+        "KPI per seed 1–8: {values:?}"
+    );
+}
