@@ -19,6 +19,7 @@ mod measurable_cli;
 mod nongeometric_cli;
 mod outputs_cli;
 mod pool_cli;
+mod predict_sigma_cli;
 mod readme;
 mod refit_cli;
 mod scale;
