@@ -162,7 +162,10 @@ fn compensate_export_and_accuracy() {
         "position",
     ]);
     assert!(ok, "{err}");
-    assert!(out.contains("identifiable: 27 parameters"), "{out}");
+    assert!(
+        out.contains("identifiable: 27 geometric parameters at these random"),
+        "{out}"
+    );
     let (ok, out, err) = armcal(&[
         "accuracy",
         "--cell",

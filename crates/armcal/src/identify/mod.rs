@@ -391,11 +391,9 @@ fn estimate_of_fit(
         .count();
     // the generic count is of geometric parameters: the non-geometric terms (compliance,
     // periodic errors) are counted apart
-    let geometric = problem
-        .free
-        .iter()
-        .filter(|&&i| !model.is_joint_correction(i))
-        .count();
+    let geometric =
+        crate::model::identifiability::IdentifiableCount::of(model, problem.free.iter().copied())
+            .geometric;
     let rank_deficit = if let Some(refit) = &opts.refit {
         refit::deficit(cell, refit, names.len(), kept)
     } else if cell.auto_free {
