@@ -13,6 +13,7 @@ mod compensate_cli;
 mod error_causes;
 mod estimate_checks;
 mod fitted_ranges_cli;
+mod fixed_priors_export_cli;
 mod identifiable_count_cli;
 mod import_cli;
 mod margins_cli;

@@ -4,7 +4,7 @@
 //! the floor `identify` states at the working pose (Monte-Carlo-checked in the library's
 //! `identify/model_floor.rs`).
 
-use crate::common::{armcal, scratch};
+use crate::common::{armcal, scratch, simulate_and_identify_variant};
 use armcal::cell::Cell;
 use armcal::identify::Estimate;
 use armcal::model::{forward_kinematics, observed_position, Data, Model, Observed};
@@ -85,25 +85,7 @@ fn predict_states_each_rows_sigma_as_monte_carlo_and_identify_give_it() {
             "joints_deg = [0, -30, 30, 0, -90, 0]",
             "joints_deg = [0, -30, 30, 0, -80, 0]",
         );
-    let cell_path = path("cell.toml");
-    std::fs::write(&cell_path, &text).unwrap();
-    let (data, est) = (path("data.csv"), path("estimate.json"));
-    let (ok, _, err) = armcal(&[
-        "simulate",
-        "--cell",
-        &cell_path,
-        "--poses",
-        "examples/paper-poses-planned-60.csv",
-        "--seed",
-        "5",
-        "--out",
-        &data,
-    ]);
-    assert!(ok, "{err}");
-    let (ok, _, err) = armcal(&[
-        "identify", "--cell", &cell_path, "--data", &data, "--out", &est,
-    ]);
-    assert!(ok, "{err}");
+    let [cell_path, _, est] = simulate_and_identify_variant(&dir, &text, "5", false);
     let joints = path("joints.csv");
     std::fs::write(
         &joints,
