@@ -20,6 +20,8 @@ mod margins_cli;
 mod measurable_cli;
 mod nongeometric_cli;
 mod outputs_cli;
+mod perturb_fixed_cli;
+mod pivot_cli;
 mod pool_cli;
 mod predict_sigma_cli;
 mod readme;
