@@ -16,6 +16,7 @@ mod fitted_ranges_cli;
 mod fixed_priors_export_cli;
 mod identifiable_count_cli;
 mod import_cli;
+mod instrument_offset_cli;
 mod margins_cli;
 mod measurable_cli;
 mod nongeometric_cli;
