@@ -235,6 +235,81 @@ fn urdf_bodies(q: &[f64]) -> Vec<(Box<dyn Shape>, Pose)> {
     bodies
 }
 
+/// The DH arm's skeleton as the planner derives it (`robots/skeleton.rs`): the segment
+/// O_{k−1} O_k from joint k's point to the next on the frame of joint k (`jk`), a segment
+/// shorter than 1 µm left out (the spherical wrist's O₄ O₅), each a capsule of the cell's
+/// radius. The tool frame is the flange: no tool segment.
+fn dh_skeleton(q: &[f64]) -> Vec<(String, Vector3<f64>, Vector3<f64>)> {
+    let o = dh_origins(q);
+    (1..o.len())
+        .filter(|&k| (o[k] - o[k - 1]).norm() > 1e-3)
+        .map(|k| (format!("j{k}"), o[k - 1], o[k]))
+        .collect()
+}
+
+/// The capsule pairs `plan` names as in contact everywhere (and so does not check), as
+/// frame names: from `not checked, in contact … : capsule j2#0 / j4#0, …`.
+fn pairs_in_contact(plan_stdout: &str) -> Vec<(String, String)> {
+    let frame = |s: &str| {
+        s.trim()
+            .trim_start_matches("capsule ")
+            .split('#')
+            .next()
+            .unwrap()
+            .to_string()
+    };
+    plan_stdout
+        .lines()
+        .find(|l| l.starts_with("not checked, in contact"))
+        .map(|l| {
+            l.split_once("): ")
+                .unwrap()
+                .1
+                .split(", ")
+                .map(|p| {
+                    let (a, b) = p.split_once(" / ").unwrap();
+                    (frame(a), frame(b))
+                })
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// The arm's least self clearance at `q` by parry: over the skeleton's capsule pairs the
+/// planner checks (paper eq. 24b, `design/cell_constraints`): not neighbours in chain order
+/// among the capsule-carrying frames (`skeleton` lists them in that order, one per frame),
+/// and not a pair `plan` names as in contact everywhere (`skip`). Negative: an overlap.
+fn self_clearance(
+    skeleton: &[(String, Vector3<f64>, Vector3<f64>)],
+    skip: &[(String, String)],
+) -> f64 {
+    let mut least = f64::INFINITY;
+    for i in 0..skeleton.len() {
+        for j in i + 2..skeleton.len() {
+            let (a, b) = (&skeleton[i], &skeleton[j]);
+            if skip
+                .iter()
+                .any(|(x, y)| (x == &a.0 && y == &b.0) || (x == &b.0 && y == &a.0))
+            {
+                continue;
+            }
+            let (ca, cb) = (capsule(&a.1, &a.2), capsule(&b.1, &b.2));
+            let d = query::distance(&Pose::identity(), &ca, &Pose::identity(), &cb)
+                .expect("capsules")
+                .distance;
+            let d = if d > 0.0 {
+                d
+            } else {
+                query::contact(&Pose::identity(), &ca, &Pose::identity(), &cb, 0.0)
+                    .expect("capsules")
+                    .map_or(0.0, |c| c.dist)
+            };
+            least = least.min(d);
+        }
+    }
+    least
+}
+
 /// Joint values (deg) of every pose of a design CSV.
 fn design(path: &std::path::Path) -> Vec<Vec<f64>> {
     std::fs::read_to_string(path)
@@ -308,6 +383,21 @@ fn a_users_dh_and_urdf_robots_plan_clear_of_a_table_and_the_floor() {
             "{name}: least clearance of 24 planned poses: table {:.2} mm, floor {:.2} mm",
             worst.0, worst.1
         );
+        // The arm's own self collision, for the DH arm whose skeleton the test derives
+        // itself (the URDF arm's cylinders are bounded by capsules the test does not
+        // rebuild): every planned pose keeps its capsules apart.
+        let skip = pairs_in_contact(&stdout);
+        if name == "dh" {
+            let least = poses
+                .iter()
+                .map(|q| self_clearance(&dh_skeleton(q), &skip))
+                .fold(f64::INFINITY, f64::min);
+            eprintln!("dh: least self clearance of 24 planned poses {least:.2} mm (pairs not checked: {skip:?})");
+            assert!(
+                least >= CLEARANCE,
+                "dh: a planned pose in self collision: {least:.2} mm"
+            );
+        }
         // The check has teeth: over a grid of the shoulder, elbow and wrist joints, a good
         // share of configurations put the arm into the table or the floor.
         let mut grid = Vec::new();
@@ -343,5 +433,18 @@ fn a_users_dh_and_urdf_robots_plan_clear_of_a_table_and_the_floor() {
             "{name}: only {hits} of {} grid configurations hit",
             grid.len()
         );
+        if name == "dh" {
+            // The self-collision check has teeth too: the elbow folds the forearm onto the
+            // base and upper arm.
+            let folded = grid
+                .iter()
+                .filter(|q| self_clearance(&dh_skeleton(&q[..]), &skip) < 0.0)
+                .count();
+            eprintln!(
+                "dh: {folded} of {} grid configurations in self collision",
+                grid.len()
+            );
+            assert!(folded > 0, "dh: no grid configuration in self collision");
+        }
     }
 }
