@@ -448,3 +448,42 @@ fn a_users_dh_and_urdf_robots_plan_clear_of_a_table_and_the_floor() {
         }
     }
 }
+
+#[test]
+fn an_arm_without_a_collision_model_is_planned_with_a_loud_warning() {
+    let dir = scratch("collision-model-none");
+    // The cell draws its arm with [[robot.capsules]], which replace the skeleton, but only
+    // a pedestal on the base: no capsule moves with a joint.
+    let cell = dh_cell()
+        .replace(&format!("link_radius_mm = {RADIUS}\n"), "")
+        .replace(
+            "\n[instrument]",
+            "\n[[robot.capsules]]\nframe = \"base\"\na_mm = [0, 0, 0]\nb_mm = [0, 0, 100]\nradius_mm = 50\n\n[instrument]",
+        );
+    assert!(cell.contains("[[robot.capsules]]") && !cell.contains("link_radius_mm"));
+    let cell_path = dir.join("bare.toml");
+    std::fs::write(&cell_path, cell).unwrap();
+    let out = dir.join("bare.csv");
+    let (ok, stdout, err) = armcal(&[
+        "plan",
+        "--cell",
+        cell_path.to_str().unwrap(),
+        "--poses",
+        "24",
+        "--starts",
+        "1",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("WARNING: the arm of `kr6-dh-table` has NO collision model (no capsule moves with a joint): self collision, the obstacles and the floor are NOT checked"),
+        "{err}"
+    );
+    assert!(
+        stdout.contains("every pose within them, but the arm's collisions are NOT checked")
+            && !stdout.contains("every pose feasible"),
+        "{stdout}"
+    );
+}
