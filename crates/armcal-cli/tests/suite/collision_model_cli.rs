@@ -326,7 +326,8 @@ fn design(path: &std::path::Path) -> Vec<Vec<f64>> {
         .collect()
 }
 
-fn plan(dir: &std::path::Path, cell: &str, name: &str) -> (String, Vec<Vec<f64>>) {
+/// `plan` of `cell` (written as `dir/name.toml`): stdout, stderr and the planned poses.
+fn plan(dir: &std::path::Path, cell: &str, name: &str) -> (String, String, Vec<Vec<f64>>) {
     let cell_path = dir.join(format!("{name}.toml"));
     std::fs::write(&cell_path, cell).unwrap();
     let out = dir.join(format!("{name}.csv"));
@@ -343,7 +344,7 @@ fn plan(dir: &std::path::Path, cell: &str, name: &str) -> (String, Vec<Vec<f64>>
         out.to_str().unwrap(),
     ]);
     assert!(ok, "plan of {name}:\n{stdout}\n{err}");
-    (stdout, design(&out))
+    (stdout, err, design(&out))
 }
 
 #[test]
@@ -362,7 +363,7 @@ fn a_users_dh_and_urdf_robots_plan_clear_of_a_table_and_the_floor() {
         ),
         ("urdf", urdf_cell, urdf_bodies),
     ] {
-        let (stdout, poses) = plan(&dir, &cell, name);
+        let (stdout, _, poses) = plan(&dir, &cell, name);
         assert!(stdout.contains("every pose feasible"), "{name}:\n{stdout}");
         assert!(
             stdout.contains("arm collision model: "),
@@ -461,22 +462,7 @@ fn an_arm_without_a_collision_model_is_planned_with_a_loud_warning() {
             "\n[[robot.capsules]]\nframe = \"base\"\na_mm = [0, 0, 0]\nb_mm = [0, 0, 100]\nradius_mm = 50\n\n[instrument]",
         );
     assert!(cell.contains("[[robot.capsules]]") && !cell.contains("link_radius_mm"));
-    let cell_path = dir.join("bare.toml");
-    std::fs::write(&cell_path, cell).unwrap();
-    let out = dir.join("bare.csv");
-    let (ok, stdout, err) = armcal(&[
-        "plan",
-        "--cell",
-        cell_path.to_str().unwrap(),
-        "--poses",
-        "24",
-        "--starts",
-        "1",
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
+    let (stdout, err, _) = plan(&dir, &cell, "bare");
     assert!(
         err.contains("WARNING: the arm of `kr6-dh-table` has NO collision model (no capsule moves with a joint): self collision, the obstacles and the floor are NOT checked"),
         "{err}"
