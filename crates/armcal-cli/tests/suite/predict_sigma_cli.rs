@@ -40,9 +40,9 @@ fn rms_sigma(points: &[Vector3<f64>]) -> f64 {
     (c.trace() / 3.0).sqrt()
 }
 
-/// The spread of the target's and the TCP's positions at `q` over `runs` parameter sets
-/// drawn from N(p̂, C_p) over the estimate's free parameters.
-fn monte_carlo(model: &Model, estimate: &Estimate, q: &[f64], runs: usize) -> (f64, f64) {
+/// `runs` parameter sets drawn from N(p̂, C_p) over the estimate's free parameters
+/// (seeded), the others at the estimate.
+fn parameter_draws(model: &Model, estimate: &Estimate, runs: usize) -> Vec<Vec<f64>> {
     let params = estimate.params_for(model).unwrap();
     let free: Vec<usize> = estimate
         .free
@@ -57,15 +57,26 @@ fn monte_carlo(model: &Model, estimate: &Estimate, q: &[f64], runs: usize) -> (f
         .unwrap()
         .l();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(17);
+    (0..runs)
+        .map(|_| {
+            let z: DVector<f64> =
+                DVector::from_fn(free.len(), |_, _| StandardNormal.sample(&mut rng));
+            let dp = &l * z;
+            let mut p = params.clone();
+            for (c, &i) in free.iter().enumerate() {
+                p[i] += dp[c];
+            }
+            p
+        })
+        .collect()
+}
+
+/// The spread of the target's and the TCP's positions at `q` over `runs` parameter sets
+/// drawn from C_p ([`parameter_draws`]).
+fn monte_carlo(model: &Model, estimate: &Estimate, q: &[f64], runs: usize) -> (f64, f64) {
     let mut data = Data::new(model);
     let (mut target, mut tcp) = (Vec::new(), Vec::new());
-    for _ in 0..runs {
-        let z: DVector<f64> = DVector::from_fn(free.len(), |_, _| StandardNormal.sample(&mut rng));
-        let dp = &l * z;
-        let mut p = params.clone();
-        for (c, &i) in free.iter().enumerate() {
-            p[i] += dp[c];
-        }
+    for p in parameter_draws(model, estimate, runs) {
         forward_kinematics(model, &mut data, &p, q);
         target.push(observed_position(&data, Observed::Target(0)));
         tcp.push(observed_position(&data, Observed::Tool));
@@ -168,4 +179,82 @@ fn predict_states_each_rows_sigma_as_monte_carlo_and_identify_give_it() {
         "{:?}",
         report.ignored
     );
+}
+
+#[test]
+fn predict_states_the_orientation_sigma_of_a_full_pose_cell() {
+    let dir = scratch("predict_sigma_pose");
+    let path = |f: &str| dir.join(f).to_str().unwrap().to_string();
+    let cell_path = "examples/ur10-leica-cell.toml";
+    let data = "data/ipa-ur10-leica/Series_B/measurements_joint_configurations.csv";
+    let (est, out) = (path("estimate.json"), path("predicted.csv"));
+    let (ok, _, err) = armcal(&[
+        "identify",
+        "--cell",
+        cell_path,
+        "--data",
+        data,
+        "--holdout",
+        "0.3",
+        "--seed",
+        "1",
+        "--out",
+        &est,
+    ]);
+    assert!(ok, "{err}");
+    // The data file's own configurations, read with the cell's data columns.
+    let (ok, _, err) = armcal(&[
+        "predict",
+        "--cell",
+        cell_path,
+        "--estimate",
+        &est,
+        "--joints",
+        data,
+        "--out",
+        &out,
+    ]);
+    assert!(ok, "{err}");
+    let table = rows(&std::fs::read_to_string(&out).unwrap());
+    let text = std::fs::read_to_string(format!("../../{cell_path}")).unwrap();
+    let cell = Cell::from_toml(&text, "ur10", std::path::Path::new("../../examples")).unwrap();
+    let model = &cell.model;
+    let estimate: Estimate = serde_json::from_str(&std::fs::read_to_string(&est).unwrap()).unwrap();
+    let params = estimate.params_for(model).unwrap();
+    let draws = parameter_draws(model, &estimate, 4000);
+    for row in [0, table.len() / 2] {
+        let q: Vec<f64> = model
+            .joints
+            .iter()
+            .map(|j| {
+                table[row][&format!("{}_deg", j.name)]
+                    .parse::<f64>()
+                    .unwrap()
+                    .to_radians()
+            })
+            .collect();
+        let mut data = Data::new(model);
+        forward_kinematics(model, &mut data, &params, &q);
+        let r0 = armcal::model::observed_pose(&data, Observed::Tool).rot;
+        let (mut positions, mut rotations) = (Vec::new(), Vec::new());
+        for p in &draws {
+            forward_kinematics(model, &mut data, p, &q);
+            let pose = armcal::model::observed_pose(&data, Observed::Tool);
+            positions.push(pose.trans);
+            let d = nalgebra::Rotation3::from_matrix_unchecked(pose.rot * r0.transpose());
+            rotations.push(d.scaled_axis().map(f64::to_degrees));
+        }
+        let value = |c: &str| -> f64 { table[row][c].parse().unwrap() };
+        for (column, mc) in [
+            ("sigma_mm", rms_sigma(&positions)),
+            ("sigma_deg", rms_sigma(&rotations)),
+        ] {
+            let stated = value(column);
+            assert!(
+                (stated - mc).abs() <= 0.05 * mc,
+                "row {row} {column}: stated {stated:.6}, Monte Carlo {mc:.6}"
+            );
+        }
+        assert!(value("total_sigma_deg") >= value("sigma_deg"));
+    }
 }
