@@ -6,7 +6,9 @@
 //! Before issue 30 such a robot had no capsules at all and `plan` printed "every pose
 //! feasible" for poses through the table (and the cell's box obstacle did not load); the
 //! test also shows that the same check finds many configurations of a grid in the table or
-//! the floor.
+//! the floor. The arm's own self collision is checked the same way, over the pairs the
+//! planner checks (not neighbouring bodies, not the pairs `plan` names as in contact
+//! everywhere), with a grid showing that check can fail too.
 
 use super::common::{armcal, scratch};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
@@ -146,6 +148,20 @@ fn capsule(a: &Vector3<f64>, b: &Vector3<f64>) -> Capsule {
     )
 }
 
+/// parry's distance of two placed shapes, or its signed contact depth where they overlap
+/// (negative).
+fn signed(shape: &dyn Shape, at: &Pose, other: &dyn Shape, other_at: &Pose) -> f64 {
+    let d = query::distance(at, shape, other_at, other)
+        .expect("supported")
+        .distance;
+    if d > 0.0 {
+        return d;
+    }
+    query::contact(at, shape, other_at, other, 0.0)
+        .expect("supported")
+        .map_or(0.0, |c| c.dist)
+}
+
 /// Smallest parry distance of `bodies` (shape, world pose) to the table and to the floor;
 /// a negative value is an overlap (parry's signed contact depth).
 fn clearances(bodies: &[(Box<dyn Shape>, Pose)]) -> (f64, f64) {
@@ -160,17 +176,6 @@ fn clearances(bodies: &[(Box<dyn Shape>, Pose)]) -> (f64, f64) {
         TABLE_CENTER[2],
     ));
     let floor = HalfSpace::new(Vector::new(0.0, 0.0, 1.0));
-    let signed = |shape: &dyn Shape, at: &Pose, other: &dyn Shape, other_at: &Pose| {
-        let d = query::distance(at, shape, other_at, other)
-            .expect("supported")
-            .distance;
-        if d > 0.0 {
-            return d;
-        }
-        query::contact(at, shape, other_at, other, 0.0)
-            .expect("supported")
-            .map_or(0.0, |c| c.dist)
-    };
     let mut out = (f64::INFINITY, f64::INFINITY);
     for (shape, at) in bodies {
         out.0 = out.0.min(signed(shape.as_ref(), at, &table, &table_pose));
@@ -235,16 +240,44 @@ fn urdf_bodies(q: &[f64]) -> Vec<(Box<dyn Shape>, Pose)> {
     bodies
 }
 
+/// A body of the arm with the frame it moves with (`plan`'s capsule names).
+type Labelled = (String, Box<dyn Shape>, Pose);
+
 /// The DH arm's skeleton as the planner derives it (`robots/skeleton.rs`): the segment
 /// O_{k−1} O_k from joint k's point to the next on the frame of joint k (`jk`), a segment
 /// shorter than 1 µm left out (the spherical wrist's O₄ O₅), each a capsule of the cell's
 /// radius. The tool frame is the flange: no tool segment.
-fn dh_skeleton(q: &[f64]) -> Vec<(String, Vector3<f64>, Vector3<f64>)> {
+fn dh_skeleton(q: &[f64]) -> Vec<Labelled> {
     let o = dh_origins(q);
     (1..o.len())
         .filter(|&k| (o[k] - o[k - 1]).norm() > 1e-3)
-        .map(|k| (format!("j{k}"), o[k - 1], o[k]))
+        .map(|k| {
+            let shape: Box<dyn Shape> = Box::new(capsule(&o[k - 1], &o[k]));
+            (format!("j{k}"), shape, Pose::identity())
+        })
         .collect()
+}
+
+/// The URDF arm's bodies by frame, as `plan` names them: `joint1`'s skeleton segment (its
+/// origin to joint 2's), the URDF's own cylinders on `joint2` and `joint3` (the planner
+/// checks capsules bounding them, so the cylinders inside keep at least its clearance), and
+/// the `tool` segment from the wrist to tool0 (the wrist's own segments have no length).
+fn urdf_labelled(q: &[f64]) -> Vec<Labelled> {
+    let f = urdf_frames(q);
+    let o: Vec<Vector3<f64>> = f.iter().map(|t| t.translation.vector).collect();
+    let mut bodies = urdf_bodies(q);
+    let tool = bodies.pop().expect("the flange segment");
+    let cylinders: Vec<_> = bodies.drain(1..3).collect();
+    let mut out: Vec<Labelled> = vec![(
+        "joint1".into(),
+        Box::new(capsule(&o[0], &o[1])),
+        Pose::identity(),
+    )];
+    for (k, (shape, at)) in cylinders.into_iter().enumerate() {
+        out.push((format!("joint{}", k + 2), shape, at));
+    }
+    out.push(("tool".into(), tool.0, tool.1));
+    out
 }
 
 /// The capsule pairs `plan` names as in contact everywhere (and so does not check), as
@@ -275,36 +308,22 @@ fn pairs_in_contact(plan_stdout: &str) -> Vec<(String, String)> {
         .unwrap_or_default()
 }
 
-/// The arm's least self clearance at `q` by parry: over the skeleton's capsule pairs the
-/// planner checks (paper eq. 24b, `design/cell_constraints`): not neighbours in chain order
-/// among the capsule-carrying frames (`skeleton` lists them in that order, one per frame),
-/// and not a pair `plan` names as in contact everywhere (`skip`). Negative: an overlap.
-fn self_clearance(
-    skeleton: &[(String, Vector3<f64>, Vector3<f64>)],
-    skip: &[(String, String)],
-) -> f64 {
+/// The arm's least self clearance by parry over the pairs of `bodies` the planner checks
+/// (paper eq. 24b, `design/cell_constraints`): not neighbours in chain order among the
+/// frames that carry a body (`bodies` lists them in that order, one per frame), and not a
+/// pair `plan` names as in contact everywhere (`skip`). Negative: an overlap.
+fn self_clearance(bodies: &[Labelled], skip: &[(String, String)]) -> f64 {
     let mut least = f64::INFINITY;
-    for i in 0..skeleton.len() {
-        for j in i + 2..skeleton.len() {
-            let (a, b) = (&skeleton[i], &skeleton[j]);
+    for i in 0..bodies.len() {
+        for j in i + 2..bodies.len() {
+            let (a, b) = (&bodies[i], &bodies[j]);
             if skip
                 .iter()
                 .any(|(x, y)| (x == &a.0 && y == &b.0) || (x == &b.0 && y == &a.0))
             {
                 continue;
             }
-            let (ca, cb) = (capsule(&a.1, &a.2), capsule(&b.1, &b.2));
-            let d = query::distance(&Pose::identity(), &ca, &Pose::identity(), &cb)
-                .expect("capsules")
-                .distance;
-            let d = if d > 0.0 {
-                d
-            } else {
-                query::contact(&Pose::identity(), &ca, &Pose::identity(), &cb, 0.0)
-                    .expect("capsules")
-                    .map_or(0.0, |c| c.dist)
-            };
-            least = least.min(d);
+            least = least.min(signed(a.1.as_ref(), &a.2, b.1.as_ref(), &b.2));
         }
     }
     least
@@ -355,13 +374,11 @@ fn a_users_dh_and_urdf_robots_plan_clear_of_a_table_and_the_floor() {
         "name = \"kr6-urdf-table\"\n[robot]\nurdf = \"kr6.urdf\"\nlink_radius_mm = {RADIUS}\n\n{}",
         rest_of_cell()
     );
-    for (name, cell, bodies) in [
-        (
-            "dh",
-            dh_cell(),
-            dh_bodies as fn(&[f64]) -> Vec<(Box<dyn Shape>, Pose)>,
-        ),
-        ("urdf", urdf_cell, urdf_bodies),
+    type Bodies = fn(&[f64]) -> Vec<(Box<dyn Shape>, Pose)>;
+    type Arm = fn(&[f64]) -> Vec<Labelled>;
+    for (name, cell, bodies, arm) in [
+        ("dh", dh_cell(), dh_bodies as Bodies, dh_skeleton as Arm),
+        ("urdf", urdf_cell, urdf_bodies, urdf_labelled),
     ] {
         let (stdout, _, poses) = plan(&dir, &cell, name);
         assert!(stdout.contains("every pose feasible"), "{name}:\n{stdout}");
@@ -384,21 +401,17 @@ fn a_users_dh_and_urdf_robots_plan_clear_of_a_table_and_the_floor() {
             "{name}: least clearance of 24 planned poses: table {:.2} mm, floor {:.2} mm",
             worst.0, worst.1
         );
-        // The arm's own self collision, for the DH arm whose skeleton the test derives
-        // itself (the URDF arm's cylinders are bounded by capsules the test does not
-        // rebuild): every planned pose keeps its capsules apart.
+        // The arm's own self collision, by the test's own bodies and parry.
         let skip = pairs_in_contact(&stdout);
-        if name == "dh" {
-            let least = poses
-                .iter()
-                .map(|q| self_clearance(&dh_skeleton(q), &skip))
-                .fold(f64::INFINITY, f64::min);
-            eprintln!("dh: least self clearance of 24 planned poses {least:.2} mm (pairs not checked: {skip:?})");
-            assert!(
-                least >= CLEARANCE,
-                "dh: a planned pose in self collision: {least:.2} mm"
-            );
-        }
+        let least = poses
+            .iter()
+            .map(|q| self_clearance(&arm(q), &skip))
+            .fold(f64::INFINITY, f64::min);
+        eprintln!("{name}: least self clearance of 24 planned poses {least:.2} mm (pairs not checked: {skip:?})");
+        assert!(
+            least >= CLEARANCE,
+            "{name}: a planned pose in self collision: {least:.2} mm"
+        );
         // The check has teeth: over a grid of the shoulder, elbow and wrist joints, a good
         // share of configurations put the arm into the table or the floor.
         let mut grid = Vec::new();
@@ -434,19 +447,20 @@ fn a_users_dh_and_urdf_robots_plan_clear_of_a_table_and_the_floor() {
             "{name}: only {hits} of {} grid configurations hit",
             grid.len()
         );
-        if name == "dh" {
-            // The self-collision check has teeth too: the elbow folds the forearm onto the
-            // base and upper arm.
-            let folded = grid
-                .iter()
-                .filter(|q| self_clearance(&dh_skeleton(&q[..]), &skip) < 0.0)
-                .count();
-            eprintln!(
-                "dh: {folded} of {} grid configurations in self collision",
-                grid.len()
-            );
-            assert!(folded > 0, "dh: no grid configuration in self collision");
-        }
+        // The self-collision check has teeth too: the elbow folds the forearm and the
+        // wrist onto the base and upper arm.
+        let folded = grid
+            .iter()
+            .filter(|q| self_clearance(&arm(&q[..]), &skip) < 0.0)
+            .count();
+        eprintln!(
+            "{name}: {folded} of {} grid configurations in self collision",
+            grid.len()
+        );
+        assert!(
+            folded > 0,
+            "{name}: no grid configuration in self collision"
+        );
     }
 }
 
