@@ -18,7 +18,8 @@ pub struct Args {
     pub out: PathBuf,
     /// The cell the estimate was identified in: a cell export then carries its instrument
     /// (noise, incidence limit), capsules, working poses, obstacles, data columns, measurement
-    /// type and fixed parameters, with `free = "auto"`, so every command accepts it unchanged.
+    /// type, fixed parameters and their stated σ (`fixed_prior`, `fixed_priors`), with
+    /// `free = "auto"`, so every command accepts it unchanged.
     #[arg(long)]
     pub cell: Option<String>,
     /// Overwrite existing output files (never an input file).

@@ -143,11 +143,12 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         report.poses, a.seed, report.candidates.len(), report.rank_svd, report.rank_qr
     );
     println!(
-        "identifiable: {} parameters, condition number of the column-scaled Jacobian {:.1}",
-        report.identifiable.len(),
+        "identifiable: {} at these random configurations and the nominal, condition number of the column-scaled Jacobian {:.1}",
+        report.count(model),
         report.condition_number
     );
     println!("  {}", report.identifiable.join(", "));
+    println!("  (`identify` counts again, by the same rule, at the data's configurations and at the fit: data that move some joints little, or terms they cannot separate, give fewer, and it says why)");
     if let Some(d) = &deficit {
         println!("below the generic count: {d}");
     }

@@ -61,6 +61,11 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         p.residual_sigma_mm,
         p.residuals_mm.iter().copied().fold(0.0, f64::max)
     );
+    println!(
+        "the cell's fixed_priors carry no correlations: they state σ = √λ_max(C_tool) = {:.4} mm on each of tool.x/y/z, never narrower than the pivot's full covariance (tool_covariance in {})",
+        p.prior_sigma_mm(),
+        a.out.display()
+    );
     println!("in the cell file:\n{}", p.cell_snippet());
     println!("→ {}", a.out.display());
     Ok(())

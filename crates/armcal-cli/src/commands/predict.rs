@@ -3,6 +3,7 @@
 use super::output::{
     load_cell, warn_outside_fitted_ranges, with_note, CalibrationOrNominal, NoteStyle, Outputs,
 };
+use armcal::identify::prediction_sigma::{csv_with_sigmas, prediction_sigmas, RowSigma};
 use armcal::measure::csv;
 use armcal::sim::predict;
 use std::path::{Path, PathBuf};
@@ -43,14 +44,15 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         warn_outside_fitted_ranges(est, model, &poses);
     }
     let data = predict(model, &params, &poses, payload.0, cell.measurement)?;
-    outputs.commit(&[(
-        &a.out,
-        &with_note(
-            csv::write_string(&data, model)?,
-            note.as_deref(),
-            NoteStyle::Hash,
-        ),
-    )])?;
+    let sigmas = match &est {
+        Some(est) => prediction_sigmas(model, &params, est, &data)?,
+        None => None,
+    };
+    let text = match &sigmas {
+        Some(s) => csv_with_sigmas(&data, model, s)?,
+        None => csv::write_string(&data, model)?,
+    };
+    outputs.commit(&[(&a.out, &with_note(text, note.as_deref(), NoteStyle::Hash))])?;
     println!(
         "predicted {} measurements at {} configurations with the {} model → {}",
         data.measurements.len(),
@@ -65,5 +67,34 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     if let Some(how) = payload.1 {
         println!("payload: {how}");
     }
+    match (&est, &sigmas) {
+        (Some(_), Some(s)) => println!("{}", sigma_summary(s)),
+        (Some(_), None) => println!(
+            "no σ columns: the estimate's free parameters are not all the cell's (a fit over instrument stations), or a row is neither a position nor a pose"
+        ),
+        _ => {}
+    }
     Ok(())
+}
+
+/// The largest σ's of the columns `predict` wrote.
+fn sigma_summary(s: &[RowSigma]) -> String {
+    let largest = |f: &dyn Fn(&RowSigma) -> Option<f64>| s.iter().filter_map(f).reduce(f64::max);
+    let mm = |x: Option<f64>| x.map(|x| format!("{x:.4} mm")).unwrap_or_default();
+    let mut line = format!(
+        "σ of each row from the estimate's C_p (sigma_mm): largest {}",
+        mm(largest(&|r| Some(r.point.position_mm)))
+    );
+    if let Some(t) = largest(&|r| r.point.total_mm()) {
+        line += &format!(
+            "; with the model floor of the fixed parameters (total_sigma_mm) {}",
+            mm(Some(t))
+        );
+    } else {
+        line += "; the estimate states no model floor";
+    }
+    if let Some(t) = largest(&|r| r.tcp.map(|t| t.total_mm().unwrap_or(t.position_mm))) {
+        line += &format!("; at the TCP (tcp_total_sigma_mm) {}", mm(Some(t)));
+    }
+    line
 }

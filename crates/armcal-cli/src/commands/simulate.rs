@@ -52,6 +52,10 @@ pub struct Args {
     /// them.
     #[arg(long)]
     pub perturb_fixed: bool,
+    /// σ (mm, per axis) of where the virtual instrument stands off the cell's position, as
+    /// `campaign simulate`'s: a tracker set up by tape measure is centimetres off.
+    #[arg(long, default_value_t = 20.0, value_name = "MM")]
+    pub instrument_offset_mm: f64,
     /// Measure without noise.
     #[arg(long)]
     pub noise_free: bool,
@@ -75,6 +79,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     outs.extend(a.truth_out.as_deref());
     let outputs = Outputs::plan(a.force, &[Path::new(&a.cell), &a.poses], &outs)?;
     for (flag, v) in [
+        ("--instrument-offset-mm", a.instrument_offset_mm),
         ("--perturb-urad-per-m", a.perturb_urad_per_m),
         ("--perturb-arcsec", a.perturb_arcsec),
         ("--perturb-urad-per-nm", a.perturb_urad_per_nm),
@@ -114,6 +119,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         joint_compliance: a.perturb_urad_per_nm / Unit::RadPerNmm.display_factor(),
         all: a.perturb_all,
         fixed: a.perturb_fixed.then(|| cell.fixed_prior.clone()),
+        instrument_length: Some(a.instrument_offset_mm),
         ..Perturbation::default()
     };
     let noise = cell.noise();

@@ -7,7 +7,10 @@ use common::{armcal, scratch};
 fn model_of_the_paper_cell_reports_27_identifiable_parameters_with_reasons() {
     let (ok, out, err) = armcal(&["model", "examples/paper-cell.toml"]);
     assert!(ok, "{err}");
-    assert!(out.contains("identifiable: 27 parameters"), "{out}");
+    assert!(
+        out.contains("identifiable: 27 geometric parameters at these random"),
+        "{out}"
+    );
     assert!(out.contains("4R + 2P + 6 = 30"), "{out}");
     assert!(out.contains("not identifiable (6)"), "{out}");
     for p in ["j1.theta", "j1.d", "j6.theta", "j6.d", "j6.a", "j6.alpha"] {
@@ -105,7 +108,10 @@ fn model_converts_to_another_convention_before_the_analysis() {
         assert!(row(&out, p).is_none(), "{p} still there:\n{out}");
     }
     // Forward kinematics are unchanged, so a full pose still identifies 4R + 6 = 30.
-    assert!(out.contains("identifiable: 30 parameters"), "{out}");
+    assert!(
+        out.contains("identifiable: 30 geometric parameters at these random"),
+        "{out}"
+    );
 
     let (ok, out, err) = armcal(&["model", "puma560", "--convention", "dh"]);
     assert!(ok, "{err}");
@@ -129,7 +135,10 @@ fn model_converts_to_another_convention_before_the_analysis() {
     }
     // Standard DH cannot describe a tilt of the parallel axes 2 and 3 and has their d's
     // dependent (book §2.6, the reason for Table 6.1's Hayati link): one parameter short.
-    assert!(out.contains("identifiable: 29 parameters"), "{out}");
+    assert!(
+        out.contains("identifiable: 29 geometric parameters at these random"),
+        "{out}"
+    );
     assert!(
         out.contains("- `j3.d` cannot be separated from `j2.d`"),
         "{out}"

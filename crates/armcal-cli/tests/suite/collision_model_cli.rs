@@ -6,7 +6,9 @@
 //! Before issue 30 such a robot had no capsules at all and `plan` printed "every pose
 //! feasible" for poses through the table (and the cell's box obstacle did not load); the
 //! test also shows that the same check finds many configurations of a grid in the table or
-//! the floor.
+//! the floor. The arm's own self collision is checked the same way, over the pairs the
+//! planner checks (not neighbouring bodies, not the pairs `plan` names as in contact
+//! everywhere), with a grid showing that check can fail too.
 
 use super::common::{armcal, scratch};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
@@ -146,6 +148,20 @@ fn capsule(a: &Vector3<f64>, b: &Vector3<f64>) -> Capsule {
     )
 }
 
+/// parry's distance of two placed shapes, or its signed contact depth where they overlap
+/// (negative).
+fn signed(shape: &dyn Shape, at: &Pose, other: &dyn Shape, other_at: &Pose) -> f64 {
+    let d = query::distance(at, shape, other_at, other)
+        .expect("supported")
+        .distance;
+    if d > 0.0 {
+        return d;
+    }
+    query::contact(at, shape, other_at, other, 0.0)
+        .expect("supported")
+        .map_or(0.0, |c| c.dist)
+}
+
 /// Smallest parry distance of `bodies` (shape, world pose) to the table and to the floor;
 /// a negative value is an overlap (parry's signed contact depth).
 fn clearances(bodies: &[(Box<dyn Shape>, Pose)]) -> (f64, f64) {
@@ -160,17 +176,6 @@ fn clearances(bodies: &[(Box<dyn Shape>, Pose)]) -> (f64, f64) {
         TABLE_CENTER[2],
     ));
     let floor = HalfSpace::new(Vector::new(0.0, 0.0, 1.0));
-    let signed = |shape: &dyn Shape, at: &Pose, other: &dyn Shape, other_at: &Pose| {
-        let d = query::distance(at, shape, other_at, other)
-            .expect("supported")
-            .distance;
-        if d > 0.0 {
-            return d;
-        }
-        query::contact(at, shape, other_at, other, 0.0)
-            .expect("supported")
-            .map_or(0.0, |c| c.dist)
-    };
     let mut out = (f64::INFINITY, f64::INFINITY);
     for (shape, at) in bodies {
         out.0 = out.0.min(signed(shape.as_ref(), at, &table, &table_pose));
@@ -235,6 +240,95 @@ fn urdf_bodies(q: &[f64]) -> Vec<(Box<dyn Shape>, Pose)> {
     bodies
 }
 
+/// A body of the arm with the frame it moves with (`plan`'s capsule names).
+type Labelled = (String, Box<dyn Shape>, Pose);
+
+/// The DH arm's skeleton as the planner derives it (`robots/skeleton.rs`): the segment
+/// O_{k−1} O_k from joint k's point to the next on the frame of joint k (`jk`), a segment
+/// shorter than 1 µm left out (the spherical wrist's O₄ O₅), each a capsule of the cell's
+/// radius. The tool frame is the flange: no tool segment.
+fn dh_skeleton(q: &[f64]) -> Vec<Labelled> {
+    let o = dh_origins(q);
+    (1..o.len())
+        .filter(|&k| (o[k] - o[k - 1]).norm() > 1e-3)
+        .map(|k| {
+            let shape: Box<dyn Shape> = Box::new(capsule(&o[k - 1], &o[k]));
+            (format!("j{k}"), shape, Pose::identity())
+        })
+        .collect()
+}
+
+/// The URDF arm's bodies by frame, as `plan` names them: `joint1`'s skeleton segment (its
+/// origin to joint 2's), the URDF's own cylinders on `joint2` and `joint3` (the planner
+/// checks capsules bounding them, so the cylinders inside keep at least its clearance), and
+/// the `tool` segment from the wrist to tool0 (the wrist's own segments have no length).
+fn urdf_labelled(q: &[f64]) -> Vec<Labelled> {
+    let f = urdf_frames(q);
+    let o: Vec<Vector3<f64>> = f.iter().map(|t| t.translation.vector).collect();
+    let mut bodies = urdf_bodies(q);
+    let tool = bodies.pop().expect("the flange segment");
+    let cylinders: Vec<_> = bodies.drain(1..3).collect();
+    let mut out: Vec<Labelled> = vec![(
+        "joint1".into(),
+        Box::new(capsule(&o[0], &o[1])),
+        Pose::identity(),
+    )];
+    for (k, (shape, at)) in cylinders.into_iter().enumerate() {
+        out.push((format!("joint{}", k + 2), shape, at));
+    }
+    out.push(("tool".into(), tool.0, tool.1));
+    out
+}
+
+/// The capsule pairs `plan` names as in contact everywhere (and so does not check), as
+/// frame names: from `not checked, in contact … : capsule j2#0 / j4#0, …`.
+fn pairs_in_contact(plan_stdout: &str) -> Vec<(String, String)> {
+    let frame = |s: &str| {
+        s.trim()
+            .trim_start_matches("capsule ")
+            .split('#')
+            .next()
+            .unwrap()
+            .to_string()
+    };
+    plan_stdout
+        .lines()
+        .find(|l| l.starts_with("not checked, in contact"))
+        .map(|l| {
+            l.split_once("): ")
+                .unwrap()
+                .1
+                .split(", ")
+                .map(|p| {
+                    let (a, b) = p.split_once(" / ").unwrap();
+                    (frame(a), frame(b))
+                })
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// The arm's least self clearance by parry over the pairs of `bodies` the planner checks
+/// (paper eq. 24b, `design/cell_constraints`): not neighbours in chain order among the
+/// frames that carry a body (`bodies` lists them in that order, one per frame), and not a
+/// pair `plan` names as in contact everywhere (`skip`). Negative: an overlap.
+fn self_clearance(bodies: &[Labelled], skip: &[(String, String)]) -> f64 {
+    let mut least = f64::INFINITY;
+    for i in 0..bodies.len() {
+        for j in i + 2..bodies.len() {
+            let (a, b) = (&bodies[i], &bodies[j]);
+            if skip
+                .iter()
+                .any(|(x, y)| (x == &a.0 && y == &b.0) || (x == &b.0 && y == &a.0))
+            {
+                continue;
+            }
+            least = least.min(signed(a.1.as_ref(), &a.2, b.1.as_ref(), &b.2));
+        }
+    }
+    least
+}
+
 /// Joint values (deg) of every pose of a design CSV.
 fn design(path: &std::path::Path) -> Vec<Vec<f64>> {
     std::fs::read_to_string(path)
@@ -251,7 +345,8 @@ fn design(path: &std::path::Path) -> Vec<Vec<f64>> {
         .collect()
 }
 
-fn plan(dir: &std::path::Path, cell: &str, name: &str) -> (String, Vec<Vec<f64>>) {
+/// `plan` of `cell` (written as `dir/name.toml`): stdout, stderr and the planned poses.
+fn plan(dir: &std::path::Path, cell: &str, name: &str) -> (String, String, Vec<Vec<f64>>) {
     let cell_path = dir.join(format!("{name}.toml"));
     std::fs::write(&cell_path, cell).unwrap();
     let out = dir.join(format!("{name}.csv"));
@@ -268,7 +363,7 @@ fn plan(dir: &std::path::Path, cell: &str, name: &str) -> (String, Vec<Vec<f64>>
         out.to_str().unwrap(),
     ]);
     assert!(ok, "plan of {name}:\n{stdout}\n{err}");
-    (stdout, design(&out))
+    (stdout, err, design(&out))
 }
 
 #[test]
@@ -279,15 +374,13 @@ fn a_users_dh_and_urdf_robots_plan_clear_of_a_table_and_the_floor() {
         "name = \"kr6-urdf-table\"\n[robot]\nurdf = \"kr6.urdf\"\nlink_radius_mm = {RADIUS}\n\n{}",
         rest_of_cell()
     );
-    for (name, cell, bodies) in [
-        (
-            "dh",
-            dh_cell(),
-            dh_bodies as fn(&[f64]) -> Vec<(Box<dyn Shape>, Pose)>,
-        ),
-        ("urdf", urdf_cell, urdf_bodies),
+    type Bodies = fn(&[f64]) -> Vec<(Box<dyn Shape>, Pose)>;
+    type Arm = fn(&[f64]) -> Vec<Labelled>;
+    for (name, cell, bodies, arm) in [
+        ("dh", dh_cell(), dh_bodies as Bodies, dh_skeleton as Arm),
+        ("urdf", urdf_cell, urdf_bodies, urdf_labelled),
     ] {
-        let (stdout, poses) = plan(&dir, &cell, name);
+        let (stdout, _, poses) = plan(&dir, &cell, name);
         assert!(stdout.contains("every pose feasible"), "{name}:\n{stdout}");
         assert!(
             stdout.contains("arm collision model: "),
@@ -307,6 +400,17 @@ fn a_users_dh_and_urdf_robots_plan_clear_of_a_table_and_the_floor() {
         eprintln!(
             "{name}: least clearance of 24 planned poses: table {:.2} mm, floor {:.2} mm",
             worst.0, worst.1
+        );
+        // The arm's own self collision, by the test's own bodies and parry.
+        let skip = pairs_in_contact(&stdout);
+        let least = poses
+            .iter()
+            .map(|q| self_clearance(&arm(q), &skip))
+            .fold(f64::INFINITY, f64::min);
+        eprintln!("{name}: least self clearance of 24 planned poses {least:.2} mm (pairs not checked: {skip:?})");
+        assert!(
+            least >= CLEARANCE,
+            "{name}: a planned pose in self collision: {least:.2} mm"
         );
         // The check has teeth: over a grid of the shoulder, elbow and wrist joints, a good
         // share of configurations put the arm into the table or the floor.
@@ -343,5 +447,43 @@ fn a_users_dh_and_urdf_robots_plan_clear_of_a_table_and_the_floor() {
             "{name}: only {hits} of {} grid configurations hit",
             grid.len()
         );
+        // The self-collision check has teeth too: the elbow folds the forearm and the
+        // wrist onto the base and upper arm.
+        let folded = grid
+            .iter()
+            .filter(|q| self_clearance(&arm(&q[..]), &skip) < 0.0)
+            .count();
+        eprintln!(
+            "{name}: {folded} of {} grid configurations in self collision",
+            grid.len()
+        );
+        assert!(
+            folded > 0,
+            "{name}: no grid configuration in self collision"
+        );
     }
+}
+
+#[test]
+fn an_arm_without_a_collision_model_is_planned_with_a_loud_warning() {
+    let dir = scratch("collision-model-none");
+    // The cell draws its arm with [[robot.capsules]], which replace the skeleton, but only
+    // a pedestal on the base: no capsule moves with a joint.
+    let cell = dh_cell()
+        .replace(&format!("link_radius_mm = {RADIUS}\n"), "")
+        .replace(
+            "\n[instrument]",
+            "\n[[robot.capsules]]\nframe = \"base\"\na_mm = [0, 0, 0]\nb_mm = [0, 0, 100]\nradius_mm = 50\n\n[instrument]",
+        );
+    assert!(cell.contains("[[robot.capsules]]") && !cell.contains("link_radius_mm"));
+    let (stdout, err, _) = plan(&dir, &cell, "bare");
+    assert!(
+        err.contains("WARNING: the arm of `kr6-dh-table` has NO collision model (no capsule moves with a joint): self collision, the obstacles and the floor are NOT checked"),
+        "{err}"
+    );
+    assert!(
+        stdout.contains("every pose within them, but the arm's collisions are NOT checked")
+            && !stdout.contains("every pose feasible"),
+        "{stdout}"
+    );
 }

@@ -96,3 +96,28 @@ pub fn cell_with_default_margins(dir: &Path) -> PathBuf {
     std::fs::write(&path, kept.join("\n") + "\n").unwrap();
     path
 }
+
+/// A variant of the paper cell, `text`, written to `dir/cell.toml`, simulated at the 60
+/// planned example poses (noise `seed`; `--allow-unmeasurable` if `unmeasurable`) into
+/// `dir/data.csv` and identified into `dir/estimate.json`; returns the three paths.
+pub fn simulate_and_identify_variant(
+    dir: &Path,
+    text: &str,
+    seed: &str,
+    unmeasurable: bool,
+) -> [String; 3] {
+    let path = |f: &str| dir.join(f).to_str().unwrap().to_string();
+    let [cell, data, est] = [path("cell.toml"), path("data.csv"), path("estimate.json")];
+    std::fs::write(&cell, text).unwrap();
+    let mut simulate = vec!["simulate", "--cell", &cell, "--poses"];
+    simulate.extend(["examples/paper-poses-planned-60.csv", "--seed", seed]);
+    if unmeasurable {
+        simulate.push("--allow-unmeasurable");
+    }
+    simulate.extend(["--out", &data]);
+    let (ok, _, err) = armcal(&simulate);
+    assert!(ok, "{err}");
+    let (ok, _, err) = armcal(&["identify", "--cell", &cell, "--data", &data, "--out", &est]);
+    assert!(ok, "{err}");
+    [cell, data, est]
+}

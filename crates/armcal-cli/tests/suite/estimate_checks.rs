@@ -154,7 +154,10 @@ fn every_consumer_refuses_an_unconverged_estimate() {
         "--measurement",
         "position",
     ]);
-    assert!(ok && out.contains("identifiable: 27 parameters"), "{err}");
+    assert!(
+        ok && out.contains("identifiable: 27 geometric parameters at these random"),
+        "{err}"
+    );
     let urdf_cell = dir.join("urdf-cell.toml");
     std::fs::write(
         &urdf_cell,

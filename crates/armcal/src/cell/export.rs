@@ -3,8 +3,8 @@
 //! was identified in — the instrument's kind, noise model and incidence limit, targets,
 //! capsules (re-expressed in the exported frames), working poses, obstacles, the design
 //! clearances, joint limits,
-//! the data columns, the measurement type, what the cell fixed or gave a prior, and
-//! `free = "auto"`.
+//! the data columns, the measurement type, what the cell fixed or gave a prior, the stated
+//! σ of the fixed parameters (`fixed_prior`, `fixed_priors`), and `free = "auto"`.
 
 use super::{Cell, NoiseModel, Obstacle};
 use crate::model::complete::LinkForm;
@@ -154,6 +154,42 @@ fn parameters(cell: &Cell, exported: &Model) -> String {
     }
     if !priors.is_empty() {
         let _ = writeln!(out, "priors = {{ {} }}", priors.join(", "));
+    }
+    out + &fixed_priors(cell, &declared, exported)
+}
+
+/// `fixed_prior` (the cell's σ per kind) and `fixed_priors`: the σ of every parameter the
+/// cell named (0 included), and of every base and tool parameter with a σ — the exported
+/// cell gives its base and tool as links, not as `[base]`/`[tool]`, and a reader takes a
+/// frame the cell does not give as a definition (σ 0), so a zero σ there needs no entry.
+fn fixed_priors(cell: &Cell, declared: &Model, exported: &Model) -> String {
+    let prior = &cell.fixed_prior;
+    let mut out = format!(
+        "fixed_prior = {{ length_mm = {:?}, angle_deg = {:?}, unitless = {:?} }}\n",
+        prior.length_mm,
+        prior.angle_rad.to_degrees(),
+        prior.unitless
+    );
+    let entries: Vec<String> = declared
+        .registry
+        .iter()
+        .filter(|p| exported.registry.index_of(&p.name).is_some())
+        .filter(|p| {
+            let named = prior.parameters.iter().any(|(n, _)| *n == p.name);
+            let frame = matches!(p.frame(), "base" | "tool");
+            (named && !frame) || (frame && prior.sigma(p) > 0.0)
+        })
+        .map(|p| {
+            format!(
+                "{} = {{ sigma{} = {:?} }}",
+                toml_text::string(&p.name),
+                model_export::suffix(p.unit),
+                prior.sigma(p) * p.unit.display_factor()
+            )
+        })
+        .collect();
+    if !entries.is_empty() {
+        let _ = writeln!(out, "fixed_priors = {{ {} }}", entries.join(", "));
     }
     out
 }

@@ -378,10 +378,11 @@ impl Cell {
         params: &[f64],
         configurations: Option<&[Vec<f64>]>,
     ) -> Result<Option<RankDeficit>, Error> {
+        let declared = self.declared_model();
         rank_deficit(
-            &self.declared_model(),
+            &declared,
             params,
-            report.identifiable.len(),
+            report.count(&declared).geometric,
             report.measurement,
             configurations,
         )

@@ -74,7 +74,7 @@ pub fn analyze_model(
             let deficit = rank_deficit(
                 &m,
                 &m.nominal(),
-                report.identifiable.len(),
+                report.count(&m).geometric,
                 opts.measurement,
                 None,
             )?;

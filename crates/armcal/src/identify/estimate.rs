@@ -214,8 +214,7 @@ pub struct Estimate {
     /// C_s by the constrained formulation (paper eq. 19), same order.
     pub tcp_constrained: Vec<Matrix3<f64>>,
     /// The model floor at the same working configurations: what the fixed parameters'
-    /// stated uncertainty adds to C_s ([`crate::identify::model_floor`]); `None` without
-    /// working configurations, for a frames refit (its robot is an earlier calibration's,
+    /// stated uncertainty adds to C_s ([`crate::identify::model_floor`]); `None` for a frames refit (its robot is an earlier calibration's,
     /// held without that calibration's C_p) or in files of an older armcal.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub model_floor: Option<crate::identify::model_floor::ModelFloor>,

@@ -18,6 +18,7 @@ pub mod model_floor;
 pub mod nongeometric_choice;
 pub mod nongeometric_gate;
 pub mod pivot;
+pub mod prediction_sigma;
 pub mod problem;
 pub mod refit;
 pub mod residuals;
@@ -390,11 +391,9 @@ fn estimate_of_fit(
         .count();
     // the generic count is of geometric parameters: the non-geometric terms (compliance,
     // periodic errors) are counted apart
-    let geometric = problem
-        .free
-        .iter()
-        .filter(|&&i| !model.is_joint_correction(i))
-        .count();
+    let geometric =
+        crate::model::identifiability::IdentifiableCount::of(model, problem.free.iter().copied())
+            .geometric;
     let rank_deficit = if let Some(refit) = &opts.refit {
         refit::deficit(cell, refit, names.len(), kept)
     } else if cell.auto_free {
@@ -415,8 +414,9 @@ fn estimate_of_fit(
     let working: Vec<Vec<f64>> = cell.working.iter().map(|w| w.q.clone()).collect();
     let wnames: Vec<String> = cell.working.iter().map(|w| w.name.clone()).collect();
     // A frames refit holds the robot at an earlier calibration, not at a nominal with the
-    // cell's prior: it states no floor.
-    let model_floor = (!working.is_empty() && opts.refit.is_none()).then(|| {
+    // cell's prior: it states no floor. Without working poses the floor still holds what
+    // `predict` needs at other configurations (its absorbed map).
+    let model_floor = opts.refit.is_none().then(|| {
         model_floor::model_floor(
             &problem,
             &sol.params,

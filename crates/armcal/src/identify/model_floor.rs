@@ -70,6 +70,24 @@ pub struct ModelFloor {
     pub fixed: Vec<FixedSigma>,
     /// The floor at every working configuration, in the order of the cell's.
     pub tcp: Vec<TcpFloor>,
+    /// What the fit absorbs of the fixed parameters' errors: the floor at any other
+    /// configuration follows from it ([`Absorbed`]); `None` in files of an older armcal.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub absorbed: Option<Absorbed>,
+}
+
+/// `A = C_p Fᵀ F_f` (module notes), the free parameters' response to the fixed ones'
+/// errors, with the fixed parameters of non-zero prior σ it maps: the floor of any point the
+/// model predicts at any configuration is `K Σ_f Kᵀ` with `K = G_f − G A`, `G`, `G_f` that
+/// point's Jacobians ([`crate::identify::prediction_sigma`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Absorbed {
+    /// The fixed parameters with a non-zero prior σ, the columns of `map`.
+    pub fixed: Vec<String>,
+    /// Their prior σ (internal units: mm, rad).
+    pub sigma: Vec<f64>,
+    /// `A` (rows: the free parameters in the order of C_p; columns: `fixed`).
+    pub map: DMatrix<f64>,
 }
 
 impl ModelFloor {
@@ -111,7 +129,9 @@ pub fn model_floor(
         .filter(|&i| prior.sigma(model.registry.get(i)) > 0.0)
         .collect();
     let qs: Vec<Vec<f64>> = working.iter().map(|w| w.q.clone()).collect();
-    let k = bias_matrix(problem, params, jacobian, cp, &fixed, &qs, outliers);
+    let absorbed = absorbed_map(problem, params, jacobian, cp, &fixed, outliers);
+    let k = tcp_jacobian(model, params, &fixed, &qs)
+        - tcp_jacobian(model, params, &problem.free, &qs) * &absorbed;
     let sigma = DVector::from_iterator(
         fixed.len(),
         fixed.iter().map(|&i| prior.sigma(model.registry.get(i))),
@@ -149,25 +169,28 @@ pub fn model_floor(
     ModelFloor {
         fixed: fixed_record,
         tcp,
+        absorbed: Some(Absorbed {
+            fixed: fixed
+                .iter()
+                .map(|&i| model.registry.get(i).name.clone())
+                .collect(),
+            sigma: sigma.iter().copied().collect(),
+            map: absorbed,
+        }),
     }
 }
 
-/// `K = G_f − G C_p Fᵀ F_f` (module notes): 3 rows per working configuration `qs`, one
-/// column per parameter of `fixed` (registry indices). `jacobian` is the fit's (its data
-/// rows those of the measurements a robust fit kept, with weight 1, then its prior rows);
-/// `F_f` is taken over the same data rows.
-pub fn bias_matrix(
+/// `A = C_p Fᵀ F_f` (module notes), one column per parameter of `fixed` (registry
+/// indices). `jacobian` is the fit's (its data rows those of the measurements a robust fit
+/// kept, with weight 1, then its prior rows); `F_f` is taken over the same data rows.
+pub fn absorbed_map(
     problem: &Problem,
     params: &[f64],
     jacobian: &DMatrix<f64>,
     cp: &DMatrix<f64>,
     fixed: &[usize],
-    qs: &[Vec<f64>],
     outliers: &[Outlier],
 ) -> DMatrix<f64> {
-    let model = problem.model;
-    let g = tcp_jacobian(model, params, &problem.free, qs);
-    let g_fixed = tcp_jacobian(model, params, fixed, qs);
     // The data rows' Jacobian over the fixed columns: the same problem with those columns
     // free and no prior rows (a fixed parameter has none), over the rows the fit's Jacobian
     // holds (the kept measurements, weight 1), so the whitening is the fit's.
@@ -177,6 +200,5 @@ pub fn bias_matrix(
     at_fixed.prior_offset = DVector::zeros(0);
     let (_, f_fixed) = kept_rows(&mut at_fixed, params, outliers);
     let data_rows = f_fixed.nrows();
-    let absorbed = jacobian.rows(0, data_rows).transpose() * f_fixed.rows(0, data_rows);
-    g_fixed - g * (cp * absorbed)
+    cp * (jacobian.rows(0, data_rows).transpose() * f_fixed.rows(0, data_rows))
 }

@@ -73,11 +73,27 @@ impl PivotCalibration {
         crate::json::sorted_pretty(self)
     }
 
+    /// The σ (mm) the cell snippet states on each of `tool.x/y/z`: √λ_max of
+    /// [`PivotCalibration::tool_covariance`]. A cell's `fixed_priors` are independent per
+    /// parameter and cannot carry the covariance's correlations (the tip's σ along the
+    /// tool's mean axis is typically several times its σ across, and the axes of the
+    /// flange frame do not follow it); `λ_max I ⪰ C`, so the diagonal prior is never
+    /// narrower than the pivot's covariance in any direction — conservative, where the
+    /// per-axis √diag C alone would understate a correlated combination.
+    pub fn prior_sigma_mm(&self) -> f64 {
+        self.tool_covariance
+            .symmetric_eigen()
+            .eigenvalues
+            .max()
+            .max(0.0)
+            .sqrt()
+    }
+
     /// The cell-file lines that use the result: the tool frame and its σ as the fixed
-    /// tool frame's prior.
+    /// tool frame's prior, conservative ([`PivotCalibration::prior_sigma_mm`]).
     pub fn cell_snippet(&self) -> String {
         let [x, y, z] = self.tool_xyz_mm;
-        let [sx, sy, sz] = self.tool_sigma_mm;
+        let [sx, sy, sz] = [self.prior_sigma_mm(); 3];
         format!(
             "[tool]\nxyz_mm = [{x:.4}, {y:.4}, {z:.4}]\n\n# in [parameters]:\n\
              fixed_priors = {{ \"tool.x\" = {{ sigma_mm = {sx:.4} }}, \"tool.y\" = {{ sigma_mm = {sy:.4} }}, \"tool.z\" = {{ sigma_mm = {sz:.4} }} }}\n"

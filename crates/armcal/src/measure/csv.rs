@@ -644,6 +644,17 @@ pub fn import(path: &Path, model: &Model, format: &DataFormat) -> Result<Import,
 /// any measurement has them, and `temperature_c` if any measurement recorded one. Only
 /// position and pose measurements have a CSV form.
 pub fn write_string(data: &Dataset, model: &Model) -> Result<String, Error> {
+    write_string_with(data, model, &[], &[])
+}
+
+/// [`write_string`] with the columns `extra` (header) appended, `rows[k]` their values in
+/// measurement `k`'s row (a reader of data files ignores them).
+pub fn write_string_with(
+    data: &Dataset,
+    model: &Model,
+    extra: &[&str],
+    rows: &[Vec<String>],
+) -> Result<String, Error> {
     let any_pose = data
         .measurements
         .iter()
@@ -681,9 +692,10 @@ pub fn write_string(data: &Dataset, model: &Model) -> Result<String, Error> {
     if any_temperature {
         header.push("temperature_c".into());
     }
+    header.extend(extra.iter().map(|c| c.to_string()));
     let mut w = table::Table::new(&header);
     let f = |x: f64| format!("{x:.9}");
-    for m in &data.measurements {
+    for (k, m) in data.measurements.iter().enumerate() {
         let mut row = vec![data.config_ids[m.config].clone()];
         if stations {
             row.push(data.stations[data.station_of(m.config)].clone());
@@ -736,6 +748,9 @@ pub fn write_string(data: &Dataset, model: &Model) -> Result<String, Error> {
         }
         if any_temperature {
             row.push(m.covariates.temperature_c.map(f).unwrap_or_default());
+        }
+        if let Some(more) = rows.get(k) {
+            row.extend(more.iter().cloned());
         }
         w.row(&row);
     }

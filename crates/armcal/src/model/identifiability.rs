@@ -150,6 +150,58 @@ pub struct Identifiability {
     pub excluded: Vec<Exclusion>,
 }
 
+/// An identifiable set counted the one way `model` and `identify` state it: the geometric
+/// parameters, which the generic count ([`expected_count`]) covers, and the non-geometric
+/// terms (joint compliance, periodic gear errors) apart.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct IdentifiableCount {
+    /// Geometric parameters (kinematic, frames, targets).
+    pub geometric: usize,
+    /// Non-geometric terms ([`Model::is_joint_correction`]).
+    pub nongeometric: usize,
+}
+
+impl IdentifiableCount {
+    /// The count of the parameters `set` (registry indices of `model`).
+    pub fn of(model: &Model, set: impl IntoIterator<Item = usize>) -> IdentifiableCount {
+        let (mut geometric, mut nongeometric) = (0, 0);
+        for i in set {
+            if model.is_joint_correction(i) {
+                nongeometric += 1;
+            } else {
+                geometric += 1;
+            }
+        }
+        IdentifiableCount {
+            geometric,
+            nongeometric,
+        }
+    }
+}
+
+impl std::fmt::Display for IdentifiableCount {
+    /// `31 geometric parameters` and, with terms, ` + 15 non-geometric terms`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} geometric parameters", self.geometric)?;
+        if self.nongeometric > 0 {
+            write!(f, " + {} non-geometric terms", self.nongeometric)?;
+        }
+        Ok(())
+    }
+}
+
+impl Identifiability {
+    /// Its identifiable set counted as [`IdentifiableCount`] (`model`: the model analysed).
+    pub fn count(&self, model: &Model) -> IdentifiableCount {
+        IdentifiableCount::of(
+            model,
+            self.identifiable
+                .iter()
+                .filter_map(|n| model.registry.index_of(n)),
+        )
+    }
+}
+
 /// Number of parameters a measurement type can identify for a model in generic geometry,
 /// where the book gives a count: `4R + 2P + 6` for a full pose; `4R + 2P + 3` for the
 /// position of one point (the tool orientation is not measured, book §4.7, Prop. 4.7.3);

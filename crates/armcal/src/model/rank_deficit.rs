@@ -52,7 +52,7 @@ impl std::fmt::Display for RankDeficit {
 }
 
 /// The rank deficit of `model` (its free parameters, at `params`) when `identifiable`
-/// parameters were found identifiable for measurement type `m`, or `None` when that is the
+/// geometric parameters ([`identifiability::IdentifiableCount`]) were found identifiable for measurement type `m`, or `None` when that is the
 /// generic count (or the measurement type has none, e.g. several point targets).
 /// `configurations`: the data's joint values, if the count came from data.
 pub fn rank_deficit(
@@ -146,8 +146,11 @@ pub fn rank_deficit(
     };
     // The data: fewer than random configurations of the same model separate.
     if let Some(qs) = configurations {
-        let generic = identifiability::analyze(model, params, &opts)?;
-        if generic.identifiable.len() > identifiable {
+        // geometric against geometric: `identifiable` counts no non-geometric term
+        let generic = identifiability::analyze(model, params, &opts)?
+            .count(model)
+            .geometric;
+        if generic > identifiable {
             let still: Vec<String> = (0..model.dof())
                 .filter_map(|k| {
                     let (lo, hi) = qs.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, q| {
@@ -161,12 +164,12 @@ pub fn rank_deficit(
                 })
                 .collect();
             causes.push(format!(
-                "these {} configurations separate {} parameters where spread-out poses separate \
-                 {}: too few or too similar poses{}; measure more poses spread over every \
+                "these {} configurations separate {} geometric parameters where spread-out poses \
+                 separate {}: too few or too similar poses{}; measure more poses spread over every \
                  joint's range (armcal plan chooses them)",
                 qs.len(),
                 identifiable,
-                generic.identifiable.len(),
+                generic,
                 if still.is_empty() {
                     String::new()
                 } else {
@@ -186,7 +189,7 @@ pub fn rank_deficit(
             all.registry.set_status(i, Status::Free);
         }
         let unfixed = identifiability::analyze(&all, params, &opts)?;
-        if unfixed.identifiable.len() > identifiable {
+        if unfixed.count(&all).geometric > identifiable {
             let names: Vec<&str> = fixed
                 .iter()
                 .map(|&i| model.registry.get(i).name.as_str())

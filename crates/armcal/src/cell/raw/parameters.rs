@@ -54,7 +54,7 @@ pub(super) fn parameters(
                 ))
             }
         };
-        let priors = pattern_sigmas(ctx, &span, "parameters.priors", &p.priors, model)?;
+        let priors = pattern_sigmas(ctx, &span, "parameters.priors", &p.priors, model, false)?;
         if !free.is_empty() {
             // An explicit free list: everything else is fixed, but the compliance and periodic
             // terms the section asks for stay free (unless `fixed` names them).
@@ -84,13 +84,15 @@ pub(super) fn parameters(
 /// `(pattern, σ)` of every entry `pattern = { sigma_<unit> = … }` of `entries` (the field
 /// `field`), σ in the unit of the parameters the pattern matches (internal units). The
 /// error names the entry: a pattern matching nothing or parameters of different units, a
-/// missing or non-positive σ.
+/// missing σ, a negative one, or a zero one unless `zero_allowed` (a fixed parameter's σ 0:
+/// exact; a prior's must be positive).
 fn pattern_sigmas(
     ctx: &Ctx,
     span: &std::ops::Range<usize>,
     field: &str,
     entries: &BTreeMap<String, toml::Table>,
     model: &Model,
+    zero_allowed: bool,
 ) -> Result<Vec<(String, f64)>, Error> {
     let mut sigmas = Vec::new();
     for (name, t) in entries {
@@ -117,8 +119,13 @@ fn pattern_sigmas(
             ));
         }
         let s = sole_unit_value(t, "sigma", unit).map_err(|e| ctx.err(span.clone(), &field, e))?;
-        if s <= 0.0 {
-            return Err(ctx.err(span.clone(), &field, "sigma must be positive"));
+        if s < 0.0 || (s == 0.0 && !zero_allowed) {
+            let why = if zero_allowed {
+                "sigma must be ≥ 0 (0: exact)"
+            } else {
+                "sigma must be positive"
+            };
+            return Err(ctx.err(span.clone(), &field, why));
         }
         sigmas.push((name.clone(), s));
     }
@@ -181,6 +188,7 @@ pub(super) fn fixed_prior(
         "parameters.fixed_priors",
         &p.fixed_priors,
         model,
+        true,
     )? {
         for i in model
             .registry
