@@ -10,6 +10,7 @@
 //! [`simulate`] runs the whole loop against a virtual robot and instrument; [`study`]
 //! compares it with one-shot and random designs over seeded runs.
 
+mod batch;
 pub mod drift;
 pub mod precision;
 pub mod prior;
@@ -30,12 +31,9 @@ use crate::measure::Dataset;
 use crate::model::Segment;
 use crate::progress::Observer;
 use crate::Error;
+use batch::check_batch;
+pub use batch::{StepSettings, JOINT_TOLERANCE};
 use precision::{poses_needed, predicted_sigmas, working_sigmas, WorkingSigma};
-
-/// Joint values of a measured pose may differ from the planned ones by this much by default
-/// (deg, mm for a prismatic joint): `next.csv` holds them to 1e-6, a controller reports its
-/// own ([`step_with`] takes another tolerance).
-pub const JOINT_TOLERANCE: f64 = 0.01;
 
 /// The fewest poses that identify the cell's free set: ⌈n_p / rows per pose⌉.
 pub fn fewest_poses(cell: &Cell) -> Result<usize, Error> {
@@ -257,102 +255,6 @@ pub struct StepResult {
     pub estimate: Option<Estimate>,
 }
 
-/// Checks that `batch` measured exactly the poses of `state.next` but those `settings`
-/// declares unmeasurable: the same ids, joint values within the joint tolerance (deg, mm for
-/// a prismatic joint). The error lists what is missing, extra, declared wrongly or moved.
-fn check_batch(
-    cell: &Cell,
-    state: &CampaignState,
-    batch: &Dataset,
-    settings: &StepSettings,
-) -> Result<(), Error> {
-    let tolerance = settings.joint_tolerance;
-    let declared = |id: &str| settings.unmeasurable.iter().any(|u| u == id);
-    let mut problems = Vec::new();
-    let missing: Vec<&str> = state
-        .next
-        .iter()
-        .filter(|p| !batch.config_ids.contains(&p.id) && !declared(&p.id))
-        .map(|p| p.id.as_str())
-        .collect();
-    if !missing.is_empty() {
-        problems.push(format!(
-            "missing poses {} (measure them, or declare the ones the instrument cannot \
-             measure with `campaign step --unmeasurable`)",
-            missing.join(", ")
-        ));
-    }
-    let unknown: Vec<&str> = settings
-        .unmeasurable
-        .iter()
-        .filter(|id| !state.next.iter().any(|p| &p.id == *id))
-        .map(String::as_str)
-        .collect();
-    if !unknown.is_empty() {
-        problems.push(format!(
-            "poses declared unmeasurable but not in next.csv: {}",
-            unknown.join(", ")
-        ));
-    }
-    let both: Vec<&str> = settings
-        .unmeasurable
-        .iter()
-        .filter(|id| batch.config_ids.contains(id))
-        .map(String::as_str)
-        .collect();
-    if !both.is_empty() {
-        problems.push(format!(
-            "poses both measured and declared unmeasurable: {}",
-            both.join(", ")
-        ));
-    }
-    let extra: Vec<&str> = batch
-        .config_ids
-        .iter()
-        .filter(|id| !state.next.iter().any(|p| &p.id == *id))
-        .map(String::as_str)
-        .collect();
-    if !extra.is_empty() {
-        problems.push(format!("poses not in next.csv: {}", extra.join(", ")));
-    }
-    for (id, q) in batch.config_ids.iter().zip(&batch.configurations) {
-        let Some(planned) = state.next.iter().find(|p| &p.id == id) else {
-            continue;
-        };
-        let measured = CampaignPose::of(&cell.model, id.clone(), q);
-        let worst = measured
-            .joints
-            .iter()
-            .zip(&planned.joints)
-            .zip(&cell.model.joints)
-            .map(|((a, b), j)| ((a - b).abs(), j.name.as_str()))
-            .max_by(|a, b| a.0.total_cmp(&b.0));
-        if let Some((d, joint)) = worst.filter(|w| w.0 > tolerance) {
-            problems.push(format!(
-                "pose {id}: joint `{joint}` is {d:.4} from the planned value (more than the joint tolerance {tolerance}; `campaign step --joint-tolerance-deg` sets it)"
-            ));
-        }
-    }
-    if batch.measurements.is_empty() {
-        problems.push("no measurements".into());
-    }
-    if problems.is_empty() {
-        return Ok(());
-    }
-    Err(Error::Input(format!(
-        "{}: not the batch of next.csv ({} poses, ids {}): {}; measure exactly the poses of next.csv but those declared unmeasurable",
-        batch.source,
-        state.next.len(),
-        state
-            .next
-            .iter()
-            .map(|p| p.id.as_str())
-            .collect::<Vec<_>>()
-            .join(", "),
-        problems.join("; ")
-    )))
-}
-
 /// Takes the measured batch `batch` (the poses of `state.next`): identifies the free
 /// parameters on everything measured (warm start from the last converged fit), computes
 /// the TCP precision at every working pose ([`precision`]), and decides: stop when every
@@ -368,29 +270,6 @@ pub fn step(
     observer: &mut dyn Observer,
 ) -> Result<StepResult, Error> {
     step_with(cell, state, batch, &StepSettings::default(), observer)
-}
-
-/// How [`step_with`] takes a batch.
-#[derive(Clone, Debug, PartialEq)]
-pub struct StepSettings {
-    /// The measured joint values may differ from the planned ones by this (deg, mm for a
-    /// prismatic joint; a finite number ≥ 0): a controller that reports its joints to 0.05°
-    /// needs 0.05. Default [`JOINT_TOLERANCE`].
-    pub joint_tolerance: f64,
-    /// Ids of `next.csv` poses the instrument could not measure (the beam blocked, the
-    /// reflector turned past its acceptance angle on the real cell): the batch lacks them,
-    /// the step records them ([`CampaignStep::unmeasurable`]) and the campaign goes on
-    /// without them. At least one pose of the batch must be measured.
-    pub unmeasurable: Vec<String>,
-}
-
-impl Default for StepSettings {
-    fn default() -> Self {
-        StepSettings {
-            joint_tolerance: JOINT_TOLERANCE,
-            unmeasurable: Vec::new(),
-        }
-    }
 }
 
 /// [`step`] with the joint tolerance and the unmeasurable poses of `settings`.

@@ -210,55 +210,84 @@ fn the_fewest_poses_batch_is_fittable_at_the_robot_measured() {
     }
 }
 
-/// A pose the virtual instrument cannot measure for its incidence is left out, declared
-/// unmeasurable, and the campaign goes on (it stopped the whole run before): on virtual robot
-/// 166 of the paper cell (the tracker placed with σ 20 mm, as `campaign simulate` does) the
-/// 14-pose fit of step 2 puts the tracker 160 mm off (3σ), and poses 17 and 18 of batch 3,
-/// planned at most 28° there, meet the true reflector at 30.2–30.3°. The step records them,
-/// fits the three measured, and numbers the next batch on after every id it issued.
+/// A pose the virtual instrument cannot measure for its incidence or line of sight is left
+/// out, declared unmeasurable, and the campaign goes on (it stopped the whole run before;
+/// robot 166 of the paper cell, the tracker placed with σ 20 mm, stopped at batch 3). With the
+/// virtual tracker placed 150 mm off per axis (σ), the first batch, planned where the cell
+/// puts the tracker, meets the reflector beyond 30° at some poses: each step records them,
+/// fits the rest, and numbers the next batch on after every id it issued.
 #[test]
 fn a_pose_the_instrument_cannot_measure_is_left_out_and_recorded() {
     let cell = paper_cell();
-    let settings = CampaignSettings {
-        target_sigma_mm: 0.6,
-        batch: 5,
-        budget: Some(22),
-        seed: 166,
-        ..CampaignSettings::default()
-    };
     let perturbation = Perturbation {
-        instrument_length: Some(20.0),
+        instrument_length: Some(150.0),
         ..Perturbation::default()
     };
-    let run =
-        campaign::simulate(&cell, "paper", &settings, &perturbation, 166, &mut Silent).unwrap();
-    let s = &run.state;
-    let skipped: Vec<(usize, Vec<&str>)> = s
-        .steps
-        .iter()
-        .enumerate()
-        .filter(|(_, st)| !st.unmeasurable.is_empty())
-        .map(|(k, st)| {
-            (
-                k + 1,
-                st.unmeasurable.iter().map(|p| p.id.as_str()).collect(),
-            )
-        })
-        .collect();
-    assert_eq!(skipped, [(3, vec!["17", "18"])]);
-    let step3 = &s.steps[2];
-    let measured: Vec<&str> = step3.poses.iter().map(|p| p.id.as_str()).collect();
-    assert_eq!(measured, ["15", "16", "19"]);
-    assert_eq!(step3.measured, 17);
-    assert!(step3
-        .data
-        .config_ids
-        .iter()
-        .all(|id| id != "17" && id != "18"));
-    let step4_ids: Vec<&str> = s.steps[3].poses.iter().map(|p| p.id.as_str()).collect();
-    assert_eq!(step4_ids, ["20", "21", "22", "23", "24"]);
-    // the state with the unmeasurable poses reads back
-    let back = CampaignState::from_json(&s.to_json().unwrap(), "state").unwrap();
-    let ids = |p: &[campaign::CampaignPose]| p.iter().map(|p| p.id.clone()).collect::<Vec<_>>();
-    assert_eq!(ids(&back.steps[2].unmeasurable), ids(&step3.unmeasurable));
+    let mut skipped_runs = 0;
+    for seed in 1..=4u64 {
+        let settings = CampaignSettings {
+            target_sigma_mm: 0.6,
+            batch: 5,
+            budget: Some(19),
+            seed,
+            ..CampaignSettings::default()
+        };
+        // a batch with no measurable pose, or one in collision, stops a run: not this test's
+        let Ok(run) =
+            campaign::simulate(&cell, "paper", &settings, &perturbation, seed, &mut Silent)
+        else {
+            continue;
+        };
+        let s = &run.state;
+        let mut issued = 0;
+        for st in &s.steps {
+            let ids: Vec<usize> = st
+                .poses
+                .iter()
+                .chain(&st.unmeasurable)
+                .map(|p| p.id.parse().unwrap())
+                .collect();
+            // numbered on after every id issued before, the unmeasurable ones included
+            assert_eq!(
+                ids.iter().min(),
+                Some(&(issued + 1)),
+                "seed {seed}: {ids:?}"
+            );
+            issued += ids.len();
+            for u in &st.unmeasurable {
+                assert!(
+                    !st.data.config_ids.contains(&u.id),
+                    "seed {seed}: pose {} measured",
+                    u.id
+                );
+            }
+        }
+        assert_eq!(
+            s.measured()
+                + s.steps
+                    .iter()
+                    .map(|st| st.unmeasurable.len())
+                    .sum::<usize>(),
+            issued
+        );
+        if s.steps.iter().any(|st| !st.unmeasurable.is_empty()) {
+            skipped_runs += 1;
+            let back = CampaignState::from_json(&s.to_json().unwrap(), "state").unwrap();
+            let ids = |st: &campaign::CampaignStep| {
+                st.unmeasurable
+                    .iter()
+                    .map(|p| p.id.clone())
+                    .collect::<Vec<_>>()
+            };
+            assert!(back
+                .steps
+                .iter()
+                .zip(&s.steps)
+                .all(|(a, b)| ids(a) == ids(b)));
+        }
+    }
+    assert!(
+        skipped_runs > 0,
+        "no run left a pose out: the test does not test"
+    );
 }
