@@ -71,6 +71,7 @@ mod real_data {
     mod motoman_calibration;
     mod motoman_nominal;
     mod motoman_nongeometric;
+    mod solver_convergence;
     mod ur10_cubes;
     mod ur10_import;
     mod ur10_nongeometric;
