@@ -18,6 +18,7 @@ mod identify {
     mod estimate_branch;
     mod estimate_checks;
     mod fitted_ranges;
+    mod frames_first;
     mod frames_refit;
     mod honest_free_set;
     mod identification;
