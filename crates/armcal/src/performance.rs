@@ -8,7 +8,7 @@
 //!   joints it reports. The measurements are in the instrument's frame, which the nominal
 //!   robot does not know: its instrument, base, tool and target frames are fitted to these
 //!   data first, the robot's own parameters kept nominal ("nominal + frames fitted", as
-//!   `identify` reports it, [`frames_first_start`]). So AP before is the best the uncalibrated
+//!   `identify` reports it, [`frames_only_fit`]). So AP before is the best the uncalibrated
 //!   robot can do once its set-up is measured; it absorbs whatever part of the robot's error
 //!   a frame can, more so the fewer poses the test has.
 //! * **after**: the calibrated model's prediction at the same joints, i.e. the pose a
@@ -22,7 +22,7 @@
 use crate::accuracy::report::{accuracy_report, AccuracyReport, Orientation};
 use crate::accuracy::same_pose::{commanded_poses, GroupingSummary, SamePose};
 use crate::cell::Cell;
-use crate::identify::{frames_first_start, IdentifySettings};
+use crate::identify::{frames_only_fit, IdentifySettings};
 use crate::measure::Dataset;
 use crate::progress::Observer;
 use crate::Error;
@@ -90,7 +90,7 @@ pub fn performance(
     );
     observer.finish();
     observer.start("frames of the nominal robot", None);
-    let frames = frames_first_start(model, data, &cell.noise(), &IdentifySettings::default());
+    let frames = frames_only_fit(model, data, &cell.noise(), &IdentifySettings::default());
     observer.finish();
     let report =
         |params: &[f64]| accuracy_report(model, params, data, &poses, settings.orientation);

@@ -37,7 +37,9 @@ pub use estimate::{
 pub use fingerprint::ModelFingerprint;
 pub use fit_checks::FitChecks;
 use frames_first::frames_model;
-pub use frames_first::{frames_first_start, frames_only, is_frame_parameter};
+pub use frames_first::{
+    frames_first_start, frames_only, frames_only_fit, is_frame_parameter, DETERMINED_VIF,
+};
 pub use gauss_newton::gauss_newton;
 pub use kalman::{kalman_filter, KalmanSettings};
 pub use lm::{levenberg_marquardt, LmSettings};

@@ -61,6 +61,16 @@ pub struct ToleranceSettings {
     pub xtol: f64,
     /// Largest cosine between the residual and a Jacobian column (MINPACK's gtol).
     pub gtol: f64,
+    /// Levenberg–Marquardt also stops when what remains of the way to the minimum moves no
+    /// parameter by more than this fraction of its standard deviation σᵢ (the Gauss–Newton
+    /// step's `‖Jδ‖` in the whitened residual, corrected for the observed contraction;
+    /// [`super::levenberg_marquardt`]).
+    #[serde(default = "default_sigma_step")]
+    pub sigma_step: f64,
+}
+
+fn default_sigma_step() -> f64 {
+    1e-4
 }
 
 impl Default for ToleranceSettings {
@@ -70,6 +80,7 @@ impl Default for ToleranceSettings {
             ftol: 1e-14,
             xtol: 1e-12,
             gtol: 1e-12,
+            sigma_step: default_sigma_step(),
         }
     }
 }

@@ -3,7 +3,7 @@
 
 use super::held_out::held_out_errors;
 use super::{
-    frames_first_start, holdout_split, residuals, AxisErrors, HeldOutAxes, HeldOutOrientation,
+    frames_only_fit, holdout_split, residuals, AxisErrors, HeldOutAxes, HeldOutOrientation,
     IdentifySettings, Problem, Validation,
 };
 use crate::accuracy::ErrorStats;
@@ -102,7 +102,7 @@ impl<'d> Split<'d> {
         let Some((test, source)) = &self.test else {
             return Ok(None);
         };
-        let frames = frames_first_start(model, &self.train, noise, opts)?;
+        let frames = frames_only_fit(model, &self.train, noise, opts)?;
         let eval = Problem::new(model, test, noise)?;
         let mut ws = eval.workspace();
         let orientation = |ws: &mut super::problem::Workspace, params: &[f64]| {

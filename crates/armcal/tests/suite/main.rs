@@ -18,6 +18,7 @@ mod identify {
     mod estimate_branch;
     mod estimate_checks;
     mod fitted_ranges;
+    mod frames_first;
     mod frames_refit;
     mod honest_free_set;
     mod identification;
@@ -71,6 +72,7 @@ mod real_data {
     mod motoman_calibration;
     mod motoman_nominal;
     mod motoman_nongeometric;
+    mod solver_convergence;
     mod ur10_cubes;
     mod ur10_import;
     mod ur10_nongeometric;

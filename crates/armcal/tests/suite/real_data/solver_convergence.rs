@@ -1,0 +1,227 @@
+//! Real data: the fits of the real data sets converge at the default settings, on seeds
+//! 1–20 of their 70/30 held-out split, within a bounded number of Levenberg–Marquardt
+//! iterations per solver run (issue 30, item 6), and the checks of the fit (units,
+//! blunders, gross misfit) raise no false alarm on them. Every Levenberg–Marquardt run of
+//! a fit counts (the free-set and non-geometric refits); the frames-first stage runs
+//! silently and is not counted. `measure_iterations` prints the table of every set.
+//!
+//! Not checked here: the Motoman non-geometric cells (compliance and periodic terms), whose
+//! first run still takes 111–989 iterations (README "Identification"; the cost keeps falling
+//! by 0.1–2 in ½χ² over hundreds of iterations in the terms the gate then drops, so no stop
+//! rule ends it sooner without moving the estimate by about σ) and whose 40 fits take
+//! 70 s: `measure_iterations` measures them.
+
+use super::motoman_calibration::motoman;
+use super::ur10_stations::{series, ur10_cell};
+use armcal::cell::Cell;
+use armcal::identify::{identify, Estimate, IdentifySettings};
+use armcal::measure::Dataset;
+use armcal::progress::Observer;
+use rayon::prelude::*;
+
+/// Records the iterations of every Levenberg–Marquardt run it observes.
+#[derive(Default)]
+struct Runs {
+    /// Iterations of each finished run.
+    done: Vec<usize>,
+    /// Open tasks: `Some(iterations)` for a solver run.
+    open: Vec<Option<usize>>,
+    /// The lowest cost after each iteration of the current run, and of the longest run.
+    costs: Vec<f64>,
+    longest: Vec<f64>,
+}
+
+impl Observer for Runs {
+    fn start(&mut self, task: &str, _total: Option<usize>) {
+        self.open.push((task == "Levenberg–Marquardt").then_some(0));
+    }
+    fn iteration(&mut self, iteration: usize, _cost: f64, _damping: f64) {
+        if let Some(Some(k)) = self.open.last_mut() {
+            *k = (*k).max(iteration);
+            let low = self.costs.last().map_or(_cost, |c: &f64| c.min(_cost));
+            self.costs.resize(iteration, low);
+            self.costs[iteration - 1] = low;
+        }
+    }
+    fn finish(&mut self) {
+        if let Some(Some(k)) = self.open.pop() {
+            self.done.push(k);
+            if self.costs.len() > self.longest.len() {
+                self.longest = std::mem::take(&mut self.costs);
+            }
+            self.costs.clear();
+        }
+    }
+}
+
+/// The real data sets with their cells `examples/*-cell.toml` (`nongeometric`: the
+/// non-geometric cells `examples/*-nongeometric-cell.toml`).
+fn sets(nongeometric: bool) -> Vec<(String, Cell, Dataset)> {
+    let kind = if nongeometric {
+        "nongeometric-cell"
+    } else {
+        "cell"
+    };
+    let mut sets = Vec::new();
+    for arm in ["right", "left"] {
+        let (cell, data) = motoman(&format!("{arm}-{kind}"), arm);
+        sets.push((format!("motoman {arm} {kind}"), cell, data));
+    }
+    let cell = ur10_cell(&format!("ur10-leica-{kind}"));
+    for s in ["B", "D"] {
+        let data = series(&cell, s);
+        sets.push((format!("ur10 {s} {kind}"), cell.clone(), data));
+    }
+    sets
+}
+
+/// The fit of `data` at the default settings with 30 % held out at random by `seed` and
+/// the iteration limit `max_iterations`, and its solver runs' iterations.
+fn fit(cell: &Cell, data: &Dataset, seed: u64, max_iterations: usize) -> (Estimate, Vec<usize>) {
+    let (est, runs) = fit_runs(cell, data, seed, max_iterations);
+    (est, runs.done)
+}
+
+fn fit_runs(cell: &Cell, data: &Dataset, seed: u64, max_iterations: usize) -> (Estimate, Runs) {
+    let mut opts = IdentifySettings {
+        holdout: 0.3,
+        seed,
+        ..Default::default()
+    };
+    opts.lm.tolerances.max_iterations = max_iterations;
+    let mut runs = Runs::default();
+    let est = identify(cell, data, &opts, &mut runs).unwrap();
+    (est, runs)
+}
+
+/// Every fit of `sets` on `seeds` converges at the default settings, every solver run
+/// within `bound(name)` iterations, and no check of the fit refuses it or names a blunder.
+fn converge_within(
+    sets: Vec<(String, Cell, Dataset)>,
+    seeds: std::ops::RangeInclusive<u64>,
+    bound: impl Fn(&str) -> usize + Sync,
+) {
+    let cases: Vec<(usize, u64)> = (0..sets.len())
+        .flat_map(|s| seeds.clone().map(move |seed| (s, seed)))
+        .collect();
+    let failures: Vec<String> = cases
+        .into_par_iter()
+        .filter_map(|(s, seed)| {
+            let (name, cell, data) = &sets[s];
+            let default = IdentifySettings::default().lm.tolerances.max_iterations;
+            let (est, runs) = fit(cell, data, seed, default);
+            let checks = &est.verdicts.as_ref().unwrap().fit;
+            let ok = est.solver.status.is_converged()
+                && runs.iter().all(|&k| k <= bound(name))
+                && !checks.refuses()
+                && checks.blunders.is_empty();
+            (!ok).then(|| {
+                format!(
+                    "{name} seed {seed}: runs {runs:?}, {}, checks {:?}",
+                    est.solver.status,
+                    checks.reasons()
+                )
+            })
+        })
+        .collect();
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// The kinematic cells of the Motoman arms and the UR10 series B and D: bound 120 on the
+/// Motoman (measured 55–87 right, 11–78 left), 20 on the UR10 (3 and 6). Before the
+/// frames-first start held the undetermined reflector offset and Levenberg–Marquardt
+/// became a trust-region method the right arm needed 101–536 (over the default limit 200
+/// on 13 of 20 seeds: `identify` failed), the left 71–184, the UR10 6–7 and 11–14.
+#[test]
+fn every_kinematic_fit_converges_on_20_seeds_without_a_false_alarm() {
+    converge_within(sets(false), 1..=20, |name| {
+        if name.starts_with("ur10") {
+            20
+        } else {
+            120
+        }
+    });
+}
+
+/// The UR10 non-geometric cells (compliance and periodic terms): bound 20 (measured
+/// 3–4 on series B, 6–7 on D); seeds 1–5 (a B fit takes 2 CPU-s).
+#[test]
+fn ur10_nongeometric_fits_converge_without_a_false_alarm() {
+    let sets = sets(true)
+        .into_iter()
+        .filter(|(name, _, _)| name.starts_with("ur10"))
+        .collect();
+    converge_within(sets, 1..=5, |_| 20);
+}
+
+/// The table of iterations per seed of every real data set (kinematic and non-geometric
+/// cells) with the iteration limit `LM_MAX` (default 2000), and per set the minimum,
+/// median and maximum over the seeds of the longest run; with `LM_TABLE=dir`, every seed's
+/// estimate (free parameters with σ, final cost) to `dir/<set>.txt`:
+/// `LM_MAX=2000 cargo test -p armcal --test suite measure_iterations -- --ignored --nocapture`.
+#[test]
+#[ignore = "a measurement (minutes), not a check"]
+fn measure_iterations() {
+    let max = std::env::var("LM_MAX").map_or(2000, |s| s.parse().unwrap());
+    let out = std::env::var("LM_TABLE").ok();
+    let mut summary = Vec::new();
+    for (name, cell, data) in sets(false).into_iter().chain(sets(true)) {
+        let t = std::time::Instant::now();
+        let rows: Vec<(usize, String, String)> = (1..=20u64)
+            .into_par_iter()
+            .map(|seed| {
+                let (est, all) = fit_runs(&cell, &data, seed, max);
+                let runs = all.done.clone();
+                let c = &all.longest;
+                let trace: Vec<String> = [1usize, 10, 20, 30, 50, 100, 200, 400, 800]
+                    .iter()
+                    .filter(|&&k| k < c.len())
+                    .map(|&k| format!("{k}:{:.2e}", c[k - 1] - c[c.len() - 1]))
+                    .collect();
+                let params: Vec<String> = est
+                    .parameters
+                    .iter()
+                    .filter(|p| p.free)
+                    .map(|p| format!("{} {:.9e} {:.3e}", p.name, p.estimate, p.sigma.unwrap()))
+                    .collect();
+                let fit = est
+                    .verdicts
+                    .as_ref()
+                    .map(|v| v.fit.reasons())
+                    .unwrap_or_default();
+                let line = format!(
+                    "{name} seed {seed}: runs {runs:?} {} cost {:.6e} checks {fit:?} trace {}",
+                    est.solver.status,
+                    est.solver.history.last().unwrap(),
+                    trace.join(" ")
+                );
+                let table = format!(
+                    "seed {seed} cost {:.9e} status {}\n{}\n",
+                    est.solver.history.last().unwrap(),
+                    est.solver.status,
+                    params.join("\n")
+                );
+                (runs.iter().copied().max().unwrap_or(0), line, table)
+            })
+            .collect();
+        for (_, line, _) in &rows {
+            println!("{line}");
+        }
+        if let Some(dir) = &out {
+            let text: String = rows.iter().map(|r| r.2.clone()).collect();
+            std::fs::write(format!("{dir}/{}.txt", name.replace(' ', "-")), text).unwrap();
+        }
+        let mut longest: Vec<usize> = rows.iter().map(|r| r.0).collect();
+        longest.sort();
+        summary.push(format!(
+            "{name}: longest run min {} median {} max {} ({:.1} s)",
+            longest[0],
+            longest[longest.len() / 2],
+            longest[longest.len() - 1],
+            t.elapsed().as_secs_f64()
+        ));
+    }
+    for s in summary {
+        println!("{s}");
+    }
+}
