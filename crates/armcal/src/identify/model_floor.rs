@@ -157,7 +157,15 @@ pub fn model_floor(
                 })
                 .filter(|(_, part)| *part > 1e-9 * kpi)
                 .collect();
-            contributions.sort_by(|a, b| b.1.total_cmp(&a.1));
+            // Largest first, in steps of 1e-9 of the total and then by name: two lengths the
+            // TCP feels alike (equal but for rounding) keep one order between builds.
+            let step = 1e-9 * kpi;
+            contributions.sort_by_cached_key(|(name, part)| {
+                (
+                    std::cmp::Reverse((part / step).round() as i64),
+                    name.clone(),
+                )
+            });
             TcpFloor {
                 name: pose.name.clone(),
                 kpi,
