@@ -7,6 +7,11 @@ use crate::common::{armcal, scratch};
 
 #[test]
 fn a_campaign_steps_through_its_files_and_refuses_a_wrong_batch() {
+    let step = |dir: &str, data: &str, extra: &[&str]| {
+        let mut args = vec!["campaign", "step", dir, "--data", data];
+        args.extend_from_slice(extra);
+        armcal(&args)
+    };
     let dir = scratch("campaign-cli");
     let c = dir.join("c");
     let c_s = c.to_str().unwrap();
@@ -58,13 +63,7 @@ fn a_campaign_steps_through_its_files_and_refuses_a_wrong_batch() {
         std::fs::read_to_string(&state).unwrap(),
         std::fs::read_to_string(&next).unwrap(),
     );
-    let (ok, _, err) = armcal(&[
-        "campaign",
-        "step",
-        c_s,
-        "--data",
-        wrong_path.to_str().unwrap(),
-    ]);
+    let (ok, _, err) = step(c_s, wrong_path.to_str().unwrap(), &[]);
     assert!(!ok);
     assert!(
         err.contains("missing poses 9") && err.contains("poses not in next.csv: 99"),
@@ -97,7 +96,7 @@ fn a_campaign_steps_through_its_files_and_refuses_a_wrong_batch() {
     let moved_path = dir.join("moved.csv");
     std::fs::write(&moved_path, moved.join("\n") + "\n").unwrap();
     let moved_s = moved_path.to_str().unwrap();
-    let (ok, _, err) = armcal(&["campaign", "step", c_s, "--data", moved_s]);
+    let (ok, _, err) = step(c_s, moved_s, &[]);
     assert!(!ok);
     assert!(
         err.contains("joint `q1` is 0.0300 from the planned value")
@@ -110,32 +109,17 @@ fn a_campaign_steps_through_its_files_and_refuses_a_wrong_batch() {
         std::fs::copy(c.join(f), copy.join(f)).unwrap();
     }
     let copy_s = copy.to_str().unwrap();
-    let (ok, out, err) = armcal(&[
-        "campaign",
-        "step",
-        copy_s,
-        "--data",
-        moved_s,
-        "--joint-tolerance-deg",
-        "0.05",
-    ]);
+    let (ok, out, err) = step(copy_s, moved_s, &["--joint-tolerance-deg", "0.05"]);
     assert!(ok, "{err}");
     assert!(out.contains("step 1: 9 poses measured"), "{out}");
-    let (ok, _, err) = armcal(&[
-        "campaign",
-        "step",
-        copy_s,
-        "--data",
-        moved_s,
-        "--joint-tolerance-deg=-1",
-    ]);
+    let (ok, _, err) = step(copy_s, moved_s, &["--joint-tolerance-deg=-1"]);
     assert!(
         !ok && err.contains("joint tolerance -1: give a number ≥ 0"),
         "{err}"
     );
 
     // The right batch: a step, a new next.csv of 5 poses numbered on from 10.
-    let (ok, out, err) = armcal(&["campaign", "step", c_s, "--data", batch.to_str().unwrap()]);
+    let (ok, out, err) = step(c_s, batch.to_str().unwrap(), &[]);
     assert!(ok, "{err}");
     assert!(out.contains("step 1: 9 poses measured"), "{out}");
     assert!(out.contains("measure the next batch"), "{out}");
@@ -148,7 +132,7 @@ fn a_campaign_steps_through_its_files_and_refuses_a_wrong_batch() {
     assert_eq!(ids, ["10", "11", "12", "13", "14"]);
     assert!(c.join("estimate.json").exists());
     // The same batch again is not the new next.csv.
-    let (ok, _, err) = armcal(&["campaign", "step", c_s, "--data", batch.to_str().unwrap()]);
+    let (ok, _, err) = step(c_s, batch.to_str().unwrap(), &[]);
     assert!(!ok);
     assert!(err.contains("missing poses 10, 11, 12, 13, 14"), "{err}");
 
@@ -171,34 +155,18 @@ fn a_campaign_steps_through_its_files_and_refuses_a_wrong_batch() {
     let partial_path = dir.join("partial.csv");
     std::fs::write(&partial_path, partial).unwrap();
     let partial_s = partial_path.to_str().unwrap();
-    let (ok, _, err) = armcal(&["campaign", "step", c_s, "--data", partial_s]);
+    let (ok, _, err) = step(c_s, partial_s, &[]);
     assert!(!ok);
     assert!(
         err.contains("missing poses 12, 13") && err.contains("--unmeasurable"),
         "{err}"
     );
-    let (ok, _, err) = armcal(&[
-        "campaign",
-        "step",
-        c_s,
-        "--data",
-        partial_s,
-        "--unmeasurable",
-        "12,13,77",
-    ]);
+    let (ok, _, err) = step(c_s, partial_s, &["--unmeasurable", "12,13,77"]);
     assert!(
         !ok && err.contains("declared unmeasurable but not in next.csv: 77"),
         "{err}"
     );
-    let (ok, out, err) = armcal(&[
-        "campaign",
-        "step",
-        c_s,
-        "--data",
-        partial_s,
-        "--unmeasurable",
-        "12,13",
-    ]);
+    let (ok, out, err) = step(c_s, partial_s, &["--unmeasurable", "12,13"]);
     assert!(ok, "{err}");
     assert!(out.contains("step 2: 12 poses measured (+3)"), "{out}");
     assert!(

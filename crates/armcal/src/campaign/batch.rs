@@ -46,52 +46,46 @@ pub(super) fn check_batch(
     let tolerance = settings.joint_tolerance;
     let declared = |id: &str| settings.unmeasurable.iter().any(|u| u == id);
     let mut problems = Vec::new();
-    let missing: Vec<&str> = state
-        .next
-        .iter()
-        .filter(|p| !batch.config_ids.contains(&p.id) && !declared(&p.id))
-        .map(|p| p.id.as_str())
-        .collect();
-    if !missing.is_empty() {
-        problems.push(format!(
-            "missing poses {} (measure them, or declare the ones the instrument cannot \
-             measure with `campaign step --unmeasurable`)",
-            missing.join(", ")
-        ));
-    }
-    let unknown: Vec<&str> = settings
-        .unmeasurable
-        .iter()
-        .filter(|id| !state.next.iter().any(|p| &p.id == *id))
-        .map(String::as_str)
-        .collect();
-    if !unknown.is_empty() {
-        problems.push(format!(
-            "poses declared unmeasurable but not in next.csv: {}",
-            unknown.join(", ")
-        ));
-    }
-    let both: Vec<&str> = settings
-        .unmeasurable
-        .iter()
-        .filter(|id| batch.config_ids.contains(id))
-        .map(String::as_str)
-        .collect();
-    if !both.is_empty() {
-        problems.push(format!(
-            "poses both measured and declared unmeasurable: {}",
-            both.join(", ")
-        ));
-    }
-    let extra: Vec<&str> = batch
-        .config_ids
-        .iter()
-        .filter(|id| !state.next.iter().any(|p| &p.id == *id))
-        .map(String::as_str)
-        .collect();
-    if !extra.is_empty() {
-        problems.push(format!("poses not in next.csv: {}", extra.join(", ")));
-    }
+    let mut name = |ids: Vec<&str>, what: &str, then: &str| {
+        if !ids.is_empty() {
+            problems.push(format!("{what}{}{then}", ids.join(", ")));
+        }
+    };
+    let in_next = |id: &str| state.next.iter().any(|p| p.id == id);
+    name(
+        state
+            .next
+            .iter()
+            .map(|p| p.id.as_str())
+            .filter(|id| !batch.config_ids.iter().any(|b| b == id) && !declared(id))
+            .collect(),
+        "missing poses ",
+        " (measure them, or declare the ones the instrument cannot measure with `campaign \
+         step --unmeasurable`)",
+    );
+    let unmeasurable = || settings.unmeasurable.iter().map(String::as_str);
+    name(
+        unmeasurable().filter(|id| !in_next(id)).collect(),
+        "poses declared unmeasurable but not in next.csv: ",
+        "",
+    );
+    name(
+        unmeasurable()
+            .filter(|id| batch.config_ids.iter().any(|b| b == id))
+            .collect(),
+        "poses both measured and declared unmeasurable: ",
+        "",
+    );
+    name(
+        batch
+            .config_ids
+            .iter()
+            .map(String::as_str)
+            .filter(|id| !in_next(id))
+            .collect(),
+        "poses not in next.csv: ",
+        "",
+    );
     for (id, q) in batch.config_ids.iter().zip(&batch.configurations) {
         let Some(planned) = state.next.iter().find(|p| &p.id == id) else {
             continue;
