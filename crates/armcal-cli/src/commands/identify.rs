@@ -370,8 +370,8 @@ pub fn print_summary(e: &Estimate) {
     }
 }
 
-/// What the checks of the fit found: units, blunders, a gross misfit, the sign and zero
-/// diagnosis, and whether a refused fit was accepted.
+/// What the checks of the fit found: units, blunders, a gross misfit, a robot far from its
+/// drawing, the sign and zero diagnosis, and whether a refused fit was accepted.
 fn print_fit_checks(fit: &armcal::identify::FitChecks) {
     for u in &fit.units {
         println!("UNITS ({}): {}", u.subject, u.message);
@@ -385,6 +385,9 @@ fn print_fit_checks(fit: &armcal::identify::FitChecks) {
     }
     if let Some(m) = &fit.misfit {
         println!("MISFIT: {}", m.message);
+    }
+    if let Some(f) = &fit.far {
+        println!("FAR FROM NOMINAL: {}", f.message);
     }
     if let Some(d) = &fit.diagnosis {
         println!("sign and zero diagnosis: {}", d.message);

@@ -14,12 +14,27 @@
 //! residuals are more than 10 times what the stated σ predicts (no instrument's σ is
 //! misstated by that much) and more than any model error. Then the model does not fit the
 //! data: joint signs, zeros or units differ, and the estimate is refused unless accepted.
+//!
+//! **Far from the drawing** ([`FarFromDrawing`], issue 30 item 6): an angle of a link that
+//! carries a joint (the robot proper, not the base, tool, instrument or target frames,
+//! whose nominal placement may be rough) more than 90° from its nominal with no exactly
+//! equivalent parameter set bringing it closer ([`crate::model::branch::FarAngle`] with
+//! nothing in `blocked_by`). A real robot does not differ from its drawing by a quarter
+//! turn; a fit that lands there found another robot that fits the data — with a joint
+//! negated, the mirror image of the nominal (q → −q is conjugation by a half turn about an
+//! axis normal to the joint's: the link's twist flips, e.g. `j1.alpha` −90° for +90°, and
+//! the frame before it turns 180°), which fits to the noise, so no misfit shows. It is as
+//! suspicious as a gross misfit: the sign and zero diagnosis runs and the estimate is
+//! refused unless accepted. An angle an equivalent set would bring within 90° by changing
+//! a fixed parameter is a branch the solver chose, not a different robot: it is not
+//! counted.
 
 use super::sign_diagnosis::{diagnose, SignDiagnosis};
 use super::unit_check::{arm_length, data_scale, fitted_lengths, UnitFinding, PLAUSIBLE_ARM_MM};
 use super::Estimate;
 use crate::measure::{Dataset, NoiseModel};
-use crate::model::Model;
+use crate::model::branch::FarAngle;
+use crate::model::{Model, Segment};
 use crate::Error;
 use serde::{Deserialize, Serialize};
 
@@ -77,6 +92,64 @@ pub struct GrossMisfit {
     pub message: String,
 }
 
+/// The fitted robot differs from its drawing by a quarter turn or more (module doc).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct FarFromDrawing {
+    /// The robot's angles more than 90° from nominal that no equivalent set brings closer.
+    pub angles: Vec<FarAngle>,
+    /// One sentence: the angles, what the sign and zero diagnosis found, what to check.
+    pub message: String,
+}
+
+/// The angles of `far` that belong to a link carrying a joint and that no exactly
+/// equivalent parameter set brings within 90° of nominal (module doc).
+pub fn robot_far_angles(model: &Model, far: &[FarAngle]) -> Vec<FarAngle> {
+    let jointed = |i: usize| {
+        model.registry.get(i).segment == Segment::Chain
+            && model.links.iter().any(|l| {
+                l.joint.is_some() && (l.first_param..l.first_param + l.param_count()).contains(&i)
+            })
+    };
+    far.iter()
+        .filter(|f| f.blocked_by.is_empty())
+        .filter(|f| model.registry.index_of(&f.name).is_some_and(jointed))
+        .cloned()
+        .collect()
+}
+
+/// The far-from-drawing verdict on `angles` (non-empty) with the diagnosis's finding.
+fn far_from_drawing(angles: Vec<FarAngle>, diagnosis: Option<&SignDiagnosis>) -> FarFromDrawing {
+    let listed = angles
+        .iter()
+        .map(|a| {
+            format!(
+                "`{}` = {:.3}° is {:.1}° from its nominal {:.3}°",
+                a.name,
+                a.estimate_deg,
+                (a.estimate_deg - a.nominal_deg).abs(),
+                a.nominal_deg
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    let found = match diagnosis {
+        Some(d) if d.explains => match &d.best {
+            Some(b) => format!(
+                "the data fit the nominal robot with {} ({:.3} mm RMS)",
+                b.words, b.rms_mm
+            ),
+            None => String::new(),
+        },
+        _ => "no joint sign or zero hypothesis explains it; the nominal model's conventions may differ from the controller's".to_string(),
+    };
+    FarFromDrawing {
+        message: format!(
+            "the fitted robot is not the nominal one: {listed}, and no exactly equivalent parameter set brings it within 90° (a real robot does not differ from its drawing by a quarter turn); {found}: check joint signs, zeros and units"
+        ),
+        angles,
+    }
+}
+
 /// What the checks found about the fit as a whole; empty for a fit of the right robot in
 /// the right units.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
@@ -99,6 +172,9 @@ pub struct FitChecks {
     /// Set when the model does not fit the data.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub misfit: Option<GrossMisfit>,
+    /// Set when the fitted robot differs from its drawing by 90° or more.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub far: Option<FarFromDrawing>,
     /// The joint sign and zero diagnosis, when it ran.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub diagnosis: Option<SignDiagnosis>,
@@ -109,9 +185,10 @@ pub struct FitChecks {
 }
 
 impl FitChecks {
-    /// Whether the fit is refused: a gross misfit or a unit mistake.
+    /// Whether the fit is refused: a gross misfit, a robot far from its drawing or a unit
+    /// mistake.
     pub fn refuses(&self) -> bool {
-        self.misfit.is_some() || !self.units.is_empty()
+        self.misfit.is_some() || self.far.is_some() || !self.units.is_empty()
     }
 
     /// Why the fit is refused, one sentence per finding; empty when it is not.
@@ -125,6 +202,7 @@ impl FitChecks {
             )
         });
         let misfit = self.misfit.iter().map(|m| m.message.clone());
+        let far = self.far.iter().map(|f| f.message.clone());
         let diagnosis = self
             .diagnosis
             .iter()
@@ -132,15 +210,16 @@ impl FitChecks {
         units
             .chain(blunders)
             .chain(misfit)
+            .chain(far)
             .chain(diagnosis)
             .collect()
     }
 }
 
 /// The checks of the fit `estimate` of `model` (the cell's model with the data's stations)
-/// to `data` (the fitted part): the diagnosis runs when the misfit fires unexplained by a
-/// unit or a blunder, or when `diagnose_signs`; `accepted` is recorded when the fit is
-/// refused.
+/// to `data` (the fitted part): the diagnosis runs when the misfit or the far-from-drawing
+/// verdict fires unexplained by a unit or a blunder, or when `diagnose_signs`; `accepted`
+/// is recorded when the fit is refused.
 pub fn check(
     model: &Model,
     data: &Dataset,
@@ -206,12 +285,18 @@ pub fn check(
             rows_words(&worst_rows)
         ),
     });
-    let unexplained = misfit.is_some() && units.is_empty() && blunders.is_empty();
+    let far_angles = robot_far_angles(model, &estimate.far_from_nominal);
+    let suspicious = misfit.is_some() || !far_angles.is_empty();
+    let unexplained = suspicious && units.is_empty() && blunders.is_empty();
     let diagnosis = if unexplained || diagnose_signs {
-        Some(diagnose(model, data, noise, plausible_mm, rms_mm)?)
+        // a fit far from the drawing fits another robot: its RMS is no baseline for the
+        // hypotheses, which keep the drawing
+        let near = far_angles.is_empty().then_some(rms_mm);
+        Some(diagnose(model, data, noise, plausible_mm, near)?)
     } else {
         None
     };
+    let far = (!far_angles.is_empty()).then(|| far_from_drawing(far_angles, diagnosis.as_ref()));
     let mut checks = FitChecks {
         arm_mm,
         plausible_mm,
@@ -219,6 +304,7 @@ pub fn check(
         blunders,
         worst_rows,
         misfit,
+        far,
         diagnosis,
         accepted: None,
     };

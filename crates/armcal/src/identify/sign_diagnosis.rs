@@ -15,7 +15,9 @@
 //! as read — the smaller of the quick fit's and the full calibration's (a quick fit of the
 //! data as read may stop in a local minimum that another hypothesis's start avoids: on the
 //! Motoman left-arm data, 31.6 mm as read against 0.11 mm with `e` shifted by +90°, while
-//! the full calibration leaves 0.07 mm).
+//! the full calibration leaves 0.07 mm). A full calibration that ended far from the
+//! drawing ([`super::fit_checks::FarFromDrawing`]) fitted another robot — the mirror image
+//! a negated joint makes fits to the noise — and is no baseline: the quick fit's alone is.
 
 use super::{
     frames_model, frames_only, levenberg_marquardt, LmSettings, Problem, ToleranceSettings,
@@ -100,8 +102,9 @@ pub struct HypothesisFit {
 pub struct SignDiagnosis {
     /// The quick fit of the data as read.
     pub as_read: HypothesisFit,
-    /// The residual RMS of the full calibration of the data as read (mm).
-    pub fit_rms_mm: f64,
+    /// The residual RMS of the full calibration of the data as read (mm); `None` when it
+    /// is no baseline (a fit far from the drawing, module doc).
+    pub fit_rms_mm: Option<f64>,
     /// The hypothesis with the smallest RMS.
     pub best: Option<HypothesisFit>,
     /// Whether `best` explains the data (module doc).
@@ -188,13 +191,14 @@ fn score(
 
 /// Tries every hypothesis on `data` for `model` (the cell's model with the data's stations)
 /// and reports the one that explains the data, if any, within `tolerance_mm` (the plausible
-/// model error); `fit_rms_mm` is the full calibration's residual RMS of the data as read.
+/// model error); `fit_rms_mm` is the full calibration's residual RMS of the data as read,
+/// `None` when that calibration is no baseline (module doc).
 pub fn diagnose(
     model: &Model,
     data: &Dataset,
     noise: &NoiseModel,
     tolerance_mm: f64,
-    fit_rms_mm: f64,
+    fit_rms_mm: Option<f64>,
 ) -> Result<SignDiagnosis, Error> {
     let step = data
         .configurations
@@ -228,7 +232,7 @@ pub fn diagnose(
         .into_par_iter()
         .filter_map(fit)
         .min_by(|a, b| a.rms_mm.total_cmp(&b.rms_mm));
-    let baseline = as_read.rms_mm.min(fit_rms_mm);
+    let baseline = fit_rms_mm.map_or(as_read.rms_mm, |f| as_read.rms_mm.min(f));
     let explains = best
         .as_ref()
         .is_some_and(|b| b.rms_mm <= tolerance_mm && b.rms_mm < 0.5 * baseline);

@@ -249,6 +249,10 @@ pub struct FarAngle {
     /// Sentence saying whether an equivalent within 90° exists and which fixed parameters
     /// it would change.
     pub reason: String,
+    /// The fixed parameters (or ones with a prior) an equivalent within 90° would change;
+    /// empty when no exactly equivalent parameter set brings the angle within 90°.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub blocked_by: Vec<String>,
 }
 
 /// The equivalent parameter vector nearest the nominal.
@@ -338,7 +342,8 @@ pub fn nearest_branch(model: &Model, params: &[f64]) -> NearestBranch {
         for i in far_idx {
             let p = model.registry.get(i);
             let f = p.unit.display_factor();
-            let reason = if still_far.contains(&i) || blocking.is_empty() {
+            let none = still_far.contains(&i) || blocking.is_empty();
+            let reason = if none {
                 "no exactly equivalent parameter set brings it within 90° of nominal: the fit \
                  differs from the nominal robot here (check the nominal model and the data)"
                     .to_string()
@@ -353,6 +358,11 @@ pub fn nearest_branch(model: &Model, params: &[f64]) -> NearestBranch {
                 estimate_deg: out[i] * f,
                 nominal_deg: p.nominal * f,
                 reason,
+                blocked_by: if none {
+                    Vec::new()
+                } else {
+                    blocking.iter().map(|n| n.to_string()).collect()
+                },
             });
         }
     }

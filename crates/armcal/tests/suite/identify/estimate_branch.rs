@@ -74,7 +74,8 @@ fn unmapped(
 
 /// Two 10 m errors in 40 paper-cell measurements: the robust fits end far from nominal by
 /// whole turns and flipped links (before the trust-region Levenberg–Marquardt: Huber at
-/// j4.theta ≈ −360°, j5.theta ≈ 360°, no flip) and at a flipped j3 (θ ≈ −270°, α ≈ −90° for −90°/90°, with
+/// j4.theta ≈ −360°, j5.theta ≈ 360°, no flip; with the geodesic acceleration Huber's is
+/// far in j3.theta alone, Cauchy's without a flip) and at a flipped j3 (θ ≈ −270°, α ≈ −90° for −90°/90°, with
 /// j4.theta ≈ −180°; Cauchy). Reported: the equivalent parameters with every angle within
 /// 90° of nominal, the same residuals, σ's, flipped correlations and TCP covariance.
 #[test]
@@ -106,7 +107,7 @@ fn an_outlier_no_longer_gives_full_turns_or_flipped_links() {
             })
             .map(|(_, p)| p.name.as_str())
             .collect();
-        assert!(far_before.len() >= 2, "{loss:?}: {far_before:?}");
+        assert!(!far_before.is_empty(), "{loss:?}: {far_before:?}");
 
         let e = identify(&cell, &data, &opts, &mut Silent).unwrap();
         assert!(e.far_from_nominal.is_empty(), "{:?}", e.far_from_nominal);
@@ -141,11 +142,10 @@ fn an_outlier_no_longer_gives_full_turns_or_flipped_links() {
         let signs: Vec<f64> = (0..j0.ncols())
             .map(|c| j1.column(c).dot(&j0.column(c)).signum())
             .collect();
-        // Cauchy: a flipped link (Huber's fit lands on one too since Levenberg–Marquardt
-        // became a trust-region method; whole turns remain, `far_before`).
-        if loss == Loss::Cauchy {
-            assert!(signs.iter().any(|&s| s < 0.0), "{loss:?}");
-        }
+        // Whether a fit lands on a flipped link depends on the solver's path (Cauchy's did
+        // before the geodesic acceleration, Huber's with the trust region alone; now neither,
+        // whole turns remain, `far_before`); a flip's mapping is checked on its own in
+        // `model::branch` (`flipped_and_turned_estimates_map_back`).
         for (c, s) in signs.iter().enumerate() {
             let d = (j1.column(c) - j0.column(c) * *s).norm();
             assert!(d <= 1e-8 * j0.column(c).norm(), "{loss:?} column {c}");

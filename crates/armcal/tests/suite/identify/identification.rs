@@ -237,8 +237,10 @@ fn every_method_from_an_unplaced_tracker_reaches_lms_estimate_on_precise_data() 
         for other in &est[1..] {
             for (a, b) in lm.parameters.iter().zip(&other.parameters) {
                 if let Some(sigma) = a.sigma {
+                    // Levenberg–Marquardt stops within 1e-4 σ of the minimum (its σ rule),
+                    // the others tighter
                     assert!(
-                        (a.estimate - b.estimate).abs() <= 1e-6 * sigma,
+                        (a.estimate - b.estimate).abs() <= 1e-4 * sigma,
                         "frames only {frames_only}, {:?} {}: {} vs LM {} (σ {sigma})",
                         other.solver.method,
                         a.name,

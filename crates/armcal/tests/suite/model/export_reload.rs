@@ -72,7 +72,8 @@ fn every_cell_export_identifies_again_to_the_same_fit() {
             // The same parameterisation: the same estimate, parameter by parameter.
             for p in &again.parameters {
                 let q = est.parameters.iter().find(|q| q.name == p.name).unwrap();
-                let tol = 1e-9 * q.estimate.abs().max(1.0);
+                // each fit stops within 1e-4 σ of the minimum (Levenberg–Marquardt's σ rule)
+                let tol = (1e-9 * q.estimate.abs().max(1.0)).max(2e-4 * q.sigma.unwrap_or(0.0));
                 assert!(
                     (p.estimate - q.estimate).abs() <= tol,
                     "{}: {} vs {}",
