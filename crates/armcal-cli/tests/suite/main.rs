@@ -15,6 +15,7 @@ mod error_causes;
 mod estimate_checks;
 mod fitted_ranges_cli;
 mod fixed_priors_export_cli;
+mod guide_links;
 mod identifiable_count_cli;
 mod import_cli;
 mod instrument_offset_cli;

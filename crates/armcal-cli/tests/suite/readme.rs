@@ -1,9 +1,15 @@
-//! README transcripts are real (issue 12 item 11): every ```` ```text ```` block of README.md
-//! whose lines start with `$ ` is run, in document order, in one scratch folder that sees the
-//! repository's `examples/` and `data/`, and each command's output (stdout and stderr, as a
-//! terminal shows them) must be what README prints under it.
+//! README and user-guide transcripts are real (issue 12 item 11, issue 31): every
+//! ```` ```text ```` block of README.md and of every page of the guide (`docs/src/`, the pages
+//! in `SUMMARY.md` order) whose lines start with `$ ` is run, and each command's output
+//! (stdout and stderr, as a terminal shows them) must be what the page prints under it.
 //!
-//! README may leave out lines: a line that is only `…` stands for any number of lines, and a
+//! README runs in a scratch folder of its own (a newcomer's first commands); the guide's pages
+//! run one after another in one shared scratch folder, in `SUMMARY.md` order, as a reader who
+//! goes through the guide: a page may use what an earlier page wrote (`out/estimate.json` of
+//! "Identify" in "Compensation and exports"), as the tutorial always has, and no page repeats
+//! the setup of the pages before it. Each folder sees the repository's `examples/` and `data/`.
+//!
+//! A page may leave out lines: a line that is only `…` stands for any number of lines, and a
 //! line ending in ` …` for a line that begins with what precedes the `…`. Durations
 //! (`0.55 s`, `0.9 ms`) are compared as "a duration", since they change from run to run.
 
@@ -11,15 +17,15 @@ use super::common::scratch;
 use std::path::Path;
 use std::process::Command;
 
-/// One `$ command` of a README block and the lines README shows under it.
+/// One `$ command` of a page's text block and the lines the page shows under it.
 struct Transcript {
-    /// README line of the command.
+    /// Line of the command.
     line: usize,
     command: String,
     expected: Vec<String>,
 }
 
-/// The transcripts of README's text blocks, in document order.
+/// The transcripts of a page's text blocks, in document order.
 fn transcripts(readme: &str) -> Vec<Transcript> {
     let mut out: Vec<Transcript> = Vec::new();
     let mut in_text_block = false;
@@ -83,7 +89,7 @@ fn without_durations(line: &str) -> String {
     out
 }
 
-/// Whether README's `expected` line stands for the printed line `actual`.
+/// Whether the page's `expected` line stands for the printed line `actual`.
 fn line_matches(expected: &str, actual: &str) -> bool {
     let (e, a) = (without_durations(expected), without_durations(actual));
     match e.strip_suffix(" …") {
@@ -120,59 +126,164 @@ fn transcript_matches(expected: &[String], actual: &[String]) -> bool {
     actual.len() >= at + last.len() && segment_at(last, &actual[actual.len() - last.len()..])
 }
 
-#[test]
-fn readme_transcripts_are_what_the_commands_print() {
-    let root = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."));
-    let readme = std::fs::read_to_string(root.join("README.md")).expect("README.md");
-    let transcripts = transcripts(&readme);
-    let demo = transcripts.iter().any(|t| t.command == "armcal demo");
-    let model = transcripts
-        .iter()
-        .any(|t| t.command.starts_with("armcal model "));
-    assert!(
-        demo && model,
-        "README has the demo's and the model's transcripts"
-    );
+/// The repository's root.
+fn root() -> &'static Path {
+    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+}
 
-    let dir = scratch("readme-transcripts");
+/// The guide's pages (paths relative to `docs/src/`) in the order `SUMMARY.md` lists them.
+fn summary_pages() -> Vec<String> {
+    let summary =
+        std::fs::read_to_string(root().join("docs/src/SUMMARY.md")).expect("docs/src/SUMMARY.md");
+    let mut pages: Vec<String> = Vec::new();
+    for line in summary.lines() {
+        for (k, _) in line.match_indices("](") {
+            let rest = &line[k + 2..];
+            let Some(end) = rest.find(')') else { continue };
+            let page = rest[..end].to_string();
+            if page.ends_with(".md") && !pages.contains(&page) {
+                pages.push(page);
+            }
+        }
+    }
+    pages
+}
+
+/// Every Markdown file under `dir`, relative to `base`, sorted.
+fn markdown_files(base: &Path, dir: &Path) -> Vec<String> {
+    let mut out = Vec::new();
+    for entry in std::fs::read_dir(dir).expect("a folder of the guide") {
+        let path = entry.expect("a folder entry").path();
+        if path.is_dir() {
+            out.extend(markdown_files(base, &path));
+        } else if path.extension().is_some_and(|e| e == "md") {
+            let relative = path.strip_prefix(base).expect("under the base");
+            out.push(relative.to_string_lossy().into_owned());
+        }
+    }
+    out.sort();
+    out
+}
+
+/// The documents whose transcripts run, each as (name shown in failures, text): README.md
+/// alone, then the guide's pages with a `$ armcal` line in `SUMMARY.md` order. A page with
+/// such a line that `SUMMARY.md` does not list (so the reader would never see it, and its place
+/// in the shared folder's order is undefined) or a listed page that does not exist is an error.
+fn guide_documents() -> Vec<(String, String)> {
+    let src = root().join("docs/src");
+    let listed = summary_pages();
+    let has_transcript = |text: &str| !transcripts(text).is_empty();
+    let mut problems = Vec::new();
+    for page in markdown_files(&src, &src) {
+        let text = std::fs::read_to_string(src.join(&page)).expect("a guide page");
+        if has_transcript(&text) && !listed.contains(&page) {
+            problems.push(format!(
+                "docs/src/{page} has `$ ` transcripts but is not in docs/src/SUMMARY.md"
+            ));
+        }
+    }
+    let mut documents = Vec::new();
+    for page in &listed {
+        match std::fs::read_to_string(src.join(page)) {
+            Ok(text) if has_transcript(&text) => documents.push((format!("docs/src/{page}"), text)),
+            Ok(_) => {}
+            Err(e) => problems.push(format!("docs/src/SUMMARY.md lists {page}: {e}")),
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+    documents
+}
+
+/// A scratch folder `name` with `bin/armcal`, `out/` and links to the repository's `examples/`
+/// and `data/`; returns it and the `PATH` that finds `armcal` there.
+fn transcript_folder(name: &str) -> (std::path::PathBuf, String) {
+    let dir = scratch(name);
     let bin = dir.join("bin");
-    std::fs::create_dir_all(bin.join("..").join("out")).expect("out/");
+    std::fs::create_dir_all(dir.join("out")).expect("out/");
     std::fs::create_dir_all(&bin).expect("bin/");
     std::os::unix::fs::symlink(env!("CARGO_BIN_EXE_armcal"), bin.join("armcal")).expect("armcal");
     for folder in ["examples", "data"] {
-        std::os::unix::fs::symlink(root.join(folder).canonicalize().unwrap(), dir.join(folder))
-            .expect("a link to the repository's folder");
+        std::os::unix::fs::symlink(
+            root().join(folder).canonicalize().unwrap(),
+            dir.join(folder),
+        )
+        .expect("a link to the repository's folder");
     }
     let path = format!(
         "{}:{}",
         bin.display(),
         std::env::var("PATH").unwrap_or_default()
     );
+    (dir, path)
+}
 
+/// Runs the transcripts of `documents` in order in the folder `name`; returns a message per
+/// transcript whose output differs, naming the document and line.
+fn run_transcripts(name: &str, documents: &[(String, String)]) -> Vec<String> {
+    let (dir, path) = transcript_folder(name);
     let mut failures = Vec::new();
-    for t in &transcripts {
-        let out = Command::new("sh")
-            .arg("-c")
-            .arg(format!("{} 2>&1", t.command))
-            .current_dir(&dir)
-            .env("PATH", &path)
-            .output()
-            .expect("run sh");
-        let text = String::from_utf8_lossy(&out.stdout);
-        let mut actual: Vec<String> = text.lines().map(str::to_string).collect();
-        while actual.last().is_some_and(|l| l.trim().is_empty()) {
-            actual.pop();
-        }
-        if !transcript_matches(&t.expected, &actual) {
-            failures.push(format!(
-                "README.md line {}: `$ {}`\n--- README shows:\n{}\n--- the command prints:\n{}",
-                t.line,
-                t.command,
-                t.expected.join("\n"),
-                actual.join("\n")
-            ));
+    for (document, text) in documents {
+        for t in transcripts(text) {
+            let out = Command::new("sh")
+                .arg("-c")
+                .arg(format!("{} 2>&1", t.command))
+                .current_dir(&dir)
+                .env("PATH", &path)
+                .output()
+                .expect("run sh");
+            let text = String::from_utf8_lossy(&out.stdout);
+            let mut actual: Vec<String> = text.lines().map(str::to_string).collect();
+            while actual.last().is_some_and(|l| l.trim().is_empty()) {
+                actual.pop();
+            }
+            if !transcript_matches(&t.expected, &actual) {
+                failures.push(format!(
+                    "{document} line {}: `$ {}`\n--- the page shows:\n{}\n--- the command prints:\n{}",
+                    t.line,
+                    t.command,
+                    t.expected.join("\n"),
+                    actual.join("\n")
+                ));
+            }
         }
     }
+    failures
+}
+
+#[test]
+fn readme_and_guide_transcripts_are_what_the_commands_print() {
+    let readme = std::fs::read_to_string(root().join("README.md")).expect("README.md");
+    assert!(
+        transcripts(&readme)
+            .iter()
+            .any(|t| t.command.starts_with("armcal ")),
+        "README has a worked example"
+    );
+    let guide = guide_documents();
+    let commands: Vec<String> = guide
+        .iter()
+        .flat_map(|(_, text)| transcripts(text).into_iter().map(|t| t.command))
+        .collect();
+    assert!(
+        commands.iter().any(|c| c == "armcal demo")
+            && commands.iter().any(|c| c.starts_with("armcal model ")),
+        "the guide has the demo's and the model's transcripts"
+    );
+    eprintln!(
+        "transcripts: README.md and {} guide pages: {}",
+        guide.len(),
+        guide
+            .iter()
+            .map(|(name, _)| name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    // README and the guide in two threads: the two folders share nothing.
+    let readme_run = std::thread::spawn(move || {
+        run_transcripts("readme-transcripts", &[("README.md".to_string(), readme)])
+    });
+    let mut failures = run_transcripts("guide-transcripts", &guide);
+    failures.extend(readme_run.join().expect("README's transcripts"));
     assert!(failures.is_empty(), "{}", failures.join("\n\n"));
 }
 
@@ -209,14 +320,20 @@ fn the_transcript_matcher_checks_what_it_should() {
     );
 }
 
-/// The joint names README's non-geometric examples use (`compliance = ["q2", "q3"]`,
+/// The joint names the non-geometric examples of README and the guide use (`compliance = ["q2", "q3"]`,
 /// `periodic = { joints = [...] }`, `"q2.compliance.elbow"`) are joints of a built-in robot:
 /// a user who copies an example into a cell of a built-in robot gets a cell that loads.
 #[test]
 fn readme_joint_names_are_real_joints() {
-    let readme =
-        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../README.md"))
-            .expect("README.md");
+    let src = root().join("docs/src");
+    let mut documents = vec![(
+        "README.md".to_string(),
+        std::fs::read_to_string(root().join("README.md")).expect("README.md"),
+    )];
+    for page in markdown_files(&src, &src) {
+        let text = std::fs::read_to_string(src.join(&page)).expect("a guide page");
+        documents.push((format!("docs/src/{page}"), text));
+    }
     let joints: Vec<String> = armcal::robots::list()
         .into_iter()
         .flat_map(|(name, _)| armcal::robots::robot(&name).expect("built-in").spec.links)
@@ -225,34 +342,40 @@ fn readme_joint_names_are_real_joints() {
     // The quoted names inside `compliance = [...]` and `joints = [...]`, and the joint of every
     // `"<joint>.compliance.…"` / `<joint>.periodic.…` term.
     let mut named = Vec::new();
-    for (i, line) in readme.lines().enumerate() {
-        for key in ["compliance = [", "periodic = { joints = ["] {
-            for (_, rest) in line
-                .match_indices(key)
-                .map(|(k, _)| line.split_at(k + key.len()))
-            {
-                let list = rest.split(']').next().unwrap_or("");
-                named.extend(
-                    list.split(',')
-                        .map(|n| (i + 1, n.trim().trim_matches('"').to_string())),
-                );
+    for (document, text) in &documents {
+        for (i, line) in text.lines().enumerate() {
+            let at = format!("{document} line {}", i + 1);
+            for key in ["compliance = [", "periodic = { joints = ["] {
+                for (_, rest) in line
+                    .match_indices(key)
+                    .map(|(k, _)| line.split_at(k + key.len()))
+                {
+                    let list = rest.split(']').next().unwrap_or("");
+                    named.extend(
+                        list.split(',')
+                            .map(|n| (at.clone(), n.trim().trim_matches('"').to_string())),
+                    );
+                }
             }
-        }
-        for term in [".compliance.", ".periodic."] {
-            for (k, _) in line.match_indices(term) {
-                let start = line[..k]
-                    .rfind(|c: char| !(c.is_alphanumeric() || c == '_'))
-                    .map_or(0, |s| s + 1);
-                named.push((i + 1, line[start..k].to_string()));
+            for term in [".compliance.", ".periodic."] {
+                for (k, _) in line.match_indices(term) {
+                    let start = line[..k]
+                        .rfind(|c: char| !(c.is_alphanumeric() || c == '_'))
+                        .map_or(0, |s| s + 1);
+                    named.push((at.clone(), line[start..k].to_string()));
+                }
             }
         }
     }
     named.retain(|(_, n)| !n.is_empty() && !n.contains('<') && !n.contains('…'));
-    assert!(named.len() >= 10, "README's examples were found: {named:?}");
+    assert!(
+        named.len() >= 10,
+        "the non-geometric examples of README and the guide were found: {named:?}"
+    );
     let unknown: Vec<String> = named
         .iter()
         .filter(|(_, n)| !joints.contains(n))
-        .map(|(l, n)| format!("README.md line {l}: `{n}`"))
+        .map(|(at, n)| format!("{at}: `{n}`"))
         .collect();
     assert!(
         unknown.is_empty(),
