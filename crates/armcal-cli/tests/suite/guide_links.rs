@@ -126,11 +126,7 @@ fn markdown_ids(text: &str) -> BTreeSet<String> {
         };
         let id = heading_id(&title.replace('`', ""));
         let n = seen.entry(id.clone()).or_insert(0);
-        ids.insert(if *n == 0 {
-            id
-        } else {
-            format!("{id}-{n}")
-        });
+        ids.insert(if *n == 0 { id } else { format!("{id}-{n}") });
         *n += 1;
     }
     ids
@@ -156,7 +152,11 @@ fn is_external(target: &str) -> bool {
 /// or an anchor that is no heading of the page it points into.
 fn markdown_problems(page: &Path, root: &Path) -> Vec<String> {
     let text = with_includes(page);
-    let name = page.strip_prefix(root).unwrap_or(page).display().to_string();
+    let name = page
+        .strip_prefix(root)
+        .unwrap_or(page)
+        .display()
+        .to_string();
     let mut problems = Vec::new();
     for (line, prose) in prose_lines(&text) {
         for target in markdown_links(&prose) {
@@ -217,7 +217,11 @@ fn html_problems(book: &Path, root: &Path) -> Vec<String> {
     let mut problems = Vec::new();
     for page in &pages {
         let html = std::fs::read_to_string(page).expect("a built page");
-        let name = page.strip_prefix(root).unwrap_or(page).display().to_string();
+        let name = page
+            .strip_prefix(root)
+            .unwrap_or(page)
+            .display()
+            .to_string();
         let links = attribute_values(&html, "href")
             .into_iter()
             .chain(attribute_values(&html, "src"));
@@ -242,7 +246,9 @@ fn html_problems(book: &Path, root: &Path) -> Vec<String> {
             if let Some(anchor) = anchor.filter(|a| !a.is_empty()) {
                 let found = ids.get(&file).is_some_and(|ids| ids.contains(anchor));
                 if !found {
-                    problems.push(format!("{name}: `{target}`: no element with the id `{anchor}`"));
+                    problems.push(format!(
+                        "{name}: `{target}`: no element with the id `{anchor}`"
+                    ));
                 }
             }
         }
@@ -260,7 +266,11 @@ fn readme_and_guide_links_reach_files_and_headings() {
         .iter()
         .flat_map(|p| markdown_problems(p, &root))
         .collect();
-    assert!(problems.is_empty(), "broken links:\n{}", problems.join("\n"));
+    assert!(
+        problems.is_empty(),
+        "broken links:\n{}",
+        problems.join("\n")
+    );
 }
 
 #[test]
@@ -276,7 +286,11 @@ fn the_built_guide_has_no_broken_link() {
         return;
     }
     let problems = html_problems(&book, &root);
-    assert!(problems.is_empty(), "broken links in the built guide:\n{}", problems.join("\n"));
+    assert!(
+        problems.is_empty(),
+        "broken links in the built guide:\n{}",
+        problems.join("\n")
+    );
 }
 
 #[test]
@@ -297,7 +311,10 @@ fn the_link_checker_finds_broken_links() {
     .unwrap();
     let problems = markdown_problems(&page, &dir);
     assert_eq!(problems.len(), 2, "{problems:?}");
-    assert!(problems[0].contains("line 4: `missing.md`: no such file"), "{problems:?}");
+    assert!(
+        problems[0].contains("line 4: `missing.md`: no such file"),
+        "{problems:?}"
+    );
     assert!(problems[1].contains("`nowhere`"), "{problems:?}");
 
     let book = dir.join("book");
@@ -311,7 +328,13 @@ fn the_link_checker_finds_broken_links() {
     std::fs::write(book.join("b.html"), "<h2 id=\"x\">B</h2>").unwrap();
     let problems = html_problems(&book, &dir);
     assert_eq!(problems.len(), 2, "{problems:?}");
-    assert!(problems[0].contains("`c.html`: no such file"), "{problems:?}");
+    assert!(
+        problems[0].contains("`c.html`: no such file"),
+        "{problems:?}"
+    );
     assert!(problems[1].contains("`b.html#y`"), "{problems:?}");
-    assert_eq!(heading_id("The model floor: C_s + C_floor (mm²)"), "the-model-floor-c_s--c_floor-mm²");
+    assert_eq!(
+        heading_id("The model floor: C_s + C_floor (mm²)"),
+        "the-model-floor-c_s--c_floor-mm²"
+    );
 }
