@@ -223,6 +223,7 @@ fn run_transcripts(name: &str, documents: &[(String, String)]) -> Vec<String> {
     let (dir, path) = transcript_folder(name);
     let mut failures = Vec::new();
     for (document, text) in documents {
+        let start = std::time::Instant::now();
         for t in transcripts(text) {
             let out = Command::new("sh")
                 .arg("-c")
@@ -246,6 +247,7 @@ fn run_transcripts(name: &str, documents: &[(String, String)]) -> Vec<String> {
                 ));
             }
         }
+        eprintln!("{document}: {:.1} s", start.elapsed().as_secs_f64());
     }
     failures
 }
