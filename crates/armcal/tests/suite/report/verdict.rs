@@ -311,7 +311,7 @@ fn the_page_opens_with_one_verdict_panel_per_estimate() {
         "{panel}"
     );
     assert!(panel.contains(&format!("nothing fitted: RMS {:.3} mm", v.nominal.rms)));
-    let gain = held_out_gain(&est).unwrap();
+    let gain = held_out_gain(est).unwrap();
     assert!((gain - (1.0 - v.calibrated.rms / v.frames_only.rms)).abs() < 1e-12);
     // The TCP σ of the estimate is stated with the model floor beside the measurement term.
     let floor = est.model_floor.as_ref().unwrap().tcp[0].kpi;
