@@ -16,6 +16,23 @@
 //! armcal writes is a typed record of the module that produces it ([`Estimate`],
 //! [`DesignRecord`], …), read by [`report`].
 //!
+//! # Where to read on
+//!
+//! - **The user guide** (`docs/` in the repository, an mdBook: `mdbook serve docs`) holds the
+//!   tutorial, a page per task (model, plan, measure, identify, uncertainty, campaigns,
+//!   compensation, accuracy, reports), the real-data case studies and the reference of every
+//!   file format, convention and error message.
+//! - **Runnable examples** (`crates/armcal/examples/`, `cargo run --release -p armcal
+//!   --example NAME`): `plan_and_calibrate` (plan KPI poses, measure, identify, compare with
+//!   the prediction), `compensate_program` (filter a joint program through the calibrated
+//!   inverse kinematics and check it on the robot), `adaptive_campaign` (measure batch by
+//!   batch until the TCP is precise enough), `accuracy_iso9283` (pose accuracy and
+//!   repeatability).
+//! - The `armcal` command-line tool (crate `armcal-cli`) makes one call of this library per
+//!   command.
+//!
+//! # Example
+//!
 //! ```
 //! use armcal::{calibrated_ik, identify, simulate, Cell, IdentifySettings, IkSettings, IkTarget};
 //! use armcal::compensate::ik::IkWorkspace;
@@ -24,7 +41,7 @@
 //! use armcal::sim::{perturbed_truth, Perturbation};
 //!
 //! # fn main() -> armcal::Result<()> {
-//! let cell = Cell::from_toml(armcal::cell::builtin::PAPER_CELL, "paper-cell.toml", ".".as_ref())?;
+//! let cell = armcal::cell::builtin::paper_cell()?;
 //! let model = &cell.model;
 //! // A virtual robot that differs from its nominal model, measured at 40 random poses.
 //! let truth = perturbed_truth(model, &Perturbation::default(), 7);

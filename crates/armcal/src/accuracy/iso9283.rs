@@ -68,6 +68,24 @@ pub struct Accuracy {
 }
 
 /// ISO 9283 AP. `None` without positions.
+///
+/// ```
+/// use armcal::accuracy::iso9283::{position_accuracy, position_repeatability};
+/// use armcal::nalgebra::Vector3;
+///
+/// let commanded = Vector3::new(1000.0, 0.0, 500.0);
+/// // Three approaches that land 0.3 mm off in x, 0.02 mm apart.
+/// let attained = [
+///     Vector3::new(1000.28, 0.0, 500.0),
+///     Vector3::new(1000.30, 0.02, 500.0),
+///     Vector3::new(1000.32, -0.02, 500.0),
+/// ];
+/// let ap = position_accuracy(&commanded, &attained).unwrap();
+/// assert!((ap.ap - 0.30).abs() < 1e-9 && (ap.apx - 0.30).abs() < 1e-9);
+/// let rp = position_repeatability(&attained).unwrap();
+/// assert!(rp.rp > rp.mean_distance);
+/// assert!(position_accuracy(&commanded, &[]).is_none());
+/// ```
 pub fn position_accuracy(commanded: &Vector3<f64>, attained: &[Vector3<f64>]) -> Option<Accuracy> {
     if attained.is_empty() {
         return None;

@@ -10,3 +10,9 @@ pub const PAPER_CELL: &str = include_str!("../../cells/paper-cell.toml");
 /// The paper's cell with the car body and the wall (`examples/paper-cell-obstacles.toml`,
 /// paper §5.2).
 pub const PAPER_CELL_OBSTACLES: &str = include_str!("../../cells/paper-cell-obstacles.toml");
+
+/// The paper's cell ([`PAPER_CELL`]) parsed: the starting point of the examples and the
+/// demo.
+pub fn paper_cell() -> Result<crate::Cell, crate::Error> {
+    crate::Cell::from_toml(PAPER_CELL, "paper-cell.toml (built in)", ".".as_ref())
+}

@@ -311,7 +311,45 @@ impl Cell {
     }
 
     /// Parses a cell from TOML text; `file` names it in errors, `dir` resolves relative
-    /// paths (URDF).
+    /// paths (URDF). The format, every field with its unit and default, is the guide's
+    /// "Cell file" reference page (`docs/`).
+    ///
+    /// ```
+    /// use armcal::Cell;
+    ///
+    /// // A two-link planar arm written as a DH table (lengths mm, angles deg) and one reflector.
+    /// let text = r#"
+    /// name = "planar"
+    /// [robot]
+    /// name = "planar-2r"
+    /// [[robot.links]]
+    /// convention = "dh"
+    /// joint = "revolute"
+    /// limits = [-170, 170]
+    /// theta_deg = 0
+    /// d_mm = 0
+    /// a_mm = 400
+    /// alpha_deg = 0
+    /// [[robot.links]]
+    /// convention = "dh"
+    /// joint = "revolute"
+    /// limits = [-150, 150]
+    /// theta_deg = 0
+    /// d_mm = 0
+    /// a_mm = 300
+    /// alpha_deg = 0
+    /// [[targets]]
+    /// name = "smr"
+    /// xyz_mm = [50, 0, 0]
+    /// "#;
+    /// let cell = Cell::from_toml(text, "planar.toml", ".".as_ref()).unwrap();
+    /// assert_eq!(cell.model.dof(), 2);
+    ///
+    /// // A mistake is an error naming the file, the line and the field.
+    /// let wrong = text.replace("a_mm = 300", "a_mm = \"300\"");
+    /// let message = Cell::from_toml(&wrong, "planar.toml", ".".as_ref()).unwrap_err().to_string();
+    /// assert!(message.contains("planar.toml"), "{message}");
+    /// ```
     pub fn from_toml(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
         raw::parse(text, file, dir)
     }

@@ -7,8 +7,12 @@
 
 use super::estimate::code_spans;
 use super::html::{escape, facts, fixed, number, Section};
+use crate::accuracy::ErrorStats;
 use crate::design::DesignRecord;
-use crate::identify::{Chi2Outcome, Estimate};
+use crate::identify::model_floor::ModelFloor;
+use crate::identify::uncertainty::TcpCovariance;
+use crate::identify::{is_frame_parameter, Chi2Outcome, Estimate};
+use crate::model::Model;
 use crate::Error;
 
 /// How an estimate or a design fares.
@@ -49,11 +53,33 @@ fn flagged(html: String, grade: Grade) -> String {
     }
 }
 
-/// The held-out improvement `1 − after/before` of the RMS error (`None` without a
-/// validation or with a zero nominal error).
+/// What a calibration's held-out error is compared with: the drawing's kinematics with the
+/// frames (instrument, targets, base, tool) fitted on the same data, when the fit adjusts
+/// more than those frames; the nominal model otherwise (a frames-only cell, where the
+/// frames-only fit is the calibration itself). The nominal model alone is no baseline for a
+/// link calibration: its error is mostly where the instrument stands, which any fit places.
+fn held_out_baseline(e: &Estimate) -> Option<(&'static str, &ErrorStats)> {
+    let v = e.validation.as_ref()?;
+    let calibrates_links = Model::from_spec(&e.model).is_ok_and(|m| {
+        e.free.iter().any(|name| {
+            m.registry
+                .index_of(name)
+                .is_some_and(|i| !is_frame_parameter(&m, i))
+        })
+    });
+    Some(if calibrates_links {
+        ("the drawing's kinematics, frames fitted", &v.frames_only)
+    } else {
+        ("the nominal model", &v.nominal)
+    })
+}
+
+/// The held-out improvement `1 − after/before` of the RMS error over
+/// [`held_out_baseline`] (`None` without a validation or with a zero baseline error).
 pub fn held_out_gain(e: &Estimate) -> Option<f64> {
     let v = e.validation.as_ref()?;
-    (v.nominal.rms > 0.0).then(|| 1.0 - v.calibrated.rms / v.nominal.rms)
+    let (_, before) = held_out_baseline(e)?;
+    (before.rms > 0.0).then(|| 1.0 - v.calibrated.rms / before.rms)
 }
 
 fn estimate_lines(e: &Estimate) -> Vec<Line> {
@@ -88,30 +114,31 @@ fn estimate_lines(e: &Estimate) -> Vec<Line> {
             grade: Grade::Bad,
         },
     });
-    lines.push(match &e.validation {
-        Some(v) => {
-            let worse = v.calibrated.rms > v.nominal.rms;
+    lines.push(match (&e.validation, held_out_baseline(e)) {
+        (Some(v), Some((baseline, before))) => {
+            let worse = v.calibrated.rms > before.rms;
             Line {
                 key: "held-out error",
                 html: format!(
-                    "RMS {} mm before → {} mm after calibration ({}; max {} → {} mm) on {} configurations the fit did not see",
-                    fixed(v.nominal.rms, 3),
+                    "RMS {} mm with {baseline} → {} mm calibrated ({}; max {} → {} mm) on {} configurations the fit did not see; nothing fitted: RMS {} mm",
+                    fixed(before.rms, 3),
                     fixed(v.calibrated.rms, 3),
                     held_out_gain(e)
                         .map(|g| if g >= 0.0 {
                             format!("−{} %", fixed(100.0 * g, 0))
                         } else {
-                            format!("+{} %: worse than the nominal model", fixed(-100.0 * g, 0))
+                            format!("+{} %: worse than {baseline}", fixed(-100.0 * g, 0))
                         })
                         .unwrap_or_else(|| "–".into()),
-                    fixed(v.nominal.max, 3),
+                    fixed(before.max, 3),
                     fixed(v.calibrated.max, 3),
-                    v.test_configurations
+                    v.test_configurations,
+                    fixed(v.nominal.rms, 3)
                 ),
                 grade: if worse { Grade::Check } else { Grade::Good },
             }
         }
-        None => Line {
+        _ => Line {
             key: "held-out error",
             html: "not measured: this estimate was made without held-out or test data, so its accuracy on new poses is unknown".into(),
             grade: Grade::Check,
@@ -197,7 +224,53 @@ fn estimate_lines(e: &Estimate) -> Vec<Line> {
             grade,
         });
     }
+    lines.extend(tcp_lines("TCP σ", &e.tcp, e.model_floor.as_ref()));
     lines
+}
+
+/// The TCP σ at every working pose, `√((1/3) tr C)`: of the measurement term C_s and, when
+/// the fixed parameters have a stated prior, of the total C_s + C_floor
+/// ([`crate::identify::model_floor`]), which is what the TCP is known to; a floor larger
+/// than the measurement term is flagged, since more measurements of this design will not
+/// lower it.
+fn tcp_lines(key: &'static str, tcp: &[TcpCovariance], floor: Option<&ModelFloor>) -> Vec<Line> {
+    tcp.iter()
+        .enumerate()
+        .map(|(k, t)| {
+            let measurement = format!(
+                "{} mm at <em>{}</em> from the measurements ((1/3) tr C_s = {} mm²)",
+                number(t.kpi.sqrt()),
+                escape(&t.name),
+                number(t.kpi)
+            );
+            match floor.and_then(|f| f.tcp.get(k)).filter(|f| f.kpi > 0.0) {
+                Some(f) => {
+                    let grade = if f.kpi > t.kpi {
+                        Grade::Check
+                    } else {
+                        Grade::Good
+                    };
+                    Line {
+                        key,
+                        html: flagged(
+                            format!(
+                                "{} mm with the fixed parameters' model floor ({} mm² of (1/3) tr C_s + C_floor); {measurement}",
+                                number((t.kpi + f.kpi).sqrt()),
+                                number(t.kpi + f.kpi)
+                            ),
+                            grade,
+                        ),
+                        grade,
+                    }
+                }
+                None => Line {
+                    key,
+                    html: measurement,
+                    grade: Grade::Good,
+                },
+            }
+        })
+        .collect()
 }
 
 /// What the checks of the fit found (units, blunders, a gross misfit, the sign and zero
@@ -308,18 +381,11 @@ fn design_lines(d: &DesignRecord) -> Vec<Line> {
             grade: Grade::Bad,
         }
     });
-    for t in &d.assessment.tcp {
-        lines.push(Line {
-            key: "predicted TCP σ",
-            html: format!(
-                "{} mm at <em>{}</em> ((1/3) tr C_s = {} mm²)",
-                number(t.kpi.sqrt()),
-                escape(&t.name),
-                number(t.kpi)
-            ),
-            grade: Grade::Good,
-        });
-    }
+    lines.extend(tcp_lines(
+        "predicted TCP σ",
+        &d.assessment.tcp,
+        d.assessment.model_floor.as_ref(),
+    ));
     if let Some(b) = d.plan.as_ref().and_then(|p| p.bound.as_ref()) {
         lines.push(Line {
             key: "optimality",

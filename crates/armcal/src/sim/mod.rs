@@ -124,6 +124,24 @@ pub fn perturbed_truth(model: &Model, p: &Perturbation, seed: u64) -> Vec<f64> {
 /// point target (or of the tool origin if the model has no targets) and the pose of every
 /// frame target, with noise drawn from `noise` (seeded). Noise-free if `noise` is `None`.
 /// Configuration ids are 1, 2, ….
+///
+/// ```
+/// use armcal::{simulate, Cell};
+/// use armcal::model::random_configurations;
+///
+/// # fn main() -> armcal::Result<()> {
+/// let cell = armcal::cell::builtin::paper_cell()?;
+/// let model = &cell.model;
+/// let poses = random_configurations(model, 10, 1);
+/// // Noise-free measurements of the nominal robot; then the same with the tracker's noise.
+/// let exact = simulate(model, &model.nominal(), &poses, None, 1)?;
+/// let noisy = simulate(model, &model.nominal(), &poses, Some(&cell.noise()), 1)?;
+/// assert_eq!(exact.measurements.len(), 10); // one reflector per pose
+/// assert_eq!(exact.measurements[0].observed, noisy.measurements[0].observed);
+/// assert_ne!(exact.measurements[0].kind, noisy.measurements[0].kind);
+/// # Ok(())
+/// # }
+/// ```
 pub fn simulate(
     model: &Model,
     truth: &[f64],

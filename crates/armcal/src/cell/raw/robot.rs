@@ -59,8 +59,15 @@ pub(super) fn robot(
                 joint_index += 1;
             }
             let field = format!("robot.links[{i}]");
-            let spec =
-                inline_link(l.get_ref(), joint_index).map_err(|e| ctx.err(l.span(), &field, e))?;
+            // An unnamed link is named after its joint (`j3`); an unnamed fixed link after
+            // its place in the list (`fixed4`), so it cannot take its joint's name.
+            let default_name = if has_joint {
+                format!("j{joint_index}")
+            } else {
+                format!("fixed{}", i + 1)
+            };
+            let spec = inline_link(l.get_ref(), default_name, joint_index)
+                .map_err(|e| ctx.err(l.span(), &field, e))?;
             check_values(ctx, std::slice::from_ref(&spec), l.span(), &field)?;
             links.push(spec);
         }
@@ -328,12 +335,17 @@ pub(super) fn tool_capsules(
 }
 
 /// An inline link: `name`, `convention`, the convention's fields with unit suffixes,
-/// optional `joint = "revolute" | "prismatic"`, `limits = [lo, hi]` (deg or mm),
+/// optional `joint = "revolute" | "prismatic" | "fixed"` (default fixed; `limits` without
+/// `joint` is an error), `limits = [lo, hi]` (deg or mm),
 /// `axis = [x, y, z]` for URDF-convention links.
-fn inline_link(t: &toml::Table, index: usize) -> Result<LinkSpec, String> {
+fn inline_link(
+    t: &toml::Table,
+    default_name: String,
+    joint_index: usize,
+) -> Result<LinkSpec, String> {
     let name = string_field(t, "name")?
         .map(str::to_string)
-        .unwrap_or_else(|| format!("j{index}"));
+        .unwrap_or(default_name);
     let conv_name = string_field(t, "convention")?.ok_or("missing `convention`")?;
     let mut convention = Convention::from_name(conv_name).ok_or_else(|| {
         format!(
@@ -346,6 +358,15 @@ fn inline_link(t: &toml::Table, index: usize) -> Result<LinkSpec, String> {
         convention = Convention::MdhBeta;
     }
     let kind = match string_field(t, "joint")? {
+        // Joint limits on a link that names no joint: the user meant a joint, and without
+        // `joint` the link would be fixed (a robot with fewer joints than its data).
+        None if t.contains_key("limits") => {
+            return Err(
+                "`limits` without `joint`: a link without `joint` is fixed; add \
+                 `joint = \"revolute\"` (or \"prismatic\"), or remove `limits` for a fixed link"
+                    .into(),
+            )
+        }
         None | Some("fixed") => None,
         Some("revolute") => Some(JointKind::Revolute),
         Some("prismatic") => Some(JointKind::Prismatic),
@@ -419,7 +440,7 @@ fn inline_link(t: &toml::Table, index: usize) -> Result<LinkSpec, String> {
             let num = |v: &toml::Value| number(v).ok_or("`limits` must hold finite numbers");
             let jname = string_field(t, "joint_name")?
                 .map(str::to_string)
-                .unwrap_or_else(|| format!("q{index}"));
+                .unwrap_or_else(|| format!("q{joint_index}"));
             let joint = Joint {
                 name: jname,
                 kind: k,

@@ -147,6 +147,37 @@ fn errors_name_file_line_and_field() {
     expect_error(&bad, &["j9"]);
 }
 
+/// A link written with `limits` but without `joint` was silently a fixed link (two of them in
+/// a row failed as "frame name `j0` is used twice"): the user meant a joint.
+#[test]
+fn limits_without_a_joint_kind_are_an_error_and_fixed_links_get_their_own_names() {
+    let bad = INLINE.replace("joint = \"revolute\"\n", "");
+    expect_error(
+        &bad,
+        &[
+            "cell.toml",
+            "robot.links[0]",
+            "`limits` without `joint`",
+            "joint = \"revolute\"",
+        ],
+    );
+    // Two unnamed fixed links (a mounting plate and an adapter) before two unnamed joints:
+    // each gets a name of its own, and the joints keep j1, j2.
+    let fixed = "[[robot.links]]\nconvention = \"dh\"\ntheta_deg = 0\nd_mm = 100\na_mm = 0\nalpha_deg = 0\n";
+    let joint = "[[robot.links]]\nconvention = \"dh\"\njoint = \"revolute\"\nlimits = [-90, 90]\ntheta_deg = 0\nd_mm = 0\na_mm = 300\nalpha_deg = 0\n";
+    let text = format!(
+        "name = \"plated\"\n[robot]\nname = \"plated-2r\"\n{fixed}{fixed}{joint}{joint}[[targets]]\nname = \"smr\"\nxyz_mm = [50, 0, 0]\n"
+    );
+    let cell = parse(&text).unwrap();
+    assert_eq!(cell.model.dof(), 2);
+    for name in ["fixed1.d", "fixed2.d", "j1.a", "j2.a"] {
+        assert!(
+            cell.model.registry.index_of(name).is_some(),
+            "no parameter `{name}`"
+        );
+    }
+}
+
 #[test]
 fn working_pose_outside_limits_is_kept_with_a_warning() {
     let text = INLINE.replace("joints_deg = [10, 150]", "joints_deg = [10, 400]");

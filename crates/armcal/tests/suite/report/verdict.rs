@@ -15,7 +15,7 @@ use armcal::report::figures::{colour, design_colour, ellipse_figure, EllipseSeri
 use armcal::report::files::files_report;
 use armcal::report::parameter_charts::{correlation_colour, heatmap_figure};
 use armcal::report::parameter_view::{change_over_sigma, correlation, estimate_minus_truth};
-use armcal::report::verdict::{estimate_grade, Grade};
+use armcal::report::verdict::{estimate_grade, held_out_gain, Grade};
 use armcal::report::{self, design_key, Document, Input, ReportContent};
 use armcal::sim::{perturbed_truth, Perturbation, TruthRecord};
 use nalgebra::{DMatrix, Matrix3};
@@ -300,7 +300,30 @@ fn the_page_opens_with_one_verdict_panel_per_estimate() {
     ] {
         assert!(panel.contains(&format!("<th>{key}</th>")), "{key}");
     }
-    assert!(panel.contains("before →") || panel.contains("mm before"));
+    // The held-out line compares the calibration with the drawing's kinematics with the
+    // frames fitted, not with the nominal model whose error is mostly the unplaced tracker.
+    let v = est.validation.as_ref().unwrap();
+    assert!(
+        panel.contains(&format!(
+            "RMS {:.3} mm with the drawing's kinematics, frames fitted → {:.3} mm calibrated",
+            v.frames_only.rms, v.calibrated.rms
+        )),
+        "{panel}"
+    );
+    assert!(panel.contains(&format!("nothing fitted: RMS {:.3} mm", v.nominal.rms)));
+    let gain = held_out_gain(est).unwrap();
+    assert!((gain - (1.0 - v.calibrated.rms / v.frames_only.rms)).abs() < 1e-12);
+    // The TCP σ of the estimate is stated with the model floor beside the measurement term.
+    let floor = est.model_floor.as_ref().unwrap().tcp[0].kpi;
+    assert!(floor > 0.0);
+    let tcp = &est.tcp[0];
+    assert!(
+        panel.contains(&format!(
+            "{} mm with the fixed parameters' model floor",
+            armcal::report::html::number((tcp.kpi + floor).sqrt())
+        )),
+        "{panel}"
+    );
     // The new figures are on the page, each once per estimate that can have it.
     for kind in [
         "change-sigma",
@@ -324,6 +347,21 @@ fn the_page_opens_with_one_verdict_panel_per_estimate() {
         html.matches("<div class=\"table-wrap\"><table").count()
     );
     assert!(html.contains(".table-wrap { max-width: 100%; overflow-x: auto; }"));
+}
+
+/// A cell whose only free parameters are frames: the frames-only fit is the calibration
+/// itself, so its held-out error is compared with the nominal model's.
+#[test]
+fn a_frames_only_calibration_is_compared_with_the_nominal_model() {
+    let mut est = fixtures().2.clone();
+    let model = armcal::Model::from_spec(&est.model).unwrap();
+    est.free.retain(|n| {
+        armcal::identify::is_frame_parameter(&model, model.registry.index_of(n).unwrap())
+    });
+    assert!(!est.free.is_empty());
+    let v = est.validation.clone().unwrap();
+    let gain = held_out_gain(&est).unwrap();
+    assert!((gain - (1.0 - v.calibrated.rms / v.nominal.rms)).abs() < 1e-12);
 }
 
 #[test]
