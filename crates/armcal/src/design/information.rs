@@ -100,7 +100,7 @@ impl DesignModel {
                 .expect("a configuration's measurements are positions and poses");
             let s = noise.row_sigmas(&m).map_err(|e| {
                 Error::Input(format!(
-                    "{}: the design weighs each measurement as identification will: {e}",
+                    "{}: a design weighs each measurement as identification does: {e}",
                     cell.origin
                 ))
             })?;

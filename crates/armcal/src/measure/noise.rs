@@ -122,7 +122,7 @@ impl NoiseModel {
             NoiseModel::Range { a, b_per_m } => {
                 if matches!(m.kind, MeasurementKind::Pose { .. }) {
                     return Err(Error::Input(format!(
-                        "{}the range noise model has no σ for the rotation rows of a pose measurement; give σ in the data file or use the constant model",
+                        "{}the range noise model has no σ for the rotation rows of a pose measurement; give the instrument the constant model (`sigma_mm`, `sigma_angle_deg`), or σ columns in the data file with the `per-measurement` model",
                         at_line(m.line)
                     )));
                 }

@@ -155,11 +155,11 @@ pub fn simulate_carrying(
     )
 }
 
-/// As [`simulate_carrying`], measuring what `measured` says of a model without targets:
-/// the tool frame's full pose for [`Measured::Pose`] (a full-pose cell, paper eq. 3 with
-/// the orientation), else the tool origin's position. Frame targets are measured in pose
-/// and point targets in position either way.
-fn simulate_measuring(
+/// As [`simulate_carrying`], measuring what `measured` (a cell's `measurement`) says of a
+/// model without targets: the tool frame's full pose for [`Measured::Pose`] (a full-pose
+/// cell, paper eq. 3 with the orientation), else the tool origin's position. Frame targets
+/// are measured in pose and point targets in position either way ([`measurement_at`]).
+pub fn simulate_measuring(
     model: &Model,
     truth: &[f64],
     configurations: &[Vec<f64>],
