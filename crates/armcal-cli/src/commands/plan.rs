@@ -243,9 +243,10 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
     }
     for t in &record.assessment.tcp {
         println!(
-            "(1/3) tr C_s at `{}`{with_measured}: {} mm²{}",
+            "(1/3) tr C_s at `{}`{with_measured}: {} mm²{}{}",
             t.name,
             decimals_or_digits(t.kpi, 5),
+            orientation_note(t),
             floor_note(&record.assessment, &t.name)
         );
     }
@@ -266,6 +267,19 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         bail!("the design violates constraints; see the report");
     }
     Ok(())
+}
+
+/// `; orientation (1/3) tr C_ω = … deg²` for a design whose instrument measures
+/// orientations, or nothing.
+fn orientation_note(t: &armcal::identify::uncertainty::TcpCovariance) -> String {
+    t.orientation_kpi_deg2
+        .map(|v| {
+            format!(
+                "; orientation (1/3) tr C_ω = {} deg² (not in the KPI)",
+                decimals_or_digits(v, 5)
+            )
+        })
+        .unwrap_or_default()
 }
 
 /// `; model floor … mm² (…; not in the KPI)` for
@@ -355,9 +369,10 @@ pub fn run_evaluate(a: &EvaluateArgs) -> anyhow::Result<()> {
     println!("  φ_A(C_p) = tr(C_p)/n_p = {:.6}", ev.assessment.phi_a_cp);
     for t in &ev.assessment.tcp {
         println!(
-            "  (1/3) tr C_s at `{}` = {} mm²{}",
+            "  (1/3) tr C_s at `{}` = {} mm²{}{}",
             t.name,
             decimals_or_digits(t.kpi, 5),
+            orientation_note(t),
             floor_note(&ev.assessment, &t.name)
         );
     }

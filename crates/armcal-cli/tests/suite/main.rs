@@ -26,6 +26,7 @@ mod outputs_cli;
 mod perturb_fixed_cli;
 mod pivot_cli;
 mod pool_cli;
+mod pose_design_cli;
 mod predict_sigma_cli;
 mod readme;
 mod real_poses_measurable_cli;

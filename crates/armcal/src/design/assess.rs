@@ -114,11 +114,18 @@ pub fn assess(cell: &Cell, design: &[Vec<f64>]) -> Result<DesignAssessment, Erro
     let unc = uncertainty::parameter_uncertainty(&j, &DVector::zeros(j.nrows()), &names)?;
     let wnames: Vec<String> = cell.working.iter().map(|w| w.name.clone()).collect();
     let working: Vec<Vec<f64>> = cell.working.iter().map(|w| w.q.clone()).collect();
-    let tcp = uncertainty::with_base_frame(
+    let mut tcp = uncertainty::with_base_frame(
         uncertainty::tcp_covariance(&d.kpi_rows, &unc.covariance, &wnames),
         &uncertainty::tcp_jacobian_world(&d.model, &d.params, &d.free, &working),
         &unc.covariance,
     );
+    if d.measures_orientation() {
+        tcp = uncertainty::with_orientation(
+            tcp,
+            &uncertainty::tcp_orientation_jacobian(&d.model, &d.params, &d.free, &working),
+            &unc.covariance,
+        );
+    }
     let mut criteria = Vec::new();
     for c in Criterion::ALL {
         if matches!(c, Criterion::Kpi | Criterion::KpiMax) && d.kpi_weights.is_empty() {

@@ -1,20 +1,33 @@
 //! The information a measurement configuration carries: `M(q) = J(q)ᵀ W J(q)` with `J` the
-//! identification Jacobian of the measured target positions w.r.t. the free parameters and
-//! `W = Σ⁻¹` (paper §1.1: `C = (F₁ᵀF₁)⁻¹`), and the derivative w.r.t. q of a weighted sum
+//! identification Jacobian of what the instrument measures there w.r.t. the free parameters
+//! and `W = Σ⁻¹` (paper §1.1: `C = (F₁ᵀF₁)⁻¹`), and the derivative w.r.t. q of a weighted sum
 //! `⟨Ω, W^{1/2}J⟩` through the foundation's mixed derivative
 //! ([`identification_jacobian_dq_along`]): every design gradient is one.
+//!
+//! The rows are those of the identification of the data the design will give: at each
+//! configuration the measurements `simulate` writes ([`crate::sim::measurement_at`]: a point
+//! target's position, a frame target's pose, the tool frame's pose in a full-pose cell),
+//! each with its Jacobian rows ([`MeasurementKind::jacobian_rows`], book §4.3: 3 position
+//! rows, or 3 position and 3 rotation rows) divided by its σ from the noise model exactly as
+//! identification weighs it ([`NoiseModel::row_sigmas`]), over the free set identification
+//! estimates (the model's free parameters). At the nominal parameters and a zero residual,
+//! `Jᵀ W J` is the information of [`crate::identify::Problem`] on that data.
 
 use crate::cell::Cell;
 use crate::measure::NoiseModel;
 use crate::model::{
-    forward_kinematics, identification_jacobian, identification_jacobian_dq_along,
-    observed_position, AlongWorkspace, Data, Model, Observed, Rows,
+    forward_kinematics, identification_jacobian, identification_jacobian_dq_along, AlongWorkspace,
+    Data, Model, Observed, Rows,
 };
 use crate::Error;
 use nalgebra::DMatrix;
 
+#[cfg(doc)]
+use crate::measure::MeasurementKind;
+
 /// What the design optimises over: the model at its nominal parameters, the free columns,
-/// the measured targets, row weights, and the KPI rows (TCP at the working configurations).
+/// the measured frames with their rows and σ's, and the KPI rows (TCP at the working
+/// configurations).
 #[derive(Clone, Debug)]
 pub struct DesignModel {
     /// The cell's model (internal units: mm, rad).
@@ -23,12 +36,17 @@ pub struct DesignModel {
     pub params: Vec<f64>,
     /// Parameter index of each column.
     pub free: Vec<usize>,
-    /// Observed targets (position rows, 3 each).
-    pub observed: Vec<Observed>,
-    /// σ (mm) of each position axis. The range noise model is evaluated at the distance
-    /// from the instrument to the TCP at the first working configuration and then held
-    /// constant, so that the weights do not depend on q.
-    pub sigma: [f64; 3],
+    /// What each configuration measures, in row order: the observed frame and its rows
+    /// (3 position rows, or 6 pose rows for a frame target or the tool frame of a full-pose
+    /// cell).
+    pub observed: Vec<(Observed, Rows)>,
+    /// σ of each row of one configuration's block (mm for a position row, rad for a rotation
+    /// row): [`NoiseModel::row_sigmas`] of its measurement at the reference configuration,
+    /// the first KPI configuration (the joints at mid-range without one). Only the range
+    /// noise model depends on it; held constant, so that the weights do not depend on q.
+    pub sigma: Vec<f64>,
+    /// 1/σ of each row of [`DesignModel::sigma`].
+    inverse_sigma: Vec<f64>,
     /// `G`: 3 rows per KPI configuration ([`Cell::kpi_configurations`]: the working poses,
     /// then the working paths' configurations), TCP position w.r.t. the free parameters.
     pub kpi_rows: DMatrix<f64>,
@@ -40,8 +58,9 @@ pub struct DesignModel {
 }
 
 impl DesignModel {
-    /// The design model of a cell: its free parameters, point targets (or the tool origin),
-    /// the instrument noise, and its working configurations.
+    /// The design model of a cell: its free parameters, what its instrument measures (the
+    /// cell's `measurement`: positions or full poses), the instrument noise, and its working
+    /// configurations.
     pub fn from_cell(cell: &Cell) -> Result<DesignModel, Error> {
         let mut model = cell.model.clone();
         // A planned pose carries no payload: the payload terms are not designed for (measure
@@ -56,40 +75,45 @@ impl DesignModel {
                 "the cell has no free parameters to design for".into(),
             ));
         }
-        let observed: Vec<Observed> = if model.targets.is_empty() {
-            vec![Observed::Tool]
-        } else {
-            (0..model.targets.len()).map(Observed::Target).collect()
-        };
         let kpi = cell.kpi_configurations();
         let working: Vec<Vec<f64>> = kpi.iter().map(|(q, _)| q.to_vec()).collect();
         let kpi_rows = crate::identify::uncertainty::tcp_jacobian(&model, &params, &free, &working);
         let noise = cell.noise();
-        let sigma = match noise {
-            NoiseModel::Constant { sigma, .. } => sigma,
-            NoiseModel::Range { a, b_per_m } => {
-                let range = match working.first() {
-                    Some(q) => {
-                        let mut d = Data::new(&model);
-                        forward_kinematics(&model, &mut d, &params, q);
-                        observed_position(&d, Observed::Tool).norm()
-                    }
-                    None => 0.0,
-                };
-                [a + b_per_m * range / 1000.0; 3]
-            }
-            NoiseModel::PerMeasurement { .. } => {
-                return Err(Error::Input(
-                    "pose design needs a noise model with known σ (constant or range), not per-measurement".into(),
+        if let NoiseModel::PerMeasurement { .. } = noise {
+            return Err(Error::Input(
+                "pose design needs a noise model with known σ (constant or range), not per-measurement".into(),
+            ));
+        }
+        let reference = working.first().cloned().unwrap_or_else(|| {
+            let mid = |j: &crate::model::Joint| 0.5 * (j.lower + j.upper);
+            model.joints.iter().map(mid).collect()
+        });
+        let mut data = Data::new(&model);
+        forward_kinematics(&model, &mut data, &params, &reference);
+        let mut observed = Vec::new();
+        let mut sigma = Vec::new();
+        for obs in crate::sim::observed_frames(&model) {
+            let m = crate::sim::measurement_at(&model, &data, 0, obs, cell.measurement);
+            let rows = m
+                .kind
+                .jacobian_rows()
+                .expect("a configuration's measurements are positions and poses");
+            let s = noise.row_sigmas(&m).map_err(|e| {
+                Error::Input(format!(
+                    "{}: a design weighs each measurement as identification does: {e}",
+                    cell.origin
                 ))
-            }
-        };
+            })?;
+            sigma.extend_from_slice(&s[..rows.count()]);
+            observed.push((obs, rows));
+        }
         let prior_rows = crate::model::prior::prior_rows(&model.registry, &free)?.0;
         Ok(DesignModel {
             model,
             params,
             free,
             observed,
+            inverse_sigma: sigma.iter().map(|s| 1.0 / s).collect(),
             sigma,
             kpi_rows,
             kpi_weights: kpi.iter().map(|(_, w)| *w).collect(),
@@ -102,9 +126,15 @@ impl DesignModel {
         self.free.len()
     }
 
-    /// Rows per configuration (3 per observed target).
+    /// Rows per configuration (3 per observed position, 6 per observed pose).
     pub fn rows(&self) -> usize {
-        3 * self.observed.len()
+        self.sigma.len()
+    }
+
+    /// Whether the instrument measures an orientation (a pose's rotation rows): the design
+    /// then also predicts the TCP orientation's covariance.
+    pub fn measures_orientation(&self) -> bool {
+        self.observed.iter().any(|(_, rows)| *rows == Rows::Pose)
     }
 
     /// Number of joints (entries of a configuration).
@@ -168,16 +198,10 @@ impl DesignModel {
         row: usize,
     ) {
         forward_kinematics(&self.model, data, &self.params, q);
-        for (k, &obs) in self.observed.iter().enumerate() {
-            identification_jacobian(
-                &self.model,
-                data,
-                obs,
-                Rows::Position,
-                &self.free,
-                out,
-                row + 3 * k,
-            );
+        let mut at = row;
+        for &(obs, rows) in &self.observed {
+            identification_jacobian(&self.model, data, obs, rows, &self.free, out, at);
+            at += rows.count();
         }
         self.whiten(out, row);
     }
@@ -195,31 +219,30 @@ impl DesignModel {
         buffers.weight.copy_from(omega);
         self.whiten(&mut buffers.weight, 0);
         out.fill(0.0);
-        for (k, &obs) in self.observed.iter().enumerate() {
+        let mut at = 0;
+        for &(obs, rows) in &self.observed {
             identification_jacobian_dq_along(
                 &self.model,
                 &mut buffers.along,
                 data,
                 obs,
-                Rows::Position,
+                rows,
                 &self.free,
                 &buffers.weight,
-                3 * k,
+                at,
                 out,
             );
+            at += rows.count();
         }
     }
 
-    /// Divides rows `row..row + rows` (x, y, z of one target after another) by their
-    /// axis's σ, multiplying with 1/σ down each column (the matrix is column-major).
+    /// Divides rows `row..row + rows` (one configuration's block) by their σ, multiplying
+    /// with 1/σ down each column (the matrix is column-major).
     fn whiten(&self, m: &mut DMatrix<f64>, row: usize) {
         let (height, rows) = (m.nrows(), self.rows());
-        let inverse = self.sigma.map(|s| 1.0 / s);
         for column in m.as_mut_slice().chunks_mut(height) {
-            for axes in column[row..row + rows].chunks_exact_mut(3) {
-                for (x, s) in axes.iter_mut().zip(&inverse) {
-                    *x *= s;
-                }
+            for (x, s) in column[row..row + rows].iter_mut().zip(&self.inverse_sigma) {
+                *x *= s;
             }
         }
     }

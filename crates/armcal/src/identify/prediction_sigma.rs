@@ -19,7 +19,7 @@
 
 use crate::identify::model_floor::Absorbed;
 use crate::identify::Estimate;
-use crate::measure::{csv, Dataset, MeasurementKind};
+use crate::measure::{csv, Dataset};
 use crate::model::{forward_kinematics, identification_jacobian, Data, Model, Observed, Rows};
 use crate::Error;
 use nalgebra::DMatrix;
@@ -100,10 +100,8 @@ pub fn prediction_sigmas(
     let mut fk = Data::new(model);
     let mut out = Vec::with_capacity(data.measurements.len());
     for m in &data.measurements {
-        let rows = match m.kind {
-            MeasurementKind::Position { .. } => Rows::Position,
-            MeasurementKind::Pose { .. } => Rows::Pose,
-            _ => return Ok(None),
+        let Some(rows) = m.kind.jacobian_rows() else {
+            return Ok(None);
         };
         fk.payload = data.config_payloads.get(m.config).copied().flatten();
         forward_kinematics(model, &mut fk, params, &data.configurations[m.config]);

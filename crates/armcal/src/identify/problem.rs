@@ -125,12 +125,7 @@ impl<'a> Problem<'a> {
             };
             slot_of.push(slot);
             row_of.push(sigmas.len());
-            let range = match &m.kind {
-                MeasurementKind::Position { value, .. } => value.norm(),
-                MeasurementKind::Pose { value, .. } => value.trans.norm(),
-                _ => 0.0,
-            };
-            let s = noise.sigmas(m, range)?;
+            let s = noise.row_sigmas(m)?;
             sigmas.extend_from_slice(&s[..m.kind.rows()]);
         }
         let (prior_rows, prior_offset) = prior_rows(&model.registry, &free)?;

@@ -4,7 +4,7 @@
 
 use crate::linalg::unit_diagonal;
 use crate::model::{
-    forward_kinematics, identification_jacobian, Data, Model, Observed, Rows, Segment,
+    forward_kinematics, identification_jacobian, Data, Model, Observed, Rows, Segment, Unit,
 };
 use crate::Error;
 use nalgebra::{DMatrix, DMatrixView, DVector, Matrix3};
@@ -179,6 +179,13 @@ pub struct TcpCovariance {
     /// older armcal.
     #[serde(default)]
     pub covariance_base: Option<Matrix3<f64>>,
+    /// (1/3) tr of the covariance of the TCP orientation (the tool frame's small rotation
+    /// vector in the instrument frame, `G_ω C_p G_ωᵀ` with [`tcp_orientation_jacobian`]),
+    /// deg²: the orientation's KPI beside the position's, for a design whose instrument
+    /// measures orientations ([`with_orientation`]); `None` otherwise (a position-only
+    /// design holds the tool's orientation parameters fixed, so it would state them exact).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orientation_kpi_deg2: Option<f64>,
 }
 
 /// `G_w` rows (3 per working configuration) of the TCP position in the world (robot base)
@@ -234,6 +241,37 @@ pub fn with_base_frame(
     cs
 }
 
+/// `cs` with their orientation KPIs `(1/3) tr G_ω C_p G_ωᵀ` (deg²) set (`g_orientation`
+/// from [`tcp_orientation_jacobian`], same working configurations and columns as `cp`).
+pub fn with_orientation(
+    mut cs: Vec<TcpCovariance>,
+    g_orientation: &DMatrix<f64>,
+    cp: &DMatrix<f64>,
+) -> Vec<TcpCovariance> {
+    let deg2 = Unit::Rad.display_factor().powi(2);
+    for (i, c) in cs.iter_mut().enumerate() {
+        let g = g_orientation.rows(3 * i, 3);
+        c.orientation_kpi_deg2 = Some((g * cp).component_mul(&g).sum() / 3.0 * deg2);
+    }
+    cs
+}
+
+/// `G_ω` rows (3 per working configuration) of the TCP orientation w.r.t. the free
+/// parameters: the rotation rows of the tool frame's identification Jacobian, the small
+/// rotation vector in the instrument frame (book eqs. 4.14–4.20, as a pose measurement's).
+pub fn tcp_orientation_jacobian(
+    model: &Model,
+    params: &[f64],
+    free: &[usize],
+    working: &[Vec<f64>],
+) -> DMatrix<f64> {
+    let mut pose = DMatrix::zeros(6, free.len());
+    tcp_rows(model, params, free, working, |data, g, row| {
+        identification_jacobian(model, data, Observed::Tool, Rows::Pose, free, &mut pose, 0);
+        g.rows_mut(row, 3).copy_from(&pose.rows(3, 3));
+    })
+}
+
 /// `G` rows (3 per working configuration) of the TCP position w.r.t. the free parameters.
 pub fn tcp_jacobian(
     model: &Model,
@@ -259,6 +297,7 @@ pub fn tcp_covariance(g: &DMatrix<f64>, cp: &DMatrix<f64>, names: &[String]) -> 
                 kpi: c.trace() / 3.0,
                 covariance: c,
                 covariance_base: None,
+                orientation_kpi_deg2: None,
             }
         })
         .collect()

@@ -18,7 +18,7 @@ pub mod stations;
 
 pub use noise::NoiseModel;
 
-use crate::model::{Observed, Pose};
+use crate::model::{Observed, Pose, Rows};
 use nalgebra::{Matrix3, Matrix4, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -80,6 +80,18 @@ impl MeasurementKind {
             MeasurementKind::Position { .. } => 3,
             MeasurementKind::Pose { .. } => 6,
             _ => 1,
+        }
+    }
+
+    /// The identification Jacobian rows of the kind's residual at a zero residual: a
+    /// position's 3 rows, a pose's 6 (position, then rotation: `J_l⁻¹(φ)` of
+    /// [`residual::residual_rows`] is the identity at φ = 0); `None` for the one-row kinds,
+    /// whose rows are projections ([`residual::residual_rows`]).
+    pub fn jacobian_rows(&self) -> Option<Rows> {
+        match self {
+            MeasurementKind::Position { .. } => Some(Rows::Position),
+            MeasurementKind::Pose { .. } => Some(Rows::Pose),
+            _ => None,
         }
     }
 

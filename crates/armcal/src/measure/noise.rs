@@ -53,6 +53,16 @@ fn stated_sigma(m: &Measurement) -> Option<[f64; 6]> {
     }
 }
 
+/// `line N: ` for a measurement read from line N of a file, nothing for a synthetic one
+/// (line 0: simulated, or the design's measurement at a planned pose).
+fn at_line(line: usize) -> String {
+    if line == 0 {
+        String::new()
+    } else {
+        format!("line {line}: ")
+    }
+}
+
 impl NoiseModel {
     /// A sentence for the user when `data` states σ for some rows but this noise model does
     /// not use them (constant and range models weight every row by their own σ).
@@ -81,6 +91,19 @@ impl NoiseModel {
         })
     }
 
+    /// σ of each residual row of `m` ([`NoiseModel::sigmas`]) at the range of its own
+    /// measured point: the distance from the instrument of a position or a pose's origin,
+    /// 0 for the one-row kinds. Every measurement's weights in identification
+    /// ([`crate::identify::Problem`]), simulation and the pose design come from here.
+    pub fn row_sigmas(&self, m: &Measurement) -> Result<[f64; 6], Error> {
+        let range = match &m.kind {
+            MeasurementKind::Position { value, .. } => value.norm(),
+            MeasurementKind::Pose { value, .. } => value.trans.norm(),
+            _ => 0.0,
+        };
+        self.sigmas(m, range)
+    }
+
     /// σ of each residual row of `m` (first `m.kind.rows()` entries). `range` is the
     /// distance of the observed point from the instrument (mm), for the range model.
     pub fn sigmas(&self, m: &Measurement, range: f64) -> Result<[f64; 6], Error> {
@@ -99,8 +122,8 @@ impl NoiseModel {
             NoiseModel::Range { a, b_per_m } => {
                 if matches!(m.kind, MeasurementKind::Pose { .. }) {
                     return Err(Error::Input(format!(
-                        "line {}: the range noise model has no σ for the rotation rows of a pose measurement; give σ in the data file or use the constant model",
-                        m.line
+                        "{}the range noise model has no σ for the rotation rows of a pose measurement; give the instrument the constant model (`sigma_mm`, `sigma_angle_deg`), or σ columns in the data file with the `per-measurement` model",
+                        at_line(m.line)
                     )));
                 }
                 let s = a + b_per_m * range / 1000.0;
@@ -109,8 +132,8 @@ impl NoiseModel {
             NoiseModel::PerMeasurement { floor } => {
                 let g = given.ok_or_else(|| {
                     Error::Input(format!(
-                        "line {}: the noise model is per-measurement but this {} measurement has no σ columns",
-                        m.line,
+                        "{}the noise model is per-measurement but this {} measurement has no σ columns",
+                        at_line(m.line),
                         m.kind.name()
                     ))
                 })?;
@@ -121,8 +144,8 @@ impl NoiseModel {
         }
         if let Some(bad) = out[..rows].iter().find(|s| !(s.is_finite() && **s > 0.0)) {
             return Err(Error::Input(format!(
-                "line {}: σ = {bad} is not a positive number",
-                m.line
+                "{}σ = {bad} is not a positive number",
+                at_line(m.line)
             )));
         }
         Ok(out)

@@ -146,6 +146,17 @@ pub fn design_section(id: &str, label: &str, d: &DesignRecord) -> Result<Section
                 number(c[(2, 2)].sqrt())
             ),
         ));
+        if let Some(v) = t.orientation_kpi_deg2 {
+            rows.push((
+                "predicted C_ω",
+                format!(
+                    "at <em>{}</em>: TCP orientation (1/3) tr C_ω = {} deg², σ = {} deg (not in the KPI)",
+                    escape(&t.name),
+                    number(v),
+                    number(v.sqrt())
+                ),
+            ));
+        }
     }
     for p in &a.paths {
         rows.push((

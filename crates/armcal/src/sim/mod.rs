@@ -173,11 +173,11 @@ pub fn simulate_carrying(
     )
 }
 
-/// As [`simulate_carrying`], measuring what `measured` says of a model without targets:
-/// the tool frame's full pose for [`Measured::Pose`] (a full-pose cell, paper eq. 3 with
-/// the orientation), else the tool origin's position. Frame targets are measured in pose
-/// and point targets in position either way.
-fn simulate_measuring(
+/// As [`simulate_carrying`], measuring what `measured` (a cell's `measurement`) says of a
+/// model without targets: the tool frame's full pose for [`Measured::Pose`] (a full-pose
+/// cell, paper eq. 3 with the orientation), else the tool origin's position. Frame targets
+/// are measured in pose and point targets in position either way ([`measurement_at`]).
+pub fn simulate_measuring(
     model: &Model,
     truth: &[f64],
     configurations: &[Vec<f64>],
@@ -192,11 +192,7 @@ fn simulate_measuring(
         source: format!("simulation (seed {seed})"),
         ..Default::default()
     };
-    let observed: Vec<Observed> = if model.targets.is_empty() {
-        vec![Observed::Tool]
-    } else {
-        (0..model.targets.len()).map(Observed::Target).collect()
-    };
+    let observed = observed_frames(model);
     let mut fk = Data::new(model);
     for (c, q) in configurations.iter().enumerate() {
         model
@@ -207,30 +203,9 @@ fn simulate_measuring(
         let config = data.push_configuration(format!("{}", c + 1), q.clone());
         data.set_payload(config, fk.payload.map(|k| model.payloads[k].name.as_str()));
         for &obs in &observed {
-            let is_frame = match obs {
-                Observed::Target(k) => model.target_is_frame(k),
-                Observed::Tool => measured == Measured::Pose,
-            };
-            let pose = observed_pose(&fk, obs);
-            let mut m = Measurement {
-                config,
-                observed: obs,
-                kind: if is_frame {
-                    MeasurementKind::Pose {
-                        value: pose,
-                        sigma: None,
-                    }
-                } else {
-                    MeasurementKind::Position {
-                        value: pose.trans,
-                        sigma: None,
-                    }
-                },
-                line: 0,
-                covariates: Default::default(),
-            };
+            let mut m = measurement_at(model, &fk, config, obs, measured);
             if let Some(noise) = noise {
-                let s = noise.sigmas(&m, pose.trans.norm())?;
+                let s = noise.row_sigmas(&m)?;
                 let mut z = || unit_normal.sample(&mut rng);
                 match &mut m.kind {
                     MeasurementKind::Position { value, .. } => {
@@ -257,6 +232,52 @@ fn simulate_measuring(
         }
     }
     Ok(data)
+}
+
+/// The frames a configuration's measurements observe: every target of `model`, or the tool
+/// frame if it has none.
+pub fn observed_frames(model: &Model) -> Vec<Observed> {
+    if model.targets.is_empty() {
+        vec![Observed::Tool]
+    } else {
+        (0..model.targets.len()).map(Observed::Target).collect()
+    }
+}
+
+/// The noise-free measurement of `obs` at the kinematics `fk` (configuration `config`): the
+/// pose of a frame target, the pose of the tool frame if `measured` is
+/// [`Measured::Pose`], else the position. What [`simulate`] and [`predict`] write, and so
+/// the rows and σ's an identification of such data has; the pose design builds its rows
+/// from it ([`crate::design::DesignModel::from_cell`]).
+pub fn measurement_at(
+    model: &Model,
+    fk: &Data<f64>,
+    config: usize,
+    obs: Observed,
+    measured: Measured,
+) -> Measurement {
+    let is_frame = match obs {
+        Observed::Target(k) => model.target_is_frame(k),
+        Observed::Tool => measured == Measured::Pose,
+    };
+    let pose = observed_pose(fk, obs);
+    Measurement {
+        config,
+        observed: obs,
+        kind: if is_frame {
+            MeasurementKind::Pose {
+                value: pose,
+                sigma: None,
+            }
+        } else {
+            MeasurementKind::Position {
+                value: pose.trans,
+                sigma: None,
+            }
+        },
+        line: 0,
+        covariates: Default::default(),
+    }
 }
 
 /// One parameter of a simulated robot, display units (mm, deg).

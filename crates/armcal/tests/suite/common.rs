@@ -290,16 +290,42 @@ pub fn monte_carlo_tcp_covariances(
     runs: u64,
     seed: u64,
 ) -> Vec<nalgebra::Matrix3<f64>> {
+    let poses = monte_carlo_tcp_poses(cell, truth, design, configs, runs, seed);
+    (0..configs.len())
+        .map(|k| sample_covariance(poses.iter().map(|run| run[k].trans)))
+        .collect()
+}
+
+/// `runs` calibrations (seeds `seed..seed + runs`) of `truth` measured at `design` as the
+/// cell measures (its `measurement`: positions, or full poses) with its instrument noise,
+/// each identified from the nominal; returns each run's identified tool pose (instrument
+/// frame) at each of `configs`.
+pub fn monte_carlo_tcp_poses(
+    cell: &Cell,
+    truth: &[f64],
+    design: &[Vec<f64>],
+    configs: &[Vec<f64>],
+    runs: u64,
+    seed: u64,
+) -> Vec<Vec<Pose<f64>>> {
     use armcal::identify::{solve, IdentifySettings, Problem};
     use armcal::progress::Silent;
-    use nalgebra::{Matrix3, Vector3};
     use rayon::prelude::*;
     let model = &cell.model;
-    let noise = cell.instrument.as_ref().unwrap().noise.clone();
-    let tcps: Vec<Vec<Vector3<f64>>> = (seed..seed + runs)
+    let noise = cell.noise();
+    (seed..seed + runs)
         .into_par_iter()
         .map(|s| {
-            let data = armcal::sim::simulate(model, truth, design, Some(&noise), s).unwrap();
+            let data = armcal::sim::simulate_measuring(
+                model,
+                truth,
+                design,
+                &[],
+                cell.measurement,
+                Some(&noise),
+                s,
+            )
+            .unwrap();
             let mut p = Problem::new(model, &data, &noise).unwrap();
             let (sol, _, _) = solve(
                 &mut p,
@@ -313,20 +339,23 @@ pub fn monte_carlo_tcp_covariances(
                 .iter()
                 .map(|q| {
                     forward_kinematics(model, &mut data, &sol.params, q);
-                    observed_position(&data, Observed::Tool)
+                    observed_pose(&data, Observed::Tool)
                 })
                 .collect()
         })
-        .collect();
-    let n = runs as f64;
-    (0..configs.len())
-        .map(|k| {
-            let mean = tcps.iter().fold(Vector3::zeros(), |a, t| a + t[k]) / n;
-            tcps.iter().fold(Matrix3::zeros(), |a, t| {
-                a + (t[k] - mean) * (t[k] - mean).transpose()
-            }) / (n - 1.0)
-        })
         .collect()
+}
+
+/// The sample covariance (n − 1) of 3-vectors.
+pub fn sample_covariance(
+    xs: impl Iterator<Item = nalgebra::Vector3<f64>> + Clone,
+) -> nalgebra::Matrix3<f64> {
+    use nalgebra::{Matrix3, Vector3};
+    let n = xs.clone().count() as f64;
+    let mean = xs.clone().fold(Vector3::zeros(), |a, x| a + x) / n;
+    xs.fold(Matrix3::zeros(), |a, x| {
+        a + (x - mean) * (x - mean).transpose()
+    }) / (n - 1.0)
 }
 
 /// Every parameter of the estimate `e` of `model` within 1e-6 (display units) of `truth`
@@ -368,5 +397,27 @@ pub fn cell_from_text(text: &str, tag: &str) -> Result<Cell, armcal::Error> {
     std::fs::write(&path, text).unwrap();
     let cell = Cell::from_file(&path);
     std::fs::remove_file(&path).unwrap();
+    cell
+}
+
+/// The UR10 + Leica T-Mac full-pose cell (`examples/ur10-leica-cell.toml`, `measurement =
+/// "pose"`: the T-Mac frame's position and orientation) with its tracker placed where the
+/// Series B fit puts it, the tracker's noise stated (σ 0.05 mm per axis, 0.005° per
+/// rotation axis) and a working pose `w` reaching forward.
+pub fn ur10_pose_cell() -> Cell {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let text = std::fs::read_to_string(dir.join("ur10-leica-cell.toml")).unwrap();
+    let instrument = "kind = \"laser-tracker\"";
+    assert!(text.contains(instrument));
+    let text = text.replace(
+        instrument,
+        "kind = \"laser-tracker\"\nxyz_mm = [747, 3526, 1224]\nrpy_deg = [0, 0, -20]\n\
+         noise = { model = \"constant\", sigma_mm = 0.05, sigma_angle_deg = 0.005 }",
+    ) + "\n[[working]]\nname = \"w\"\njoints_deg = [30, -60, 90, -120, -90, 0]\n";
+    let cell = cell_from_text(&text, "ur10-pose").unwrap();
+    assert_eq!(
+        cell.measurement,
+        armcal::model::identifiability::Measurement::Pose
+    );
     cell
 }

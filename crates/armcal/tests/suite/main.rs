@@ -49,6 +49,7 @@ mod design {
     mod measurable;
     mod nongeometric_design;
     mod paper_cell_geometry;
+    mod pose_design;
     mod tracker_shift;
     mod working_paths;
 }
