@@ -13,6 +13,7 @@ mod collision_model_cli;
 mod compensate_cli;
 mod error_causes;
 mod estimate_checks;
+mod facing_target_cli;
 mod fitted_ranges_cli;
 mod fixed_priors_export_cli;
 mod guide_links;

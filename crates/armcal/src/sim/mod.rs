@@ -245,8 +245,8 @@ pub fn observed_frames(model: &Model) -> Vec<Observed> {
 }
 
 /// The noise-free measurement of `obs` at the kinematics `fk` (configuration `config`): the
-/// pose of a frame target, the pose of the tool frame if `measured` is
-/// [`Measured::Pose`], else the position. What [`simulate`] and [`predict`] write, and so
+/// pose of a frame target (unless `measured` is [`Measured::Position`]), the pose of the tool
+/// frame if `measured` is [`Measured::Pose`], else the position. What [`simulate`] and [`predict`] write, and so
 /// the rows and σ's an identification of such data has; the pose design builds its rows
 /// from it ([`crate::design::DesignModel::from_cell`]).
 pub fn measurement_at(
@@ -256,8 +256,10 @@ pub fn measurement_at(
     obs: Observed,
     measured: Measured,
 ) -> Measurement {
+    // A frame target of a position-measuring cell is measured as a point: its orientation
+    // only says where the reflector faces (incidence), as the model analysis assumes.
     let is_frame = match obs {
-        Observed::Target(k) => model.target_is_frame(k),
+        Observed::Target(k) => model.target_is_frame(k) && measured != Measured::Position,
         Observed::Tool => measured == Measured::Pose,
     };
     let pose = observed_pose(fk, obs);
