@@ -238,14 +238,14 @@ mod tests {
     fn the_conditional_start_is_the_fit_with_the_term_held() {
         let mut rng = ChaCha8Rng::seed_from_u64(3);
         let (m, n, i) = (12, 4, 2);
-        let mut j = DMatrix::from_fn(m, n, |_, _| rng.gen_range(-1.0..1.0));
+        let mut j = DMatrix::from_fn(m, n, |_, _| rng.random_range(-1.0..1.0));
         // nearly inseparable: column i is almost a combination of columns 0 and 1
         let mix = j.column(0) * 0.7 - j.column(1) * 0.4;
         j.set_column(
             i,
-            &(mix + DMatrix::from_fn(m, 1, |_, _| rng.gen_range(-0.05..0.05))),
+            &(mix + DMatrix::from_fn(m, 1, |_, _| rng.random_range(-0.05..0.05))),
         );
-        let y = DVector::from_fn(m, |_, _| rng.gen_range(-1.0..1.0));
+        let y = DVector::from_fn(m, |_, _| rng.random_range(-1.0..1.0));
         let c = (j.transpose() * &j).try_inverse().unwrap();
         let fit = &c * j.transpose() * &y;
         let term = DroppedTerm {
