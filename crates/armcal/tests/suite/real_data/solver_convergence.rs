@@ -138,15 +138,19 @@ fn every_kinematic_fit_converges_on_20_seeds_without_a_false_alarm() {
 
 /// The non-geometric cells (compliance and periodic terms; with `free = "auto"` the gate
 /// drops the inseparable terms one by one, a refit each) on seeds 1–20: bound 60 on the
-/// Motoman right arm and the UR10 (measured 26–38, 3–5, 6–7), the default limit 200 on
-/// the left arm (21–182: a refit after a dropped term takes up to 182, on seed 9). Before:
-/// first runs of 252–2000+ on the Motoman (trust region alone: 66–1229, over the default
-/// limit on most seeds).
+/// Motoman right arm and the UR10 (measured 24–34, 3–4, 6–7), 120 on the left arm
+/// (18–99). The left arm's refits after a dropped term start from the conditional fit
+/// (the others absorb the term, `free_set::DroppedTerm`); from the term alone at nominal
+/// they took up to 182 (seed 9; 131 on seed 16, 112 on seed 7), over this bound. Its
+/// longest run left (99, seed 16) is a refit whose minimum lies far along the curved
+/// valley of `b2.theta`, `b2.d` and the reflector offset: even the geodesically
+/// accelerated step is valid only to about twice the accepted length there. Before the
+/// trust region and the acceleration: first runs of 252–2000+ on the Motoman.
 #[test]
 fn every_nongeometric_fit_converges_on_20_seeds_without_a_false_alarm() {
     converge_within(sets(true), 1..=20, |name| {
         if name.starts_with("motoman left") {
-            200
+            120
         } else {
             60
         }
