@@ -146,6 +146,13 @@ pub struct Identifiability {
     pub identifiable: Vec<String>,
     /// Condition number σmax/σmin of the column-normalised Jacobian of the identifiable set.
     pub condition_number: f64,
+    /// Variance inflation of each identifiable parameter, in the order of `identifiable`:
+    /// `VIFᵢ = [(JᵀJ)⁻¹]ᵢᵢ ‖Jᵢ‖² = 1 / sin² θᵢ`, θᵢ the angle between its column and the
+    /// span of the other identifiable columns (Belsley, Kuh & Welsch 1980, *Regression
+    /// Diagnostics*, §3.1): 1 for a column orthogonal to the others, large for one that is
+    /// nearly their combination (a target a fraction of a millimetre from the last axis).
+    #[serde(default)]
+    pub variance_inflation: Vec<f64>,
     /// Candidates left out of the identifiable set, each with the reason.
     pub excluded: Vec<Exclusion>,
 }
@@ -493,6 +500,7 @@ pub fn analyze_at(
     };
     let qr = kept_matrix.clone().qr();
     let (q, r) = (qr.q(), qr.r());
+    let vif_by_kept = variance_inflation(&r);
     let mut excluded = Vec::new();
     for &c in &dropped {
         let pname = name(candidates[c]);
@@ -552,8 +560,12 @@ pub fn analyze_at(
             partners,
         });
     }
-    let mut identifiable: Vec<usize> = kept.iter().map(|&k| candidates[k]).collect();
-    identifiable.sort();
+    let mut identifiable: Vec<(usize, f64)> = kept
+        .iter()
+        .zip(&vif_by_kept)
+        .map(|(&k, &v)| (candidates[k], v))
+        .collect();
+    identifiable.sort_by_key(|&(i, _)| i);
     let (rv, pr) = joint_counts(model);
     Ok(Identifiability {
         measurement: opts.measurement,
@@ -573,10 +585,22 @@ pub fn analyze_at(
         rank_svd,
         rank_qr,
         singular_values: sv,
-        identifiable: identifiable.into_iter().map(name).collect(),
+        variance_inflation: identifiable.iter().map(|&(_, v)| v).collect(),
+        identifiable: identifiable.into_iter().map(|(i, _)| name(i)).collect(),
         condition_number,
         excluded,
     })
+}
+
+/// The variance inflation of every column of a matrix with unit-norm columns from the
+/// triangular factor `r` of its QR decomposition: `(JᵀJ)⁻¹ = R⁻¹R⁻ᵀ`, so `VIFᵢ` is the
+/// squared norm of row `i` of `R⁻¹` (∞ for a singular factor).
+fn variance_inflation(r: &DMatrix<f64>) -> Vec<f64> {
+    let n = r.ncols();
+    match r.clone().try_inverse() {
+        Some(inv) if n > 0 => (0..n).map(|i| inv.row(i).norm_squared()).collect(),
+        _ => vec![f64::INFINITY; n],
+    }
 }
 
 fn measurement_name(m: Measurement) -> &'static str {
