@@ -159,7 +159,7 @@ impl Default for IdentifySettings {
 /// frames-first estimate or a fit, not the nominal: a target whose nominal offset is
 /// unknown and written as `[0, 0, 0]` lies on the last joint axis there, where two
 /// parameters of that joint have no effect), and the reason for every parameter left out.
-/// A parameter the cell's analysis at the nominal leaves out is freed there only if the
+/// A parameter the same analysis at the nominal leaves out is freed there only if the
 /// data determine it ([`weak_gain`]: variance inflation at most [`DETERMINED_VIF`]), so
 /// `plan`'s prediction at the nominal and the fit agree on a target on the last axis.
 /// With `free = "auto"` the free set is the minimal identifiable set *at the data's
@@ -211,13 +211,8 @@ fn identifiable_model_given(
         payloads: Some(data.model_payloads(&declared)?),
         ..cell.identifiability_settings()
     };
-    let (report, held) = weak_gain::analyze_holding_weak(
-        &mut declared,
-        at,
-        &data.configurations,
-        &settings,
-        generic,
-    )?;
+    let (report, held) =
+        weak_gain::analyze_holding_weak(&mut declared, at, &data.configurations, &settings)?;
     report.apply(&mut declared)?;
     let weak = held.iter().map(|(name, _)| name.clone()).collect();
     let generic_excluded: std::collections::HashSet<&str> =

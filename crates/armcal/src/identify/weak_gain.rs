@@ -10,10 +10,10 @@
 //! column within a degree of the others': freed, they take σ's of millimetres and ρ ≈ 0.999
 //! and inflate the TCP covariance 10⁴-fold over what `plan` predicted at the nominal for the
 //! same poses (a KR 6 with its reflector on the q6 axis: `plan` 0.000095 mm², the fit
-//! 0.46–0.79 mm²). A parameter the cell's analysis at the nominal
-//! ([`crate::cell::Cell::identifiability`], the set `model` prints and `plan` designs for)
-//! leaves out is therefore freed at the fit only if the data determine it: its variance
-//! inflation there, `VIFᵢ = 1 / sin² θᵢ` over the data's configurations
+//! 0.46–0.79 mm²). A parameter the analysis at the nominal leaves out (the same free set
+//! and the data's configurations: the rule by which `model` prints and `plan` designs for
+//! the set at the nominal) is therefore freed at the fit only if the data determine it: its
+//! variance inflation there, `VIFᵢ = 1 / sin² θᵢ` over the data's configurations
 //! ([`crate::model::identifiability::Identifiability::variance_inflation`]), at most
 //! [`DETERMINED_VIF`] (its column more than 0.57° from the span of the others': the same
 //! threshold by which the frames-first start decides which flange offsets the data
@@ -29,16 +29,18 @@ use crate::model::{Model, Status as ParamStatus};
 use crate::Error;
 
 /// The analysis of `model`'s free set at `at` over the configurations `qs`, with every
-/// parameter that `nominal` (the cell's analysis at the nominal) leaves out and that is
-/// identifiable at `at` only with a variance inflation above [`DETERMINED_VIF`] fixed in
-/// `model` (the weakest first, then the analysis again), and the reason for each held one.
+/// parameter that the same analysis at the nominal leaves out and that is identifiable at
+/// `at` only with a variance inflation above [`DETERMINED_VIF`] fixed in `model` (the
+/// weakest first, then the analysis again), and the reason for each held one.
 pub(super) fn analyze_holding_weak(
     model: &mut Model,
     at: &[f64],
     qs: &[Vec<f64>],
     settings: &IdentifiabilitySettings,
-    nominal: &Identifiability,
 ) -> Result<(Identifiability, Vec<(String, String)>), Error> {
+    // The same free set, configurations and stations at the nominal: what is gained at `at`
+    // is gained only by the fit's geometry (not by a term left out, nor by other data).
+    let nominal = &analyze_at(model, &model.nominal(), qs, settings)?;
     let mut held = Vec::new();
     loop {
         let report = analyze_at(model, at, qs, settings)?;
