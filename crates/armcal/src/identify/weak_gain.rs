@@ -49,7 +49,7 @@ pub(super) fn analyze_holding_weak(
             .iter()
             .zip(&report.variance_inflation)
             .filter(|(name, vif)| {
-                !nominal.identifiable.contains(*name) && !(**vif <= DETERMINED_VIF)
+                !nominal.identifiable.contains(*name) && (vif.is_nan() || **vif > DETERMINED_VIF)
             })
             .max_by(|a, b| a.1.total_cmp(b.1));
         let Some((name, &vif)) = weakest else {
