@@ -1,5 +1,9 @@
 //! Completeness and identifiability of a model for a measurement type.
 //!
+//! (Over 600 lines: one analysis — the stacked, column-scaled factor, its rank, the greedy
+//! minimal set, the explanation of every left-out parameter and the variance inflation of
+//! every kept one all read the same factor; split, it would be passed between files.)
+//!
 //! The book's count (book §2.3, eq. 2.49): a complete, minimal model of a serial robot has
 //! `N = 4R + 2P + 6` parameters. What a calibration can identify also depends on what is
 //! measured: a point instead of a full pose loses the tool orientation (3), distances lose
