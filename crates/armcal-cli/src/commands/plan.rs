@@ -241,6 +241,9 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         ),
         None => {}
     }
+    if let Some(d) = &record.rank_deficit {
+        println!("below the generic count: {d}");
+    }
     for t in &record.assessment.tcp {
         println!(
             "(1/3) tr C_s at `{}`{with_measured}: {} mm²{}{}",

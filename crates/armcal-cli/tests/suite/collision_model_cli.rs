@@ -487,3 +487,41 @@ fn an_arm_without_a_collision_model_is_planned_with_a_loud_warning() {
         "{stdout}"
     );
 }
+
+/// A zero skeleton radius builds lines, not an arm: the cell loads (a line is a valid
+/// capsule) with a warning on every command that reads it; a positive radius warns nothing.
+#[test]
+fn a_zero_link_radius_warns_that_the_skeleton_has_no_volume() {
+    let dir = scratch("collision-model-zero-radius");
+    let path = dir.join("cell.toml");
+    for (radius, warns) in [("0", true), ("0.0", true), ("60", false)] {
+        let cell = dh_cell().replace(
+            &format!("link_radius_mm = {RADIUS}\n"),
+            &format!("link_radius_mm = {radius}\n"),
+        );
+        std::fs::write(&path, &cell).unwrap();
+        let (ok, out, err) = armcal(&["model", path.to_str().unwrap()]);
+        assert!(ok, "{err}");
+        assert!(
+            out.contains(&format!("radius {} mm", radius.trim_end_matches(".0"))),
+            "{out}"
+        );
+        let warned = err.contains(
+            "warning: `[robot] link_radius_mm = 0`: a skeleton capsule of radius 0 is the line \
+             between two joint origins, which does not model the arm's volume",
+        );
+        assert_eq!(warned, warns, "radius {radius}: {err}");
+    }
+    // one frame's radius
+    let cell = dh_cell().replace(
+        &format!("link_radius_mm = {RADIUS}\n"),
+        "link_radii_mm = { j2 = 0 }\n",
+    );
+    std::fs::write(&path, &cell).unwrap();
+    let (ok, _, err) = armcal(&["model", path.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("warning: `[robot] link_radii_mm.j2 = 0`: a skeleton capsule of radius 0"),
+        "{err}"
+    );
+}

@@ -11,6 +11,7 @@ mod check_cli;
 mod cli;
 mod collision_model_cli;
 mod compensate_cli;
+mod degenerate_target_cli;
 mod error_causes;
 mod estimate_checks;
 mod facing_target_cli;

@@ -8,6 +8,7 @@ use crate::design::assess::{assess, DesignAssessment};
 use crate::design::plan::{constraint_set, plan, PlanResult, PlanSettings};
 use crate::design::user_pool::{plan_from_pool, PoolReport, PoolSettings};
 use crate::design::ConstraintKind;
+use crate::model::rank_deficit::RankDeficit;
 use crate::model::Model;
 use crate::progress::Observer;
 use crate::Error;
@@ -86,6 +87,11 @@ pub struct DesignRecord {
     /// infeasible rows and the row of every pose.
     #[serde(default)]
     pub pool: Option<PoolReport>,
+    /// Why the cell identifies fewer parameters than the generic count at the nominal, if it
+    /// does (a target on the last joint axis, …): the note `model` prints
+    /// ([`Cell::rank_deficit`]), which bounds what any design can identify.
+    #[serde(default)]
+    pub rank_deficit: Option<RankDeficit>,
 }
 
 /// Display factor (internal → display) and unit name of each joint of a model.
@@ -243,6 +249,8 @@ impl DesignRecord {
     ) -> Result<DesignRecord, Error> {
         let all: Vec<Vec<f64>> = measured.iter().chain(design).cloned().collect();
         let units = joint_units(&cell.model);
+        let generic = cell.identifiability(&cell.identifiability_settings())?;
+        let rank_deficit = cell.rank_deficit(&generic, &cell.model.nominal(), None)?;
         Ok(DesignRecord {
             cell: cell.name.clone(),
             cell_source: cell_source.map(String::from),
@@ -269,6 +277,7 @@ impl DesignRecord {
             collisions,
             plan,
             pool: None,
+            rank_deficit,
         })
     }
 

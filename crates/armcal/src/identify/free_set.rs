@@ -8,6 +8,9 @@ use super::*;
 pub(super) struct FreeSetFit {
     pub(super) model: Model,
     pub(super) reasons: Vec<(String, String)>,
+    /// The parameters held at their nominal as only weakly identifiable at the fit
+    /// ([`super::weak_gain`]).
+    pub(super) weak: Vec<String>,
     /// The problem's final row weights (a robust fit's IRLS weights).
     pub(super) row_weights: Vec<f64>,
     pub(super) solution: SolverResult,
@@ -55,7 +58,7 @@ pub(super) fn fit_free_set(
                     (model.registry.get(*i).name.clone(), why.clone())
                 })
                 .collect();
-            Ok((model, reasons))
+            Ok((model, reasons, Vec::new()))
         }
     };
     let mut at = match &opts.start {
@@ -80,7 +83,7 @@ pub(super) fn fit_free_set(
         decide(&at, &dropped)
     })?;
     loop {
-        let (model, reasons) = decided;
+        let (model, reasons, weak) = decided;
         let mut problem = Problem::new(&model, train, noise)?;
         let (mut solution, mut outliers, mut robust_scale) =
             solve(&mut problem, &at, opts, observer)?;
@@ -126,6 +129,7 @@ pub(super) fn fit_free_set(
             return Ok(FreeSetFit {
                 model,
                 reasons,
+                weak,
                 row_weights,
                 solution,
                 outliers,

@@ -29,6 +29,7 @@ mod split;
 pub mod uncertainty;
 pub mod unit_check;
 pub mod verdicts;
+mod weak_gain;
 
 pub use estimate::{
     Acceptance, AxisErrors, Estimate, HeldOutAxes, HeldOutOrientation, MeasurementResidual,
@@ -158,6 +159,9 @@ impl Default for IdentifySettings {
 /// frames-first estimate or a fit, not the nominal: a target whose nominal offset is
 /// unknown and written as `[0, 0, 0]` lies on the last joint axis there, where two
 /// parameters of that joint have no effect), and the reason for every parameter left out.
+/// A parameter the same analysis at the nominal leaves out is freed there only if the
+/// data determine it ([`weak_gain`]: variance inflation at most [`DETERMINED_VIF`]), so
+/// `plan`'s prediction at the nominal and the fit agree on a target on the last axis.
 /// With `free = "auto"` the free set is the minimal identifiable set *at the data's
 /// configurations*; parameters these data cannot identify although the cell could (e.g. a
 /// joint that never moves, or all poses alike) are marked "from these data". Too few
@@ -171,20 +175,23 @@ pub fn identifiable_model(
         return Ok((cell.model.clone(), Vec::new()));
     }
     let generic = cell.identifiability(&cell.identifiability_settings())?;
-    identifiable_model_given(cell, data, at, &generic, &[])
+    let (model, reasons, _) = identifiable_model_given(cell, data, at, &generic, &[])?;
+    Ok((model, reasons))
 }
 
 /// [`identifiable_model`] of an `auto` cell with the cell's generic analysis (its declared
 /// free set at the nominal, random configurations) already done, so that a fit deciding its
 /// free set more than once does it once; `dropped` are parameters already left out (a
-/// non-geometric term the gate found not separable), with their reasons.
+/// non-geometric term the gate found not separable), with their reasons; and the
+/// parameters held as only weakly identifiable at `at` ([`weak_gain`]).
+type FreeSet = (Model, Vec<(String, String)>, Vec<String>);
 fn identifiable_model_given(
     cell: &Cell,
     data: &Dataset,
     at: &[f64],
     generic: &Identifiability,
     dropped: &[(usize, String)],
-) -> Result<(Model, Vec<(String, String)>), Error> {
+) -> Result<FreeSet, Error> {
     let rows = data.rows();
     if rows < generic.identifiable.len() {
         return Err(Error::Input(format!(
@@ -199,17 +206,15 @@ fn identifiable_model_given(
     for &(i, _) in dropped {
         declared.registry.set_status(i, ParamStatus::Fixed);
     }
-    let report = crate::model::identifiability::analyze_at(
-        &declared,
-        at,
-        &data.configurations,
-        &IdentifiabilitySettings {
-            stations: data.config_stations.clone(),
-            payloads: Some(data.model_payloads(&declared)?),
-            ..cell.identifiability_settings()
-        },
-    )?;
+    let settings = IdentifiabilitySettings {
+        stations: data.config_stations.clone(),
+        payloads: Some(data.model_payloads(&declared)?),
+        ..cell.identifiability_settings()
+    };
+    let (report, held) =
+        weak_gain::analyze_holding_weak(&mut declared, at, &data.configurations, &settings)?;
     report.apply(&mut declared)?;
+    let weak = held.iter().map(|(name, _)| name.clone()).collect();
     let generic_excluded: std::collections::HashSet<&str> =
         generic.excluded.iter().map(|e| e.name.as_str()).collect();
     let reasons = report
@@ -223,13 +228,14 @@ fn identifiable_model_given(
             };
             (e.name, reason)
         })
+        .chain(held)
         .chain(
             dropped
                 .iter()
                 .map(|(i, why)| (declared.registry.get(*i).name.clone(), why.clone())),
         )
         .collect();
-    Ok((declared, reasons))
+    Ok((declared, reasons, weak))
 }
 
 /// The measurement type of a data set for the identifiability analysis, from its first
@@ -424,13 +430,20 @@ fn estimate_of_fit(
     let geometric =
         crate::model::identifiability::IdentifiableCount::of(model, problem.free.iter().copied())
             .geometric;
+    // With a parameter held as only weakly identifiable at the fit (weak_gain), the deficit
+    // is the nominal geometry's (a target on the last axis there), and it is explained there.
+    let deficit_at = if fit.weak.is_empty() {
+        sol.params.clone()
+    } else {
+        model.nominal()
+    };
     let rank_deficit = if let Some(refit) = &opts.refit {
         refit::deficit(cell, refit, names.len(), kept)
     } else if cell.auto_free {
         let declared = cell.declared_model();
         crate::model::rank_deficit::rank_deficit(
             &declared,
-            &sol.params,
+            &deficit_at,
             geometric,
             cell.measurement,
             Some(&train.configurations),

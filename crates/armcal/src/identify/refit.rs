@@ -88,6 +88,7 @@ pub(super) fn fit_frames(
         row_weights: problem.row_weights.clone(),
         model,
         reasons,
+        weak: Vec::new(),
         solution,
         outliers,
         robust_scale,

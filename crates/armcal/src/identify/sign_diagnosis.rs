@@ -8,8 +8,15 @@
 //! with only the instrument, base, tool and target frames and the joint offsets free
 //! (the free set the as-read data identify at the nominal), Levenberg–Marquardt from the
 //! nominal, at most [`QUICK_ITERATIONS`] iterations, on at most [`QUICK_CONFIGURATIONS`]
-//! of the data's configurations. The hypotheses are independent and run
-//! in parallel. One *explains the data* when its residual RMS is within the plausible model
+//! of the data's configurations. Its work is bounded in two stages: every hypothesis is
+//! first screened by a fit of at most [`SCREEN_ITERATIONS`] iterations on at most
+//! [`SCREEN_CONFIGURATIONS`] configurations, and only the [`REFINED`] best that fit better
+//! than the data as read (screened alike) get the quick fit — none when none does, the early
+//! exit on data no hypothesis explains. A right hypothesis leaves the noise after a few
+//! iterations (its frames and offsets start near the nominal's), a wrong one stays near the
+//! as-read RMS, so the screening ranks them apart; on 1000 rows of nonsense (measured points
+//! shuffled between rows) the diagnosis went from 3.7 s to 0.4 s (test profile, 2 shared
+//! cores). The hypotheses are independent and run in parallel. One *explains the data* when its residual RMS is within the plausible model
 //! error (the nominal robot's geometry is kept, so the error it may leave is the nominal
 //! model's, [`super::fit_checks::plausible_model_error`]) and below half the RMS of the data
 //! as read — the smaller of the quick fit's and the full calibration's (a quick fit of the
@@ -28,12 +35,19 @@ use crate::progress::Silent;
 use crate::Error;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Iteration limit of each hypothesis's quick fit.
 pub const QUICK_ITERATIONS: usize = 60;
 /// The quick fits use at most this many of the data's configurations, evenly spread (a sign
 /// or zero mistake shows at every configuration that moves the joint).
 pub const QUICK_CONFIGURATIONS: usize = 200;
+/// Iteration limit of each hypothesis's screening fit (the first stage, module doc).
+pub const SCREEN_ITERATIONS: usize = 15;
+/// The screening fits use at most this many of the quick fits' configurations.
+pub const SCREEN_CONFIGURATIONS: usize = 50;
+/// How many of the best-screened hypotheses get the quick fit (the second stage).
+pub const REFINED: usize = 2;
 
 /// One way the data's joint values may differ from the model's.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -111,6 +125,11 @@ pub struct SignDiagnosis {
     pub explains: bool,
     /// Number of hypotheses fitted (besides the data as read).
     pub tried: usize,
+    /// Levenberg–Marquardt iterations of every screening and quick fit together: the work
+    /// the diagnosis did, at most `(tried + 1) · SCREEN_ITERATIONS + (REFINED + 1) ·
+    /// QUICK_ITERATIONS` (module doc).
+    #[serde(default)]
+    pub iterations: usize,
     /// One sentence: the hypothesis that explains the data with its RMS against the as-read
     /// one, or that none does.
     pub message: String,
@@ -161,14 +180,26 @@ fn quick_model(model: &Model, data: &Dataset) -> Result<Model, Error> {
     Ok(quick)
 }
 
-/// The RMS (mm) of the position errors after the quick fit of `quick` to `data` under
-/// `hypothesis`; `None` when the fit fails.
+/// At most `n` of `data`'s configurations, evenly spread (all of them when there are no more).
+fn evenly_spread(data: &Dataset, n: usize) -> Dataset {
+    let step = data.configurations.len().div_ceil(n).max(1);
+    if step == 1 {
+        return data.clone();
+    }
+    let every: Vec<usize> = (0..data.configurations.len()).step_by(step).collect();
+    data.subset(&every)
+}
+
+/// The RMS (mm) of the position errors after a fit of `quick` to `data` under `hypothesis`
+/// of at most `iterations` iterations, and the iterations it took; `None` when the fit
+/// fails.
 fn score(
     quick: &Model,
     data: &Dataset,
     noise: &NoiseModel,
     hypothesis: &Hypothesis,
-) -> Option<f64> {
+    iterations: usize,
+) -> Option<(f64, usize)> {
     let mut d = data.clone();
     for q in d.configurations.iter_mut() {
         hypothesis.apply(q);
@@ -177,7 +208,7 @@ fn score(
     problem.check_determined().ok()?;
     let settings = LmSettings {
         tolerances: ToleranceSettings {
-            max_iterations: QUICK_ITERATIONS,
+            max_iterations: iterations,
             ..Default::default()
         },
         ..Default::default()
@@ -186,7 +217,7 @@ fn score(
     let mut ws = problem.workspace();
     let e = problem.errors(&mut ws, &sol.params);
     let rms = (e.iter().map(|x| x * x).sum::<f64>() / e.len().max(1) as f64).sqrt();
-    rms.is_finite().then_some(rms)
+    rms.is_finite().then_some((rms, sol.iterations))
 }
 
 /// Tries every hypothesis on `data` for `model` (the cell's model with the data's stations)
@@ -200,37 +231,43 @@ pub fn diagnose(
     tolerance_mm: f64,
     fit_rms_mm: Option<f64>,
 ) -> Result<SignDiagnosis, Error> {
-    let step = data
-        .configurations
-        .len()
-        .div_ceil(QUICK_CONFIGURATIONS)
-        .max(1);
-    let every: Vec<usize> = (0..data.configurations.len()).step_by(step).collect();
-    let sample;
-    let data = if step > 1 {
-        sample = data.subset(&every);
-        &sample
-    } else {
-        data
-    };
+    let data = &evenly_spread(data, QUICK_CONFIGURATIONS);
     let quick = quick_model(model, data)?;
-    let fit = |h: Hypothesis| {
-        score(&quick, data, noise, &h).map(|rms_mm| HypothesisFit {
+    let screen_data = evenly_spread(data, SCREEN_CONFIGURATIONS);
+    let work = AtomicUsize::new(0);
+    let scored = |data: &Dataset, h: &Hypothesis, iterations: usize| {
+        let (rms, done) = score(&quick, data, noise, h, iterations)?;
+        work.fetch_add(done, Ordering::Relaxed);
+        Some(rms)
+    };
+    let fit = |h: Hypothesis, data: &Dataset, iterations: usize| {
+        scored(data, &h, iterations).map(|rms_mm| HypothesisFit {
             words: h.words(model),
             hypothesis: h,
             rms_mm,
         })
     };
-    let as_read = fit(Hypothesis::AsRead).ok_or_else(|| {
+    let as_read = fit(Hypothesis::AsRead, data, QUICK_ITERATIONS).ok_or_else(|| {
         Error::Numerical(
             "the quick fit of the frames and joint offsets failed on the data as read".into(),
         )
     })?;
     let all = hypotheses(model);
     let tried = all.len();
-    let best = all
+    // Stage 1: screen every hypothesis (and the data as read, alike, as their yardstick).
+    let screened_as_read =
+        scored(&screen_data, &Hypothesis::AsRead, SCREEN_ITERATIONS).unwrap_or(f64::INFINITY);
+    let mut screened: Vec<HypothesisFit> = all
         .into_par_iter()
-        .filter_map(fit)
+        .filter_map(|h| fit(h, &screen_data, SCREEN_ITERATIONS))
+        .filter(|f| f.rms_mm < screened_as_read)
+        .collect();
+    screened.sort_by(|a, b| a.rms_mm.total_cmp(&b.rms_mm));
+    screened.truncate(REFINED);
+    // Stage 2: the quick fit of the best screened.
+    let best = screened
+        .into_par_iter()
+        .filter_map(|f| fit(f.hypothesis, data, QUICK_ITERATIONS))
         .min_by(|a, b| a.rms_mm.total_cmp(&b.rms_mm));
     let baseline = fit_rms_mm.map_or(as_read.rms_mm, |f| as_read.rms_mm.min(f));
     let explains = best
@@ -238,14 +275,17 @@ pub fn diagnose(
         .is_some_and(|b| b.rms_mm <= tolerance_mm && b.rms_mm < 0.5 * baseline);
     let message = match (&best, explains) {
         (Some(b), true) => format!(
-            "{} explains the data: residual RMS {:.3} mm against {baseline:.3} mm as read (a quick fit of the frames and joint offsets for each of {tried} sign and zero hypotheses)",
+            "{} explains the data: residual RMS {:.3} mm against {baseline:.3} mm as read (each of {tried} sign and zero hypotheses screened by a short fit of the frames and joint offsets, the {REFINED} best fitted again)",
             b.words, b.rms_mm
         ),
         (Some(b), false) => format!(
-            "no joint sign or zero hypothesis explains the data: the best, {}, leaves {:.3} mm RMS against {baseline:.3} mm as read and {tolerance_mm:.1} mm plausible (a quick fit of the frames and joint offsets for each of {tried} hypotheses)",
+            "no joint sign or zero hypothesis explains the data: the best, {}, leaves {:.3} mm RMS against {baseline:.3} mm as read and {tolerance_mm:.1} mm plausible (each of {tried} hypotheses screened by a short fit of the frames and joint offsets, the {REFINED} best fitted again)",
             b.words, b.rms_mm
         ),
-        (None, _) => format!("no quick fit of the {tried} sign and zero hypotheses succeeded"),
+        (None, _) => format!(
+            "no joint sign or zero hypothesis explains the data: none of the {tried} fits the data better than as read ({:.3} mm RMS; screening fits of the frames and joint offsets)",
+            as_read.rms_mm
+        ),
     };
     Ok(SignDiagnosis {
         as_read,
@@ -253,6 +293,7 @@ pub fn diagnose(
         best,
         explains,
         tried,
+        iterations: work.into_inner(),
         message,
     })
 }

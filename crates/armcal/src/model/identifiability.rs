@@ -1,5 +1,9 @@
 //! Completeness and identifiability of a model for a measurement type.
 //!
+//! (Over 600 lines: one analysis — the stacked, column-scaled factor, its rank, the greedy
+//! minimal set, the explanation of every left-out parameter and the variance inflation of
+//! every kept one all read the same factor; split, it would be passed between files.)
+//!
 //! The book's count (book §2.3, eq. 2.49): a complete, minimal model of a serial robot has
 //! `N = 4R + 2P + 6` parameters. What a calibration can identify also depends on what is
 //! measured: a point instead of a full pose loses the tool orientation (3), distances lose
@@ -146,6 +150,13 @@ pub struct Identifiability {
     pub identifiable: Vec<String>,
     /// Condition number σmax/σmin of the column-normalised Jacobian of the identifiable set.
     pub condition_number: f64,
+    /// Variance inflation of each identifiable parameter, in the order of `identifiable`:
+    /// `VIFᵢ = [(JᵀJ)⁻¹]ᵢᵢ ‖Jᵢ‖² = 1 / sin² θᵢ`, θᵢ the angle between its column and the
+    /// span of the other identifiable columns (Belsley, Kuh & Welsch 1980, *Regression
+    /// Diagnostics*, §3.1): 1 for a column orthogonal to the others, large for one that is
+    /// nearly their combination (a target a fraction of a millimetre from the last axis).
+    #[serde(default)]
+    pub variance_inflation: Vec<f64>,
     /// Candidates left out of the identifiable set, each with the reason.
     pub excluded: Vec<Exclusion>,
 }
@@ -493,6 +504,7 @@ pub fn analyze_at(
     };
     let qr = kept_matrix.clone().qr();
     let (q, r) = (qr.q(), qr.r());
+    let vif_by_kept = variance_inflation(&r);
     let mut excluded = Vec::new();
     for &c in &dropped {
         let pname = name(candidates[c]);
@@ -552,8 +564,12 @@ pub fn analyze_at(
             partners,
         });
     }
-    let mut identifiable: Vec<usize> = kept.iter().map(|&k| candidates[k]).collect();
-    identifiable.sort();
+    let mut identifiable: Vec<(usize, f64)> = kept
+        .iter()
+        .zip(&vif_by_kept)
+        .map(|(&k, &v)| (candidates[k], v))
+        .collect();
+    identifiable.sort_by_key(|&(i, _)| i);
     let (rv, pr) = joint_counts(model);
     Ok(Identifiability {
         measurement: opts.measurement,
@@ -573,10 +589,22 @@ pub fn analyze_at(
         rank_svd,
         rank_qr,
         singular_values: sv,
-        identifiable: identifiable.into_iter().map(name).collect(),
+        variance_inflation: identifiable.iter().map(|&(_, v)| v).collect(),
+        identifiable: identifiable.into_iter().map(|(i, _)| name(i)).collect(),
         condition_number,
         excluded,
     })
+}
+
+/// The variance inflation of every column of a matrix with unit-norm columns from the
+/// triangular factor `r` of its QR decomposition: `(JᵀJ)⁻¹ = R⁻¹R⁻ᵀ`, so `VIFᵢ` is the
+/// squared norm of row `i` of `R⁻¹` (∞ for a singular factor).
+fn variance_inflation(r: &DMatrix<f64>) -> Vec<f64> {
+    let n = r.ncols();
+    match r.clone().try_inverse() {
+        Some(inv) if n > 0 => (0..n).map(|i| inv.row(i).norm_squared()).collect(),
+        _ => vec![f64::INFINITY; n],
+    }
 }
 
 fn measurement_name(m: Measurement) -> &'static str {

@@ -23,7 +23,42 @@ use crate::Error;
 use serde::{Deserialize, Serialize};
 
 /// Below this distance (mm) a point target lies on a joint axis for the rank test.
-const ON_AXIS_MM: f64 = 1e-3;
+pub const ON_AXIS_MM: f64 = 1e-3;
+
+/// The distance (mm) of every point target of `model` at `params` (the tool origin when
+/// there is none) from its last joint axis, if that joint is revolute: `(what, joint, mm)`,
+/// e.g. ``("target `smr1`", "q6", 0.97)``. A point on that axis does not move when the
+/// joint turns (book Prop. 4.7.3).
+pub fn last_axis_distances(model: &Model, params: &[f64]) -> Vec<(String, String, f64)> {
+    let (axes, _) = axes_at_zero(model, params);
+    let Some(last) = axes.last().filter(|a| a.kind == JointKind::Revolute) else {
+        return Vec::new();
+    };
+    let joint = model.joints[axes.len() - 1].name.clone();
+    let mut data = Data::new(model);
+    forward_kinematics(model, &mut data, params, &vec![0.0; model.dof()]);
+    let points: Vec<(String, nalgebra::Vector3<f64>)> = if model.targets.is_empty() {
+        vec![("the tool origin".into(), data.tool().trans)]
+    } else {
+        (0..model.targets.len())
+            .filter(|&k| !model.target_is_frame(k))
+            .map(|k| {
+                (
+                    format!("target `{}`", model.targets[k].spec.name),
+                    data.targets[k].trans,
+                )
+            })
+            .collect()
+    };
+    points
+        .into_iter()
+        .map(|(what, p)| {
+            let off = p - last.point;
+            let dist = (off - last.dir * off.dot(&last.dir)).norm();
+            (what, joint.clone(), dist)
+        })
+        .collect()
+}
 
 /// A rank below the generic count, and why.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -74,34 +109,14 @@ pub fn rank_deficit(
 
     // A point target (or the tool origin) on the last joint axis.
     if m != Measurement::Pose {
-        if let Some(last) = axes.last().filter(|a| a.kind == JointKind::Revolute) {
-            let mut data = Data::new(model);
-            forward_kinematics(model, &mut data, params, &vec![0.0; model.dof()]);
-            let points: Vec<(String, nalgebra::Vector3<f64>)> = if model.targets.is_empty() {
-                vec![("the tool origin".into(), data.tool().trans)]
-            } else {
-                (0..model.targets.len())
-                    .filter(|&k| !model.target_is_frame(k))
-                    .map(|k| {
-                        (
-                            format!("target `{}`", model.targets[k].spec.name),
-                            data.targets[k].trans,
-                        )
-                    })
-                    .collect()
-            };
-            for (what, p) in points {
-                let off = p - last.point;
-                let dist = (off - last.dir * off.dot(&last.dir)).norm();
-                if dist < ON_AXIS_MM {
-                    causes.push(format!(
-                        "{what} lies on the axis of {} ({dist:.4} mm from it), so that joint's \
-                         rotation does not move it and its link parameters have no effect; give \
-                         the target's offset from the flange, even a rough one (the fit refines \
-                         it), or measure a second target off that axis",
-                        joint_name(axes.len() - 1)
-                    ));
-                }
+        for (what, joint, dist) in last_axis_distances(model, params) {
+            if dist < ON_AXIS_MM {
+                causes.push(format!(
+                    "{what} lies on the axis of {joint} ({dist:.4} mm from it), so that joint's \
+                     rotation does not move it and its link parameters have no effect; give \
+                     the target's offset from the flange, even a rough one (the fit refines \
+                     it), or measure a second target off that axis"
+                ));
             }
         }
     }

@@ -224,6 +224,31 @@ pub(super) fn collision_model(
     for (frame, r) in &per_frame {
         check(&format!("robot.link_radii_mm.{frame}"), *r)?;
     }
+    // A zero radius is a valid capsule (a line), but not a model of the arm's volume.
+    let zero: Vec<String> = rr
+        .link_radius_mm
+        .filter(|&r| r == 0.0)
+        .map(|_| "`[robot] link_radius_mm = 0`".to_string())
+        .into_iter()
+        .chain(
+            per_frame
+                .iter()
+                .filter(|(_, &r)| r == 0.0)
+                .map(|(frame, _)| format!("`[robot] link_radii_mm.{frame} = 0`")),
+        )
+        .collect();
+    if !zero.is_empty() {
+        warnings.push(format!(
+            "{}: a skeleton capsule of radius 0 is the line between two joint origins, which \
+             does not model the arm's volume: the obstacles, the floor and the arm itself are \
+             checked against its centre line only, and a planned pose may drive the arm's \
+             real links into them; give the links' half-width (the default is {:.0} % of the \
+             arm's skeleton length, here {:.0} mm)",
+            zero.join(", "),
+            100.0 * skeleton::DEFAULT_RADIUS_SHARE,
+            skeleton::default_link_radius(given)
+        ));
+    }
     let with_tool = tool_capsules.is_empty();
     let radius = |frame: &str| per_frame.get(frame).copied().unwrap_or(default);
     let mut capsules = skeleton::skeleton_capsules(given, &radius, with_tool);
