@@ -106,10 +106,12 @@ pub fn measure_until_stopped(
             .zip(state.next.iter().map(|p| p.id.clone()))
             .filter(|(_, id)| !settings.unmeasurable.contains(id))
             .unzip();
-        let mut batch = crate::sim::simulate(
+        let mut batch = crate::sim::simulate_measuring(
             model,
             truth,
             &qs,
+            &[],
+            cell.measurement,
             Some(&noise),
             seed.wrapping_mul(1000).wrapping_add(k),
         )?;

@@ -214,10 +214,12 @@ fn one_shot_run(
 ) -> Result<RunOutcome, Error> {
     let model = &cell.model;
     let truth = perturbed_truth(model, &settings.perturbation(cell), seed);
-    let data = crate::sim::simulate(
+    let data = crate::sim::simulate_measuring(
         model,
         &truth,
         design,
+        &[],
+        cell.measurement,
         Some(&cell.noise()),
         seed.wrapping_mul(1000).wrapping_add(999),
     )?;

@@ -162,12 +162,20 @@ pub fn simulate_carrying(
     noise: Option<&NoiseModel>,
     seed: u64,
 ) -> Result<Dataset, Error> {
+    // What the targets measure: a frame target its pose, a point its position; the tool
+    // origin's position without targets.
+    let any_frame = (0..model.targets.len()).any(|k| model.target_is_frame(k));
+    let measured = if any_frame {
+        Measured::Pose
+    } else {
+        Measured::Position
+    };
     simulate_measuring(
         model,
         truth,
         configurations,
         payloads,
-        Measured::Position,
+        measured,
         noise,
         seed,
     )
@@ -175,8 +183,9 @@ pub fn simulate_carrying(
 
 /// As [`simulate_carrying`], measuring what `measured` (a cell's `measurement`) says of a
 /// model without targets: the tool frame's full pose for [`Measured::Pose`] (a full-pose
-/// cell, paper eq. 3 with the orientation), else the tool origin's position. Frame targets
-/// are measured in pose and point targets in position either way ([`measurement_at`]).
+/// cell, paper eq. 3 with the orientation), else the tool origin's position. Point targets
+/// are measured in position; frame targets in pose, unless `measured` is
+/// [`Measured::Position`] (a position-measuring cell: [`measurement_at`]).
 pub fn simulate_measuring(
     model: &Model,
     truth: &[f64],
