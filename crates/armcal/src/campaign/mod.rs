@@ -45,6 +45,31 @@ pub fn fewest_poses(cell: &Cell) -> Result<usize, Error> {
 /// state): checks the settings and plans the first batch, the fewest poses that identify
 /// the free set ([`fewest_poses`]), chosen by the settings' planner under every cell
 /// constraint.
+///
+/// ```
+/// use armcal::campaign::{self, CampaignSettings, Decision};
+/// use armcal::progress::Silent;
+/// use armcal::sim::{perturbed_truth, Perturbation};
+///
+/// # fn main() -> armcal::Result<()> {
+/// let cell = armcal::cell::builtin::paper_cell()?;
+/// let settings = CampaignSettings { target_sigma_mm: 0.6, ..CampaignSettings::default() };
+/// let state = campaign::start(&cell, "paper-cell", &settings, &mut Silent)?;
+/// assert_eq!(state.decision, Decision::Measure);
+/// // Measure the poses it asks for (here on a virtual robot), keeping their ids, and step.
+/// let truth = perturbed_truth(&cell.model, &Perturbation::default(), 1);
+/// let qs: Vec<Vec<f64>> = state.next.iter().map(|p| p.q(&cell.model)).collect();
+/// let mut batch = armcal::simulate(&cell.model, &truth, &qs, Some(&cell.noise()), 2)?;
+/// batch.config_ids = state.next.iter().map(|p| p.id.clone()).collect();
+/// let step = campaign::step(&cell, &state, &batch, &mut Silent)?;
+/// assert_eq!(step.state.measured(), qs.len());
+/// // Every working pose's TCP σ from the fit, and what to do next.
+/// let last = step.state.steps.last().unwrap();
+/// assert_eq!(last.working.len(), cell.working.len());
+/// assert!(step.state.decision == Decision::Measure || step.state.decision == Decision::TargetReached);
+/// # Ok(())
+/// # }
+/// ```
 pub fn start(
     cell: &Cell,
     cell_source: &str,

@@ -141,6 +141,35 @@ impl<'a> RowCompensator<'a> {
 /// ([`crate::compensate::joint_change`]). The row's own joints seed the solve: they are
 /// the exact nominal solution of that pose (the branch the program chose), so no closed
 /// form is needed.
+///
+/// ```
+/// use armcal::compensate::program::filter_joint_program;
+/// use armcal::model::random_configurations;
+/// use armcal::{IkSettings, IkStatus};
+///
+/// # fn main() -> armcal::Result<()> {
+/// let cell = armcal::cell::builtin::paper_cell()?;
+/// let model = &cell.model;
+/// let nominal = model.nominal();
+/// let mut calibrated = nominal.clone();
+/// let k = model.registry.index_of("j2.a").unwrap();
+/// calibrated[k] += 0.5; // the calibration found link 2 half a millimetre longer
+/// let program: Vec<(String, Vec<f64>)> = random_configurations(model, 5, 3)
+///     .into_iter()
+///     .enumerate()
+///     .map(|(i, q)| (format!("p{i}"), q))
+///     .collect();
+/// let rows = filter_joint_program(model, &nominal, &calibrated, &program, &IkSettings::default());
+/// for (row, (_, q)) in rows.iter().zip(&program) {
+///     if row.result.status == IkStatus::Converged {
+///         // The joints change a little, and the calibrated robot reaches the nominal pose.
+///         assert!(row.result.q.iter().zip(q).any(|(a, b)| a != b));
+///         assert!(row.result.position_error < 1e-6);
+///     }
+/// }
+/// # Ok(())
+/// # }
+/// ```
 pub fn filter_joint_program(
     model: &Model,
     nominal: &[f64],

@@ -281,7 +281,7 @@ pub fn check(
         sigma_ratio,
         plausible_mm,
         message: format!(
-            "the model does not fit the data: check joint signs, zeros and units. The residual RMS {rms_mm:.3} mm is {sigma_ratio:.1}× what the stated σ predicts (more than {SIGMA_RATIO}×) and above the {plausible_mm:.1} mm any plausible model error leaves (2 mm + 1 % of the arm's {arm_mm:.0} mm); the worst rows: {}",
+            "the model does not fit the data: check joint signs, zeros and units. The residual RMS {rms_mm:.3} mm is {sigma_ratio:.1}× what the stated σ predicts (more than {SIGMA_RATIO}×) and above the {plausible_mm:.1} mm any plausible model error leaves (2 mm + 1 % of the {arm_mm:.0} mm from the base through every joint to the farthest target at q = 0); the worst rows: {}",
             rows_words(&worst_rows)
         ),
     });
