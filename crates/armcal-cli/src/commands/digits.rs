@@ -13,9 +13,30 @@ pub fn decimals_or_digits(x: f64, decimals: usize) -> String {
     format!("{x:.*}", decimals.max(needed))
 }
 
+/// `x` with `decimals` decimals, without the sign of a value that rounds to zero: a nominal
+/// of −1e-16° (what a convention change leaves of a zero angle) prints `0.00000`, not
+/// `-0.00000`.
+pub fn fixed(x: f64, decimals: usize) -> String {
+    let s = format!("{x:.*}", decimals);
+    match s.strip_prefix('-') {
+        Some(unsigned) if unsigned.chars().all(|c| c == '0' || c == '.') => unsigned.to_string(),
+        _ => s,
+    }
+}
+
 #[cfg(test)]
 mod tests {
-    use super::decimals_or_digits;
+    use super::{decimals_or_digits, fixed};
+
+    #[test]
+    fn a_value_that_rounds_to_zero_has_no_sign() {
+        assert_eq!(fixed(-1e-16, 5), "0.00000");
+        assert_eq!(fixed(-0.0, 3), "0.000");
+        assert_eq!(fixed(-0.000004, 5), "0.00000");
+        assert_eq!(fixed(-0.000006, 5), "-0.00001");
+        assert_eq!(fixed(12.5, 2), "12.50");
+        assert_eq!(fixed(f64::NAN, 2), "NaN");
+    }
 
     #[test]
     fn small_values_keep_three_significant_digits_and_large_ones_their_decimals() {

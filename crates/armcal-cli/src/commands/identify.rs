@@ -1,6 +1,6 @@
 //! `armcal identify`: calibrate the cell's free parameters from a data file.
 
-use super::digits::decimals_or_digits;
+use super::digits::{decimals_or_digits, fixed};
 use super::output::{
     load_cell, load_data, load_estimate, load_station_data, station_files, AcceptUnconverged,
     Outputs,
@@ -184,10 +184,10 @@ pub fn print_summary(e: &Estimate) {
     );
     for p in e.parameters.iter().filter(|p| p.free) {
         println!(
-            "{:<14} {:>14.5} {:>14.5} {:>12.5} {:>5}",
+            "{:<14} {:>14} {:>14} {:>12.5} {:>5}",
             p.name,
-            p.nominal,
-            p.estimate,
+            fixed(p.nominal, 5),
+            fixed(p.estimate, 5),
             p.sigma.unwrap_or(f64::NAN),
             p.unit
         );

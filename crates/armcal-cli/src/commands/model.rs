@@ -4,6 +4,7 @@
 //! unchanged; `armcal::cell::model_analysis` says how and with which statuses); the table
 //! and the identifiability analysis are then those of the converted model.
 
+use super::digits::fixed;
 use armcal::cell::model_analysis::{analyze_model, ModelRecord};
 use armcal::model::complete::LinkForm;
 use armcal::model::identifiability::{IdentifiabilitySettings, Measurement};
@@ -99,10 +100,10 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
             ),
         };
         println!(
-            "{:<4} {:<14} {:>14.6} {:<4} {status}",
+            "{:<4} {:<14} {:>14} {:<4} {status}",
             i + 1,
             p.name,
-            p.nominal * p.unit.display_factor(),
+            fixed(p.nominal * p.unit.display_factor(), 6),
             p.unit.display_name()
         );
     }
