@@ -142,3 +142,40 @@ fn an_exported_full_pose_cell_plans_as_identify_fits() {
         "C_s {fit} vs {predicted}"
     );
 }
+
+/// The UR10 export measuring positions, where every start's refinement is rejected (near
+/// rank deficient: column-normalised singular-value ratio 1.5e-5–9.6e-5 < 1e-4 in the
+/// j5.d/j5.alpha and j5.a/j5.theta directions): planned at σ = 1 mm and at σ = 1/16 mm (a
+/// power of two, so every intermediate scales exactly), the design is the same bit for bit,
+/// the rejection the same, and the value scales by exactly (1/16)² — nothing in the planner
+/// compares a σ-dependent quantity with an absolute threshold.
+#[test]
+fn the_ur10_position_plan_does_not_depend_on_the_noise_scale() {
+    let dir = scratch("pose_design_cli_scale");
+    let path = |f: &str| dir.join(f).to_str().unwrap().to_string();
+    let (_, cell) = exported_ur10_cell(&dir);
+    let text = std::fs::read_to_string(&cell)
+        .unwrap()
+        .replace("measurement = \"pose\"", "measurement = \"position\"");
+    let noise = "sigma_mm = [1.0, 1.0, 1.0]";
+    assert!(text.contains(noise), "{text}");
+    let mut plans = Vec::new();
+    for (name, sigma) in [("one", "1.0"), ("sixteenth", "0.0625")] {
+        let cell = path(&format!("{name}.toml"));
+        let s = format!("sigma_mm = [{sigma}, {sigma}, {sigma}]");
+        std::fs::write(&cell, text.replace(noise, &s)).unwrap();
+        let design = path(&format!("{name}.csv"));
+        let (ok, out, err) = armcal(&[
+            "plan", "--cell", &cell, "--poses", "30", "--out", &design, "--quiet",
+        ]);
+        assert!(ok, "{out}{err}");
+        plans.push(json(&path(&format!("{name}.json"))));
+    }
+    let (a, b) = (&plans[0], &plans[1]);
+    assert_eq!(a["poses"], b["poses"]);
+    assert_eq!(a["plan"]["refine_status"], b["plan"]["refine_status"]);
+    let status = a["plan"]["refine_status"].as_str().unwrap();
+    assert!(status.contains("rejected"), "{status}");
+    let value = |p: &Value| p["plan"]["value"].as_f64().unwrap();
+    assert_eq!(value(b), value(a) / 256.0);
+}
