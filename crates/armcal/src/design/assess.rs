@@ -91,6 +91,25 @@ pub fn path_precision(cell: &Cell, d: &DesignModel, cp: &DMatrix<f64>) -> Vec<Pa
 }
 
 /// The predicted precision of `design` (internal units) for `cell`, before anything is measured.
+///
+/// `C_p = (FᵀF)⁻¹` of the σ-weighted identification Jacobian F at the nominal (book §5.3)
+/// and `C_s = G C_p Gᵀ` at every working pose (paper eq. 19 and appendix): what `identify` will report on
+/// these poses if the robot is close to its drawing and the instrument's σ is right.
+///
+/// ```
+/// use armcal::assess;
+/// use armcal::model::random_configurations;
+///
+/// # fn main() -> armcal::Result<()> {
+/// let cell = armcal::cell::builtin::paper_cell()?;
+/// let few = assess(&cell, &random_configurations(&cell.model, 30, 1))?;
+/// let more = assess(&cell, &random_configurations(&cell.model, 120, 1))?;
+/// // Four times the poses: about a quarter of the TCP variance (C_s ∝ 1/N).
+/// let ratio = more.tcp[0].kpi / few.tcp[0].kpi;
+/// assert!(ratio > 0.1 && ratio < 0.5, "{ratio}");
+/// # Ok(())
+/// # }
+/// ```
 pub fn assess(cell: &Cell, design: &[Vec<f64>]) -> Result<DesignAssessment, Error> {
     let d = DesignModel::from_cell(cell)?;
     let mut ws = InformationWorkspace::new(&d);
