@@ -79,7 +79,12 @@ fn held_out_baseline(e: &Estimate) -> Option<(&'static str, &ErrorStats)> {
 pub fn held_out_gain(e: &Estimate) -> Option<f64> {
     let v = e.validation.as_ref()?;
     let (_, before) = held_out_baseline(e)?;
-    (before.rms > 0.0).then(|| 1.0 - v.calibrated.rms / before.rms)
+    gain(before, &v.calibrated)
+}
+
+/// `1 − after/before` of the RMS error (`None` with a zero `before`).
+fn gain(before: &ErrorStats, after: &ErrorStats) -> Option<f64> {
+    (before.rms > 0.0).then(|| 1.0 - after.rms / before.rms)
 }
 
 fn estimate_lines(e: &Estimate) -> Vec<Line> {
@@ -123,7 +128,7 @@ fn estimate_lines(e: &Estimate) -> Vec<Line> {
                     "RMS {} mm with {baseline} → {} mm calibrated ({}; max {} → {} mm) on {} configurations the fit did not see; nothing fitted: RMS {} mm",
                     fixed(before.rms, 3),
                     fixed(v.calibrated.rms, 3),
-                    held_out_gain(e)
+                    gain(before, &v.calibrated)
                         .map(|g| if g >= 0.0 {
                             format!("−{} %", fixed(100.0 * g, 0))
                         } else {
