@@ -5,6 +5,7 @@ mod common;
 
 mod model {
     mod cell_file;
+    mod deploy;
     mod conversions;
     mod derivatives;
     mod export_reload;

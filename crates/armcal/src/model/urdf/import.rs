@@ -383,9 +383,21 @@ fn import_joint(j: &urdf_rs::Joint, name: String) -> Result<LinkSpec, String> {
             }
         ));
     }
+    // `<calibration rising="δ"/>`: the joint offset ROS calibration tools write (the joint
+    // moves by q + δ, super::calibration); `falling` marks a reference switch and is not read.
+    let rising = j.calibration.as_ref().and_then(|c| c.rising).unwrap_or(0.0);
+    let offset = match kind {
+        JointKind::Revolute => rising,
+        JointKind::Prismatic => rising / M_PER_MM,
+    };
+    if !offset.is_finite() {
+        return Err(format!(
+            "<calibration rising=\"{rising}\"> is not a finite joint offset; fix the URDF"
+        ));
+    }
     let mut values = xyz.to_vec();
     values.extend(rpy);
-    values.push(0.0);
+    values.push(offset);
     Ok(LinkSpec {
         name: name.clone(),
         geometry: LinkGeometry {

@@ -35,9 +35,11 @@
 //! URDF links are the joint frames, not armcal's link-end frames; the end of the chain and the
 //! targets are exact.
 
+pub mod calibration;
 pub mod depth;
 pub mod export;
 pub mod import;
+pub mod joint_corrections;
 
 pub use export::to_urdf;
 pub use import::{
