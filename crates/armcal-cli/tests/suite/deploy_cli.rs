@@ -14,7 +14,13 @@ fn deploy_writes_every_vendor_format_and_says_what_it_leaves_out() {
         ("ros-params", "corrections.yaml", "ros__parameters:"),
     ] {
         let (ok, stdout, err) = armcal(&[
-            "deploy", "--estimate", est, "--format", format, "--out", &out(file),
+            "deploy",
+            "--estimate",
+            est,
+            "--format",
+            format,
+            "--out",
+            &out(file),
         ]);
         assert!(ok, "{format}: {err}");
         assert!(stdout.contains(&out(file)), "{stdout}");
@@ -24,22 +30,50 @@ fn deploy_writes_every_vendor_format_and_says_what_it_leaves_out() {
     // The UR file: the hash is not the controller's, and every "not held" line of the
     // terminal is in the file.
     let (ok, _, err) = armcal(&[
-        "deploy", "--estimate", est, "--format", "ur-yaml", "--out", &out("ur.yaml"),
+        "deploy",
+        "--estimate",
+        est,
+        "--format",
+        "ur-yaml",
+        "--out",
+        &out("ur.yaml"),
     ]);
     assert!(ok, "{err}");
     let text = std::fs::read_to_string(out("ur.yaml")).unwrap();
-    assert!(text.contains("kinematics:") && text.contains("NOT the controller's"), "{text}");
-    for line in err.lines().filter_map(|l| l.strip_prefix("warning: not held: ")) {
-        assert!(text.contains(&format!("# not held: {line}")), "{line}\n{text}");
+    assert!(
+        text.contains("kinematics:") && text.contains("NOT the controller's"),
+        "{text}"
+    );
+    for line in err
+        .lines()
+        .filter_map(|l| l.strip_prefix("warning: not held: "))
+    {
+        assert!(
+            text.contains(&format!("# not held: {line}")),
+            "{line}\n{text}"
+        );
     }
     // Conservative: a large k drops corrections, each listed with its σ.
     let (ok, _, err) = armcal(&[
-        "export", "--estimate", est, "--format", "urdf-conservative", "--k-sigma", "1000",
-        "--out", &out("cons.urdf"),
+        "export",
+        "--estimate",
+        est,
+        "--format",
+        "urdf-conservative",
+        "--k-sigma",
+        "1000",
+        "--out",
+        &out("cons.urdf"),
     ]);
     assert!(ok, "{err}");
-    assert!(err.contains("note: conservative: kept the corrections beyond 1000 σ"), "{err}");
-    let dropped = err.lines().filter(|l| l.starts_with("note: dropped ")).count();
+    assert!(
+        err.contains("note: conservative: kept the corrections beyond 1000 σ"),
+        "{err}"
+    );
+    let dropped = err
+        .lines()
+        .filter(|l| l.starts_with("note: dropped "))
+        .count();
     assert!(dropped > 5, "{err}");
     let text = std::fs::read_to_string(out("cons.urdf")).unwrap();
     assert_eq!(text.matches("<!-- dropped ").count(), dropped, "{text}");

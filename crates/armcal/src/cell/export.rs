@@ -314,8 +314,7 @@ pub fn export_against_nominal(
         Some(c) => model_export::export_form(&c.model.spec(), form)?,
         None => spec.clone(),
     };
-    let mut warnings =
-        model_export::suspicious_values(&Model::from_spec(&reference_spec)?, &spec)?;
+    let mut warnings = model_export::suspicious_values(&Model::from_spec(&reference_spec)?, &spec)?;
     let mut notes = Vec::new();
     let source = reference.map_or("an armcal model", |r| r.source);
     let need = || {

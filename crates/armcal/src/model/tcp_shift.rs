@@ -61,7 +61,9 @@ pub(crate) fn spec_shift(a: &ModelSpec, b: &ModelSpec) -> Result<f64, Error> {
 
 /// `spec` without its non-geometric terms (compliance, periodic errors, payloads), and what
 /// leaving them out costs; `None` when it has none.
-pub(crate) fn without_nongeometric(spec: &ModelSpec) -> Result<(ModelSpec, Option<NotHeld>), Error> {
+pub(crate) fn without_nongeometric(
+    spec: &ModelSpec,
+) -> Result<(ModelSpec, Option<NotHeld>), Error> {
     let model = Model::from_spec(spec)?;
     let terms: Vec<&str> = model
         .joint_corrections()

@@ -41,13 +41,13 @@
 //! says so in the file: the UR driver then warns that the file does not match the
 //! controller's calibration, which is true.
 
+use crate::input::field_line;
 use crate::model::chain::{LinkSpec, Model, ModelSpec};
 use crate::model::link::{Convention, Joint, JointKind, LinkGeometry};
 use crate::model::pose::{rot_z, Pose};
 use crate::model::tcp_shift::{spec_shift, without_nongeometric, NotHeld};
 use crate::model::urdf::export::{fixed_pose, split_at_joint};
 use crate::model::urdf::CONTINUOUS_RANGE;
-use crate::input::field_line;
 use crate::Error;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use serde::{Deserialize, Serialize};
@@ -240,7 +240,11 @@ pub fn to_ur_kinematics(spec: &ModelSpec, source: &str) -> Result<UrKinematicsFi
     let tool_index = rigid.links.len() - 1;
     let tool = &rigid.links[tool_index];
     let has_tool = tool.joint.is_none();
-    let arm_end = if has_tool { tool_index } else { rigid.links.len() };
+    let arm_end = if has_tool {
+        tool_index
+    } else {
+        rigid.links.len()
+    };
     let mut origins: Vec<Pose<f64>> = Vec::new();
     let mut pending = Pose::identity();
     for link in &rigid.links[..arm_end] {
@@ -251,7 +255,12 @@ pub fn to_ur_kinematics(spec: &ModelSpec, source: &str) -> Result<UrKinematicsFi
                 let r = z_onto(&axis);
                 let rest = rotation(r.transpose()).compose(&b);
                 let d = rest.trans.z;
-                origins.push(pending.compose(&a).compose(&rotation(r)).compose(&shift_z(d)));
+                origins.push(
+                    pending
+                        .compose(&a)
+                        .compose(&rotation(r))
+                        .compose(&shift_z(d)),
+                );
                 pending = shift_z(-d).compose(&rest);
             }
         }
@@ -356,4 +365,3 @@ fn fnv1a(k: &Kinematics) -> u64 {
     }
     h
 }
-

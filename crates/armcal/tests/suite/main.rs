@@ -5,8 +5,8 @@ mod common;
 
 mod model {
     mod cell_file;
-    mod deploy;
     mod conversions;
+    mod deploy;
     mod derivatives;
     mod export_reload;
     mod exports;

@@ -22,7 +22,10 @@ pub const DEFAULT_K_SIGMA: f64 = 3.0;
 /// Joint `i`'s zero offset of `calibrated` against `nominal`: the difference of the value of
 /// the field the joint acts on (θ, d, the URDF or zero-reference offset). Both specs must
 /// have the same links in the same conventions (an estimate and its nominal model).
-pub(crate) fn joint_offsets(calibrated: &ModelSpec, nominal: &ModelSpec) -> Result<Vec<f64>, Error> {
+pub(crate) fn joint_offsets(
+    calibrated: &ModelSpec,
+    nominal: &ModelSpec,
+) -> Result<Vec<f64>, Error> {
     same_structure(calibrated, nominal)?;
     Ok(calibrated
         .links

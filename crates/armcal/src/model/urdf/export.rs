@@ -252,7 +252,10 @@ pub(crate) fn fixed_pose(g: &LinkGeometry) -> Pose<f64> {
 /// Splits a jointed link `T(q) = A · J(q) · B`: returns `A` (factors up to and including the
 /// joint's factor at its nominal value), the unit joint direction in the frame after `A`,
 /// and `B` (the factors after the joint's).
-pub(crate) fn split_at_joint(g: &LinkGeometry, kind: JointKind) -> (Pose<f64>, Vector3<f64>, Pose<f64>) {
+pub(crate) fn split_at_joint(
+    g: &LinkGeometry,
+    kind: JointKind,
+) -> (Pose<f64>, Vector3<f64>, Pose<f64>) {
     let joint_field = g
         .convention
         .joint_field(kind)

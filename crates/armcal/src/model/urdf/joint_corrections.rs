@@ -21,8 +21,8 @@
 //! how to apply it in its header. A joint the file does not name keeps its nominal origin.
 
 use super::calibration::joint_offsets;
-use crate::input::field_line;
 use super::export::urdf_robot;
+use crate::input::field_line;
 use crate::model::chain::ModelSpec;
 use crate::model::pose::Pose;
 use crate::model::tcp_shift::{without_nongeometric, NotHeld};

@@ -64,14 +64,24 @@ fn export(calibrated: &ModelSpec, nominal: &ModelSpec, format: ExportFormat) -> 
         .content
 }
 
-const ROBOTS: [&str; 6] = ["ur10", "puma560", "irb120", "kr15", "motoman-right", "paper"];
+const ROBOTS: [&str; 6] = [
+    "ur10",
+    "puma560",
+    "irb120",
+    "kr15",
+    "motoman-right",
+    "paper",
+];
 
 #[test]
 fn urdf_with_calibration_offsets_reloads_to_the_same_kinematics() {
     for name in ROBOTS {
         let (nominal, calibrated) = nominal_and_calibrated(name, 3);
         let text = export(&calibrated, &nominal, ExportFormat::UrdfCalibration(None));
-        assert!(text.contains("<calibration rising="), "{name}: no joint offset written");
+        assert!(
+            text.contains("<calibration rising="),
+            "{name}: no joint offset written"
+        );
         let back = from_urdf_str(&text, None).unwrap();
         let (p, r) = fk_gap(&calibrated, &back);
         assert!(p < 1e-9 && r < 1e-12, "{name}: {p} mm, {r} rad");
@@ -92,8 +102,13 @@ fn conservative_urdf_keeps_what_is_beyond_k_sigma_and_lists_the_rest() {
         let (nominal, calibrated) = nominal_and_calibrated(name, 4);
         let k = 3.0;
         let (kept, dropped, total) = conservative(&calibrated, &nominal, &sigma_of, k).unwrap();
-        assert!(!dropped.is_empty(), "{name}: σ = 0.05 drops some corrections");
-        assert!(dropped.iter().all(|d| d.correction.abs() <= k * 0.05 && d.sigma == 0.05));
+        assert!(
+            !dropped.is_empty(),
+            "{name}: σ = 0.05 drops some corrections"
+        );
+        assert!(dropped
+            .iter()
+            .all(|d| d.correction.abs() <= k * 0.05 && d.sigma == 0.05));
         // Every kept parameter is the calibrated value or beyond k σ; every dropped one nominal.
         let (mk, mc, mn) = (
             Model::from_spec(&kept).unwrap(),
@@ -114,23 +129,38 @@ fn conservative_urdf_keeps_what_is_beyond_k_sigma_and_lists_the_rest() {
             random_configurations(&ma, SHIFT_CONFIGURATIONS, SHIFT_SEED)
                 .iter()
                 .map(|q| {
-                    (tool_pose(&ma, &ma.nominal(), q).trans - tool_pose(&mb, &mb.nominal(), q).trans)
+                    (tool_pose(&ma, &ma.nominal(), q).trans
+                        - tool_pose(&mb, &mb.nominal(), q).trans)
                         .norm()
                 })
                 .fold(0.0, f64::max)
         };
         let gap = shift(&calibrated, &kept);
-        assert!(total > 0.0 && (gap - total).abs() < 1e-12, "{name}: {gap} ≠ {total}");
+        assert!(
+            total > 0.0 && (gap - total).abs() < 1e-12,
+            "{name}: {gap} ≠ {total}"
+        );
         let first = &dropped[0];
         let i = mc.registry.index_of(&first.name).unwrap();
         let mut one = mc.nominal();
         one[i] = mn.nominal()[i];
         let gap = shift(&calibrated, &mc.spec_at(&one));
-        assert!((gap - first.tcp_shift_mm).abs() < 1e-12, "{name}: {gap} vs {first:?}");
+        assert!(
+            (gap - first.tcp_shift_mm).abs() < 1e-12,
+            "{name}: {gap} vs {first:?}"
+        );
         // The file holds the conservative model and lists what it dropped.
-        let text = export(&calibrated, &nominal, ExportFormat::UrdfCalibration(Some(k)));
+        let text = export(
+            &calibrated,
+            &nominal,
+            ExportFormat::UrdfCalibration(Some(k)),
+        );
         for d in &dropped {
-            assert!(text.contains(&format!("dropped {}:", d.name)), "{name}: {}", d.name);
+            assert!(
+                text.contains(&format!("dropped {}:", d.name)),
+                "{name}: {}",
+                d.name
+            );
         }
         let (p, r) = fk_gap(&kept, &from_urdf_str(&text, None).unwrap());
         assert!(p < 1e-9 && r < 1e-12, "{name}: {p} mm, {r} rad");
@@ -145,7 +175,10 @@ fn ros_joint_corrections_reload_to_the_same_kinematics() {
     for name in ROBOTS {
         let (nominal, calibrated) = nominal_and_calibrated(name, 5);
         let text = export(&calibrated, &nominal, ExportFormat::JointCorrections);
-        assert!(text.contains("ros__parameters:") && text.contains("droll:"), "{text}");
+        assert!(
+            text.contains("ros__parameters:") && text.contains("droll:"),
+            "{text}"
+        );
         let back = apply_joint_corrections(&text, &nominal).unwrap();
         let (p, r) = fk_gap(&calibrated, &back);
         assert!(p < 1e-9 && r < 1e-12, "{name}: {p} mm, {r} rad");
@@ -159,10 +192,13 @@ fn ros_joint_corrections_reload_to_the_same_kinematics() {
 #[test]
 fn ros_joint_corrections_errors_name_line_and_field() {
     let nominal = armcal::robots::robot("ur10").unwrap().spec;
-    let text = "armcal_joint_corrections:\n  ros__parameters:\n    corrections:\n      q9:\n        \
+    let text =
+        "armcal_joint_corrections:\n  ros__parameters:\n    corrections:\n      q9:\n        \
                 dx: 0\n        dy: 0\n        dz: 0\n        droll: 0\n        dpitch: 0\n        \
                 dyaw: 0\n";
-    let e = apply_joint_corrections(text, &nominal).unwrap_err().to_string();
+    let e = apply_joint_corrections(text, &nominal)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("line 4") && e.contains("corrections.q9"), "{e}");
     let e = apply_joint_corrections(&text.replace("droll: 0", "droll: .nan"), &nominal)
         .unwrap_err()
@@ -179,7 +215,9 @@ fn the_builtin_ur10_is_universal_robots_default_kinematics_file() {
     let spec = armcal::robots::robot("ur10").unwrap().spec;
     let file = to_ur_kinematics(&spec, "the built-in UR10").unwrap();
     assert!(file.not_held.is_empty(), "{:?}", file.not_held);
-    assert!(file.text.contains("NOT the controller's calibration checksum"));
+    assert!(file
+        .text
+        .contains("NOT the controller's calibration checksum"));
     let value: serde_norway::Value = serde_norway::from_str(&file.text).unwrap();
     let k = &value["kinematics"];
     let v = |frame: &str, field: &str| k[frame][field].as_f64().unwrap();
@@ -202,7 +240,11 @@ fn the_builtin_ur10_is_universal_robots_default_kinematics_file() {
     let ur = armcal::model::Pose::from_xyz_rpy([0.0; 3], [PI / 2.0, PI, PI]);
     let ours = armcal::model::Pose::from_xyz_rpy(
         [0.0; 3],
-        [v("wrist_3", "roll"), v("wrist_3", "pitch"), v("wrist_3", "yaw")],
+        [
+            v("wrist_3", "roll"),
+            v("wrist_3", "pitch"),
+            v("wrist_3", "yaw"),
+        ],
     );
     assert!((ur.rot - ours.rot).norm() < 1e-9);
     let (p, r) = fk_gap(&spec, &from_ur_kinematics_str(&file.text).unwrap());
@@ -225,7 +267,11 @@ fn ur_kinematics_reload_and_say_what_they_do_not_hold() {
             Some(n) => assert!((p - n.tcp_shift_mm).abs() < 1e-9, "{name}: {p} vs {n:?}"),
             None => assert!(p < 1e-9 && r < 1e-12, "{name}: {p} mm, {r} rad"),
         }
-        let t = file.not_held.iter().find(tool).expect("a perturbed tool frame is listed");
+        let t = file
+            .not_held
+            .iter()
+            .find(tool)
+            .expect("a perturbed tool frame is listed");
         let (pt, _) = fk_gap(&calibrated, &arm);
         assert!((pt - t.tcp_shift_mm).abs() < 1e-9 && pt > 0.0, "{name}");
         assert!(file.text.contains(&format!("# {}", t.sentence())));
@@ -271,21 +317,26 @@ fn ur10_kinematics_with_known_deltas_read_as_a_cell_robot_reproduce_them() {
     // A bad value names the file, the line and the field.
     let bad = file.text.replacen("roll: ", "roll: .inf #", 2);
     std::fs::write(dir.join("calibration.yaml"), &bad).unwrap();
-    let e = Cell::from_file(&dir.join("cell.toml")).unwrap_err().to_string();
+    let e = Cell::from_file(&dir.join("cell.toml"))
+        .unwrap_err()
+        .to_string();
     let line = bad
         .lines()
         .position(|l| l.contains(".inf"))
         .map(|i| i + 1)
         .unwrap();
     assert!(
-        e.contains("calibration.yaml")
-            && e.contains(&format!("line {line}"))
-            && e.contains("roll"),
+        e.contains("calibration.yaml") && e.contains(&format!("line {line}")) && e.contains("roll"),
         "{e}"
     );
-    std::fs::write(dir.join("calibration.yaml"), file.text.replace("  pitch:", "  pich:"))
-        .unwrap();
-    let e = Cell::from_file(&dir.join("cell.toml")).unwrap_err().to_string();
+    std::fs::write(
+        dir.join("calibration.yaml"),
+        file.text.replace("  pitch:", "  pich:"),
+    )
+    .unwrap();
+    let e = Cell::from_file(&dir.join("cell.toml"))
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("pich") && e.contains("line"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
