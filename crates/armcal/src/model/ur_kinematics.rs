@@ -111,19 +111,7 @@ struct File {
 /// Reads a UR kinematics YAML file as a model (see the module documentation); errors name
 /// the file, the line and the field.
 pub fn read_ur_kinematics(path: &Path) -> Result<ModelSpec, Error> {
-    let file = path.display().to_string();
-    let text =
-        crate::input::read_capped(path, crate::input::TEXT_CAP).map_err(|e| Error::File {
-            file: file.clone(),
-            message: format!("cannot read the UR kinematics file: {e}"),
-        })?;
-    from_ur_kinematics_str(&text).map_err(|e| Error::File {
-        file,
-        message: match e {
-            Error::Input(m) => m,
-            other => other.to_string(),
-        },
-    })
+    crate::model::urdf::parse_file(path, "the UR kinematics file", from_ur_kinematics_str)
 }
 
 /// Parses UR kinematics YAML text as a model named `ur` (see the module documentation).

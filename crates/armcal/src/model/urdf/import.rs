@@ -23,20 +23,7 @@ pub fn read_urdf_with_collisions(
     path: impl AsRef<Path>,
     tip: Option<&str>,
 ) -> Result<(ModelSpec, Vec<CollisionShape>), Error> {
-    let path = path.as_ref();
-    let file = path.display().to_string();
-    let text =
-        crate::input::read_capped(path, crate::input::TEXT_CAP).map_err(|e| Error::File {
-            file: file.clone(),
-            message: format!("cannot read the URDF file: {e}"),
-        })?;
-    parse(&text, tip).map_err(|e| Error::File {
-        file,
-        message: match e {
-            Error::Input(m) => m,
-            other => other.to_string(),
-        },
-    })
+    super::parse_file(path.as_ref(), "the URDF file", |text| parse(text, tip))
 }
 
 /// Parses URDF text and imports the chain from its root to `tip` (default: the single leaf);

@@ -136,18 +136,8 @@ pub fn to_joint_corrections(
 /// Reads a joint-corrections file and applies it to `nominal` (see the module
 /// documentation); errors name the file, the line and the field.
 pub fn read_joint_corrections(path: &Path, nominal: &ModelSpec) -> Result<ModelSpec, Error> {
-    let file = path.display().to_string();
-    let text =
-        crate::input::read_capped(path, crate::input::TEXT_CAP).map_err(|e| Error::File {
-            file: file.clone(),
-            message: format!("cannot read the joint corrections file: {e}"),
-        })?;
-    apply_joint_corrections(&text, nominal).map_err(|e| Error::File {
-        file,
-        message: match e {
-            Error::Input(m) => m,
-            other => other.to_string(),
-        },
+    super::parse_file(path, "the joint corrections file", |text| {
+        apply_joint_corrections(text, nominal)
     })
 }
 
