@@ -202,6 +202,69 @@ pub fn urdf(text: &str) {
     }
 }
 
+/// The tool poses of `spec` at three seeded configurations, and those of `again`: the same
+/// to 1e-6 of their size (a file armcal wrote, read back).
+fn same_tool_poses(spec: &armcal::model::ModelSpec, again: &armcal::model::ModelSpec, file: &str) {
+    let (Ok(model), Ok(back)) = (Model::from_spec(spec), Model::from_spec(again)) else {
+        panic!("armcal cannot build the model of the file it wrote:\n{file}");
+    };
+    for q in random_configurations(&model, 3, 1) {
+        let (a, b) = (
+            tool_pose(&model, &model.nominal(), &q),
+            tool_pose(&back, &back.nominal(), &q),
+        );
+        let scale = 1.0 + a.trans.norm();
+        assert!(
+            (a.trans - b.trans).norm() <= 1e-6 * scale || !a.trans.norm().is_finite(),
+            "reading back moved the tool: {:?} → {:?}\n{file}",
+            a.trans,
+            b.trans
+        );
+    }
+}
+
+/// UR kinematics YAML → model → UR kinematics file → model: the same tool pose.
+pub fn ur_kinematics(text: &str) {
+    use armcal::model::ur_kinematics::{from_ur_kinematics_str, to_ur_kinematics};
+    let Ok(spec) = from_ur_kinematics_str(text) else {
+        return;
+    };
+    if Model::from_spec(&spec).is_err() {
+        return;
+    }
+    let Ok(file) = to_ur_kinematics(&spec, "fuzz") else {
+        return;
+    };
+    let again = from_ur_kinematics_str(&file.text)
+        .unwrap_or_else(|e| panic!("armcal cannot read the UR file it wrote: {e}\n{}", file.text));
+    same_tool_poses(&spec, &again, &file.text);
+}
+
+/// ROS 2 joint corrections applied to the built-in UR10 → model → corrections against the
+/// UR10's URDF chain → applied again: the same tool pose.
+pub fn joint_corrections(text: &str) {
+    use armcal::model::urdf::joint_corrections::{apply_joint_corrections, to_joint_corrections};
+    let nominal = armcal::robots::robot("ur10").expect("built in").spec;
+    let Ok(spec) = apply_joint_corrections(text, &nominal) else {
+        return;
+    };
+    if Model::from_spec(&spec).is_err() {
+        return;
+    }
+    // The corrected chain is a URDF chain; its nominal is the UR10's URDF chain.
+    let Ok(chain) = armcal::model::urdf::to_urdf(&nominal)
+        .and_then(|x| armcal::model::urdf::from_urdf_str(&x, None))
+    else {
+        return;
+    };
+    let Ok(file) = to_joint_corrections(&spec, &chain, "fuzz") else {
+        return;
+    };
+    let again = apply_joint_corrections(&file.text, &chain)
+        .unwrap_or_else(|e| panic!("armcal cannot read the corrections it wrote: {e}\n{}", file.text));
+    same_tool_poses(&spec, &again, &file.text);
+}
+
 /// armcal JSON (estimate, design, study, demo summary) → the report page; an estimate also
 /// through every export and a prediction, a design through its evaluation.
 pub fn records(text: &str) {

@@ -53,7 +53,9 @@ enum Command {
     Pivot(commands::pivot::Args),
     /// Joint axes by circle point analysis from one-joint-at-a-time sweeps.
     Axes(commands::axes::Args),
-    /// Export the calibrated model (cell file with DH / modified-DH / zero-reference links, JSON, URDF).
+    /// Export the calibrated model (cell file with DH / modified-DH / zero-reference links, JSON, URDF,
+    /// URDF with calibration offsets, Universal Robots kinematics YAML, ROS 2 joint corrections).
+    #[command(alias = "deploy")]
     Export(commands::export::Args),
     /// A self-contained HTML report (inline SVG figures, 3D cell view) of estimates, designs and studies.
     Report(commands::report::Args),

@@ -44,3 +44,25 @@ pub fn read_capped(path: &Path, default: u64) -> std::io::Result<String> {
     }
     Ok(text)
 }
+
+/// The 1-based line of `field:` in the block that starts at the first line `key:` of a YAML
+/// text (the line of `key:` itself for an empty `field`; 0 without `key:`): where an error
+/// found after parsing (a value that is not finite) points the user.
+pub fn field_line(text: &str, key: &str, field: &str) -> usize {
+    let lines: Vec<&str> = text.lines().collect();
+    let Some(start) = lines
+        .iter()
+        .position(|l| l.trim_start().starts_with(&format!("{key}:")))
+    else {
+        return 0;
+    };
+    if field.is_empty() {
+        return start + 1;
+    }
+    lines
+        .iter()
+        .enumerate()
+        .skip(start)
+        .find(|(_, l)| l.contains(&format!("{field}:")))
+        .map_or(start + 1, |(i, _)| i + 1)
+}

@@ -94,6 +94,7 @@ pub use compensate::{calibrated_ik, IkSettings, IkStatus, IkTarget};
 pub use design::assess::assess;
 pub use design::plan::{plan, PlanResult, PlanSettings};
 pub use design::{Criterion, DesignRecord};
+pub use identify::export::export_estimate;
 pub use identify::{identify, Estimate, IdentifySettings};
 pub use measure::Dataset;
 pub use model::Model;

@@ -1,8 +1,12 @@
-//! `armcal export`: the calibrated model as a cell file (DH, modified-DH or zero-reference
-//! links), a parameter table, JSON or URDF.
+//! `armcal export` (alias `armcal deploy`): the calibrated model as a cell file (DH,
+//! modified-DH or zero-reference links), a parameter table, JSON, URDF (plain, with
+//! `<calibration rising>` joint offsets, conservative), a Universal Robots kinematics YAML or
+//! a ROS 2 parameter file of per-joint corrections. One command writes a model in every
+//! format: the vendor files are formats of it, and `deploy` (the name) is an alias.
 
 use super::output::{with_note, Calibration, NoteStyle, Outputs};
-use armcal::cell::export::{export_model, ExportFormat};
+use armcal::cell::export::ExportFormat;
+use armcal::model::urdf::calibration::DEFAULT_K_SIGMA;
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -10,8 +14,12 @@ pub struct Args {
     #[command(flatten)]
     pub calibration: Calibration,
     /// Output format.
-    #[arg(long, value_parser = ["dh", "mdh", "zrp", "json", "urdf", "cell"])]
+    #[arg(long, value_parser = ["dh", "mdh", "zrp", "json", "urdf", "cell", "urdf-calibration",
+        "urdf-conservative", "ur-yaml", "ros-params"])]
     pub format: String,
+    /// `urdf-conservative`: keep a correction only if it is more than this many σ from zero.
+    #[arg(long, default_value_t = DEFAULT_K_SIGMA)]
+    pub k_sigma: f64,
     /// Output file. `dh`, `mdh`, `zrp` and `cell` write a loadable cell file (TOML) and a
     /// parameter table next to it (same name, `.csv`).
     #[arg(long)]
@@ -28,7 +36,10 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
-    let format = ExportFormat::from_name(&a.format).expect("clap checked");
+    let format = match ExportFormat::from_name(&a.format).expect("clap checked") {
+        ExportFormat::UrdfCalibration(Some(_)) => ExportFormat::UrdfCalibration(Some(a.k_sigma)),
+        f => f,
+    };
     let table = a.out.with_extension("csv");
     let mut outs = vec![a.out.as_path()];
     if matches!(format, ExportFormat::Cell(_)) {
@@ -44,16 +55,22 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         .transpose()?;
     let (est, note) = a.calibration.load(cell.as_ref().map(|c| &c.model))?;
     let note = note.as_deref();
-    let exported = export_model(&est.model, cell.as_ref(), format)?;
+    let exported = armcal::export_estimate(&est, cell.as_ref(), format)?;
     for w in &exported.warnings {
         eprintln!("warning: {w}");
+    }
+    for n in &exported.notes {
+        eprintln!("note: {n}");
     }
     match format {
         ExportFormat::Json => {
             outputs.commit(&[(&a.out, &with_note(exported.content, note, NoteStyle::Json))])?
         }
-        ExportFormat::Urdf => {
+        ExportFormat::Urdf | ExportFormat::UrdfCalibration(_) => {
             outputs.commit(&[(&a.out, &with_note(exported.content, note, NoteStyle::Xml))])?
+        }
+        ExportFormat::UrKinematics | ExportFormat::JointCorrections => {
+            outputs.commit(&[(&a.out, &with_note(exported.content, note, NoteStyle::Hash))])?
         }
         ExportFormat::Cell(_) => {
             if cell.is_none() {

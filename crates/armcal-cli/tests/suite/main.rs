@@ -12,6 +12,7 @@ mod cli;
 mod collision_model_cli;
 mod compensate_cli;
 mod degenerate_target_cli;
+mod deploy_cli;
 mod error_causes;
 mod estimate_checks;
 mod facing_target_cli;

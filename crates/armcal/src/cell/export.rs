@@ -195,7 +195,7 @@ fn fixed_priors(cell: &Cell, declared: &Model, exported: &Model) -> String {
 }
 
 /// The formats of `armcal export`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ExportFormat {
     /// A cell file with the links in this form (DH, modified DH, zero reference, or as
     /// identified), with a parameter table.
@@ -204,10 +204,21 @@ pub enum ExportFormat {
     Json,
     /// URDF (the model's links as joints and fixed frames).
     Urdf,
+    /// URDF with the joint offsets against the nominal model as `<calibration rising>`
+    /// ([`urdf::calibration`]); `Some(k)`: the conservative variant, keeping only the
+    /// corrections beyond `k σ`.
+    UrdfCalibration(Option<f64>),
+    /// Universal Robots kinematics YAML ([`crate::model::ur_kinematics`]).
+    UrKinematics,
+    /// Per-joint corrections against the nominal model as a ROS 2 parameter file
+    /// ([`urdf::joint_corrections`]).
+    JointCorrections,
 }
 
 impl ExportFormat {
-    /// `dh`, `mdh`, `zrp`, `cell` (links as identified), `json` or `urdf`.
+    /// `dh`, `mdh`, `zrp`, `cell` (links as identified), `json`, `urdf`,
+    /// `urdf-calibration`, `urdf-conservative` (k = [`urdf::calibration::DEFAULT_K_SIGMA`]),
+    /// `ur-yaml` or `ros-params`.
     pub fn from_name(s: &str) -> Option<ExportFormat> {
         Some(match s {
             "dh" => ExportFormat::Cell(LinkForm::Dh),
@@ -216,8 +227,23 @@ impl ExportFormat {
             "cell" => ExportFormat::Cell(LinkForm::AsGiven),
             "json" => ExportFormat::Json,
             "urdf" => ExportFormat::Urdf,
+            "urdf-calibration" => ExportFormat::UrdfCalibration(None),
+            "urdf-conservative" => {
+                ExportFormat::UrdfCalibration(Some(urdf::calibration::DEFAULT_K_SIGMA))
+            }
+            "ur-yaml" => ExportFormat::UrKinematics,
+            "ros-params" => ExportFormat::JointCorrections,
             _ => return None,
         })
+    }
+
+    /// Whether the format writes corrections against the nominal model (which
+    /// [`export_model`] does not have: [`crate::export_estimate`]).
+    pub fn needs_nominal(self) -> bool {
+        matches!(
+            self,
+            ExportFormat::UrdfCalibration(_) | ExportFormat::JointCorrections
+        )
     }
 }
 
@@ -230,47 +256,138 @@ pub struct Exported {
     pub content: String,
     /// The parameter table beside a cell export.
     pub table_csv: Option<String>,
-    /// Values to check before loading the export, each as a sentence.
+    /// Values to check before loading the export, and what the format does not hold with
+    /// the TCP shift its omission causes, each as a sentence.
     pub warnings: Vec<String>,
+    /// What a reader should know besides (the corrections a conservative export dropped),
+    /// each as a sentence; the file carries them as comments.
+    pub notes: Vec<String>,
 }
 
 /// Exports the identified model `identified` (the estimate's spec) in `format`
 /// ([`model_export::export_form`]); with the `cell` it was identified in, a cell export
 /// carries the cell's other sections ([`to_cell_toml`]), else the model alone, and the
-/// suspicious values are judged against the cell's nominal model in the same form.
+/// suspicious values are judged against the cell's nominal model in the same form. The
+/// formats that write corrections against the nominal model need it:
+/// [`export_against_nominal`].
 pub fn export_model(
     identified: &ModelSpec,
     cell: Option<&Cell>,
     format: ExportFormat,
 ) -> Result<Exported, Error> {
+    if format.needs_nominal() {
+        return Err(Error::Input(format!(
+            "{format:?} writes corrections against the nominal model: export an estimate"
+        )));
+    }
+    export_against_nominal(identified, None, cell, format)
+}
+
+/// The nominal model and the σ of the estimate a model was identified with: what
+/// corrections are written against.
+pub struct NominalReference<'a> {
+    /// The nominal model: the same chain at its nominal values.
+    pub nominal: &'a ModelSpec,
+    /// σ of a parameter by name (internal units); `None` for a parameter not estimated.
+    pub sigma: &'a dyn Fn(&str) -> Option<f64>,
+    /// Where the model comes from, for the file's header.
+    pub source: &'a str,
+}
+
+/// [`export_model`], with the nominal model and σ the `urdf-calibration`,
+/// `urdf-conservative` and `ros-params` formats need (`reference`); the UR kinematics file
+/// names its source from it. Every format's [`Exported::warnings`] say what it does not hold
+/// and by how much the TCP moves without it; the file says so too.
+pub fn export_against_nominal(
+    identified: &ModelSpec,
+    reference: Option<&NominalReference>,
+    cell: Option<&Cell>,
+    format: ExportFormat,
+) -> Result<Exported, Error> {
     let form = match format {
         ExportFormat::Cell(form) => form,
-        ExportFormat::Json | ExportFormat::Urdf => LinkForm::AsGiven,
+        _ => LinkForm::AsGiven,
     };
     let model = Model::from_spec(identified)?;
     let spec = model_export::export_form(identified, form)?;
-    let reference = match cell {
+    let reference_spec = match cell {
         Some(c) => model_export::export_form(&c.model.spec(), form)?,
         None => spec.clone(),
     };
-    let mut warnings = model_export::suspicious_values(&Model::from_spec(&reference)?, &spec)?;
-    let terms: Vec<&str> = model
-        .joint_corrections()
-        .map(|(p, _)| model.registry.get(p).name.as_str())
-        .collect();
-    if format == ExportFormat::Urdf && !terms.is_empty() {
-        warnings.push(format!(
-            "URDF has no form for the non-geometric terms ({}): the file holds the geometry \
-             alone and predicts without the deflection; export `cell` or `json` to keep them",
-            terms.join(", ")
-        ));
-    }
+    let mut warnings = model_export::suspicious_values(&Model::from_spec(&reference_spec)?, &spec)?;
+    let mut notes = Vec::new();
+    let source = reference.map_or("an armcal model", |r| r.source);
+    let need = || {
+        reference.ok_or_else(|| {
+            Error::Input(format!(
+                "{format:?} writes corrections against the nominal model: export an estimate"
+            ))
+        })
+    };
+    let mut not_held = Vec::new();
     let (content, table_csv) = match format {
         ExportFormat::Json => (
             serde_json::to_string_pretty(&spec).map_err(|e| Error::Input(e.to_string()))?,
             None,
         ),
-        ExportFormat::Urdf => (urdf::to_urdf(&spec)?, None),
+        ExportFormat::Urdf => {
+            let (rigid, lost) = crate::model::tcp_shift::without_nongeometric(&spec)?;
+            not_held.extend(lost);
+            (urdf::to_urdf(&rigid)?, None)
+        }
+        ExportFormat::UrdfCalibration(k) => {
+            let r = need()?;
+            let (rigid, lost) = crate::model::tcp_shift::without_nongeometric(&spec)?;
+            let (nominal, _) = crate::model::tcp_shift::without_nongeometric(r.nominal)?;
+            not_held.extend(lost);
+            let written = match k {
+                None => rigid,
+                Some(k) => {
+                    let (kept, dropped, total) =
+                        urdf::calibration::conservative(&rigid, &nominal, r.sigma, k)?;
+                    notes.push(format!(
+                        "conservative: kept the corrections beyond {k} σ; dropped {} (the TCP \
+                         moves up to {total:.4} mm without them, max over {} random \
+                         configurations, seed {})",
+                        dropped.len(),
+                        crate::model::tcp_shift::SHIFT_CONFIGURATIONS,
+                        crate::model::tcp_shift::SHIFT_SEED
+                    ));
+                    let unit = |name: &str| {
+                        model
+                            .registry
+                            .index_of(name)
+                            .map_or(crate::model::Unit::Mm, |i| model.registry.get(i).unit)
+                    };
+                    for d in &dropped {
+                        let u = unit(&d.name);
+                        notes.push(format!(
+                            "dropped {}: correction {:.6} ± σ {:.6} {} (TCP shift {:.4} mm)",
+                            d.name,
+                            d.correction * u.display_factor(),
+                            d.sigma * u.display_factor(),
+                            u.display_name(),
+                            d.tcp_shift_mm
+                        ));
+                    }
+                    kept
+                }
+            };
+            let (text, ignored) = urdf::calibration::to_urdf_calibrated(&written, &nominal)?;
+            notes.extend(ignored.map(|n| n.sentence()));
+            (text, None)
+        }
+        ExportFormat::UrKinematics => {
+            let f = crate::model::ur_kinematics::to_ur_kinematics(&spec, source)?;
+            not_held.extend(f.not_held);
+            (f.text, None)
+        }
+        ExportFormat::JointCorrections => {
+            let r = need()?;
+            let f = urdf::joint_corrections::to_joint_corrections(&spec, r.nominal, source)?;
+            not_held.extend(f.not_held);
+            (f.text, None)
+        }
         ExportFormat::Cell(_) => (
             match cell {
                 Some(c) => to_cell_toml(c, &model, &spec)?,
@@ -279,9 +396,27 @@ pub fn export_model(
             Some(model_export::to_table_csv(&spec)),
         ),
     };
+    // The UR and ROS files carry their own header; URDF gets the lines as comments.
+    let content = match format {
+        ExportFormat::Urdf | ExportFormat::UrdfCalibration(_) => {
+            let lines: Vec<String> = not_held
+                .iter()
+                .map(|n| n.sentence())
+                .chain(notes.iter().cloned())
+                .collect();
+            let comments: String = lines
+                .iter()
+                .map(|l| format!("<!-- {} -->\n", l.replace("--", "- -")))
+                .collect();
+            comments + &content
+        }
+        _ => content,
+    };
+    warnings.extend(not_held.iter().map(|n| n.sentence()));
     Ok(Exported {
         content,
         table_csv,
         warnings,
+        notes,
     })
 }

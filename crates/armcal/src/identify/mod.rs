@@ -5,6 +5,7 @@
 
 pub mod circle_point;
 pub mod estimate;
+pub mod export;
 pub mod fingerprint;
 pub mod fit_checks;
 pub mod fitted_ranges;

@@ -22,6 +22,8 @@ pub mod rank_deficit;
 pub mod registry;
 pub mod sampling;
 pub mod station;
+pub mod tcp_shift;
+pub mod ur_kinematics;
 pub mod urdf;
 
 pub use chain::{LimitTolerance, Link, LinkSpec, Model, ModelSpec, MEASURED_LIMIT_TOLERANCE};

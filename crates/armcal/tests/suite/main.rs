@@ -6,6 +6,7 @@ mod common;
 mod model {
     mod cell_file;
     mod conversions;
+    mod deploy;
     mod derivatives;
     mod export_reload;
     mod exports;

@@ -53,6 +53,9 @@ struct RawCell {
 struct RawRobot {
     builtin: Option<String>,
     urdf: Option<String>,
+    /// A Universal Robots kinematics YAML ([`crate::model::ur_kinematics`]), relative to the
+    /// cell file: the robot's factory calibration as its nominal model.
+    ur_kinematics: Option<String>,
     tip: Option<String>,
     name: Option<String>,
     #[serde(default)]

@@ -1,4 +1,5 @@
-//! `[robot]` (a built-in robot, a URDF file or inline `[[robot.links]]`, joint `limits`,
+//! `[robot]` (a built-in robot, a URDF file, a Universal Robots kinematics YAML or inline
+//! `[[robot.links]]`, joint `limits`,
 //! `[[robot.capsules]]`, the skeleton's `link_radius_mm` and `link_radii_mm`, `convention`)
 //! and `[[tool_capsules]]`.
 
@@ -7,8 +8,8 @@ use super::*;
 use crate::model::urdf::CollisionShape;
 use std::ops::Range;
 
-/// The robot of `[robot]`: exactly one of `builtin`, `urdf` (relative to `dir`) or
-/// `[[robot.links]]`, with its `limits` overrides and `[[robot.capsules]]`; and a URDF's
+/// The robot of `[robot]`: exactly one of `builtin`, `urdf`, `ur_kinematics` (both relative
+/// to `dir`) or `[[robot.links]]`, with its `limits` overrides and `[[robot.capsules]]`; and a URDF's
 /// `<collision>` shapes (for [`collision_model`]).
 pub(super) fn robot(
     ctx: &Ctx,
@@ -20,12 +21,13 @@ pub(super) fn robot(
     let file = ctx.file;
     let sources = rr.builtin.is_some() as usize
         + rr.urdf.is_some() as usize
+        + rr.ur_kinematics.is_some() as usize
         + (!rr.links.is_empty()) as usize;
     if sources != 1 {
         return Err(ctx.err(
             rspan,
             "robot",
-            "give exactly one of `builtin`, `urdf` or `[[robot.links]]`",
+            "give exactly one of `builtin`, `urdf`, `ur_kinematics` or `[[robot.links]]`",
         ));
     }
     let mut robot = if let Some(b) = &rr.builtin {
@@ -43,6 +45,19 @@ pub(super) fn robot(
             name: rr.name.clone().unwrap_or_else(|| spec.name.clone()),
             summary: format!("imported from {u}"),
             source: format!("URDF file {}", path.display()),
+            spec,
+            capsules: Vec::new(),
+            collision: String::new(),
+        }
+    } else if let Some(u) = &rr.ur_kinematics {
+        let path = dir.join(u);
+        let spec = crate::model::ur_kinematics::read_ur_kinematics(&path)
+            .map_err(|e| ctx.err(rspan.clone(), "robot.ur_kinematics", e))?;
+        check_values(ctx, &spec.links, rspan.clone(), "robot.ur_kinematics")?;
+        Robot {
+            name: rr.name.clone().unwrap_or_else(|| spec.name.clone()),
+            summary: format!("Universal Robots kinematics from {u}"),
+            source: format!("UR kinematics file {}", path.display()),
             spec,
             capsules: Vec::new(),
             collision: String::new(),

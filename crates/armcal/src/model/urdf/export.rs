@@ -13,7 +13,30 @@ use super::{unique, M_PER_MM};
 /// Writes the chain (base … tool) and its targets as a URDF document. See the module
 /// documentation for how link transforms become joint origins.
 pub fn to_urdf(spec: &ModelSpec) -> Result<String, Error> {
+    write(&urdf_robot(spec, &[])?, &spec.name)
+}
+
+/// The URDF document of `robot`.
+pub(crate) fn write(robot: &urdf_rs::Robot, name: &str) -> Result<String, Error> {
+    urdf_rs::write_to_string(robot)
+        .map_err(|e| Error::Model(format!("URDF export of `{name}`: {e}")))
+}
+
+/// The chain of `spec` as a URDF robot; joint `i` of the chain with `offsets[i] ≠ 0`
+/// (`offsets` empty: none) carries it as `<calibration rising="offsets[i]"/>` and its origin
+/// is taken with the joint's own factor at its value minus the offset, so that
+/// `origin · Rot(axis, q + rising)` is the link's motion (the joint offsets ROS calibration
+/// tools write; see [`super::calibration`]).
+pub(crate) fn urdf_robot(spec: &ModelSpec, offsets: &[f64]) -> Result<urdf_rs::Robot, Error> {
     let model = Model::from_spec(spec)?;
+    if !offsets.is_empty() && offsets.len() != model.dof() {
+        return Err(Error::Model(format!(
+            "URDF export of `{}`: {} joint offsets for {} joints",
+            spec.name,
+            offsets.len(),
+            model.dof()
+        )));
+    }
     let mut joint_names = HashSet::new();
     for j in &model.joints {
         if !joint_names.insert(j.name.clone()) {
@@ -40,7 +63,15 @@ pub fn to_urdf(spec: &ModelSpec) -> Result<String, Error> {
         match &ls.joint {
             None => pending = pending.compose(&fixed_pose(&ls.geometry)),
             Some(joint) => {
-                let (a, axis, b) = split_at_joint(&ls.geometry, joint.kind);
+                let k = link.joint.expect("a link with a joint has its index");
+                let offset = offsets.get(k).copied().unwrap_or(0.0);
+                let mut geometry = ls.geometry.clone();
+                let field = geometry
+                    .convention
+                    .joint_field(joint.kind)
+                    .expect("Model::from_spec accepted the joint");
+                geometry.values[field] -= offset;
+                let (a, axis, b) = split_at_joint(&geometry, joint.kind);
                 let child = ls.name.clone();
                 let scale = match joint.kind {
                     JointKind::Revolute => 1.0,
@@ -58,6 +89,13 @@ pub fn to_urdf(spec: &ModelSpec) -> Result<String, Error> {
                     axis,
                     Some((joint.lower * scale, joint.upper * scale)),
                 ));
+                if offset != 0.0 {
+                    let j = urdf_joints.last_mut().expect("just pushed");
+                    j.calibration = Some(urdf_rs::Calibration {
+                        rising: Some(offset * scale),
+                        falling: None,
+                    });
+                }
                 urdf_links.push(empty_link(&child));
                 parent = child;
                 pending = b;
@@ -90,15 +128,13 @@ pub fn to_urdf(spec: &ModelSpec) -> Result<String, Error> {
         urdf_joints.push(fixed(name, &end, name, &fixed_pose(&t.spec.geometry)));
         urdf_links.push(empty_link(name));
     }
-    let robot = urdf_rs::Robot {
+    Ok(urdf_rs::Robot {
         name: spec.name.clone(),
         version: None,
         links: urdf_links,
         joints: urdf_joints,
         materials: Vec::new(),
-    };
-    urdf_rs::write_to_string(&robot)
-        .map_err(|e| Error::Model(format!("URDF export of `{}`: {e}", spec.name)))
+    })
 }
 
 fn empty_link(name: &str) -> urdf_rs::Link {
@@ -194,7 +230,7 @@ fn zrp_axis_point(g: &LinkGeometry) -> (Vector3<f64>, Vector3<f64>) {
 }
 
 /// Transform of a link without a joint (all factors at their values).
-fn fixed_pose(g: &LinkGeometry) -> Pose<f64> {
+pub(crate) fn fixed_pose(g: &LinkGeometry) -> Pose<f64> {
     match g.convention.motions(None) {
         Some(motions) => {
             let axis = g.axis_vector();
@@ -216,7 +252,10 @@ fn fixed_pose(g: &LinkGeometry) -> Pose<f64> {
 /// Splits a jointed link `T(q) = A · J(q) · B`: returns `A` (factors up to and including the
 /// joint's factor at its nominal value), the unit joint direction in the frame after `A`,
 /// and `B` (the factors after the joint's).
-fn split_at_joint(g: &LinkGeometry, kind: JointKind) -> (Pose<f64>, Vector3<f64>, Pose<f64>) {
+pub(crate) fn split_at_joint(
+    g: &LinkGeometry,
+    kind: JointKind,
+) -> (Pose<f64>, Vector3<f64>, Pose<f64>) {
     let joint_field = g
         .convention
         .joint_field(kind)

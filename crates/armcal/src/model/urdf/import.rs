@@ -23,20 +23,7 @@ pub fn read_urdf_with_collisions(
     path: impl AsRef<Path>,
     tip: Option<&str>,
 ) -> Result<(ModelSpec, Vec<CollisionShape>), Error> {
-    let path = path.as_ref();
-    let file = path.display().to_string();
-    let text =
-        crate::input::read_capped(path, crate::input::TEXT_CAP).map_err(|e| Error::File {
-            file: file.clone(),
-            message: format!("cannot read the URDF file: {e}"),
-        })?;
-    parse(&text, tip).map_err(|e| Error::File {
-        file,
-        message: match e {
-            Error::Input(m) => m,
-            other => other.to_string(),
-        },
-    })
+    super::parse_file(path.as_ref(), "the URDF file", |text| parse(text, tip))
 }
 
 /// Parses URDF text and imports the chain from its root to `tip` (default: the single leaf);
@@ -383,9 +370,21 @@ fn import_joint(j: &urdf_rs::Joint, name: String) -> Result<LinkSpec, String> {
             }
         ));
     }
+    // `<calibration rising="δ"/>`: the joint offset ROS calibration tools write (the joint
+    // moves by q + δ, super::calibration); `falling` marks a reference switch and is not read.
+    let rising = j.calibration.as_ref().and_then(|c| c.rising).unwrap_or(0.0);
+    let offset = match kind {
+        JointKind::Revolute => rising,
+        JointKind::Prismatic => rising / M_PER_MM,
+    };
+    if !offset.is_finite() {
+        return Err(format!(
+            "<calibration rising=\"{rising}\"> is not a finite joint offset; fix the URDF"
+        ));
+    }
     let mut values = xyz.to_vec();
     values.extend(rpy);
-    values.push(0.0);
+    values.push(offset);
     Ok(LinkSpec {
         name: name.clone(),
         geometry: LinkGeometry {

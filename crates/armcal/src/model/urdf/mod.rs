@@ -35,9 +35,11 @@
 //! URDF links are the joint frames, not armcal's link-end frames; the end of the chain and the
 //! targets are exact.
 
+pub mod calibration;
 pub mod depth;
 pub mod export;
 pub mod import;
+pub mod joint_corrections;
 
 pub use export::to_urdf;
 pub use import::{
@@ -52,6 +54,30 @@ pub const CONTINUOUS_RANGE: f64 = 2.0 * std::f64::consts::PI;
 
 /// Metres per millimetre.
 const M_PER_MM: f64 = 1e-3;
+
+/// Reads the text file `path` (capped at [`crate::input::TEXT_CAP`]) and parses it with
+/// `parse`; every error names the file, an input error as the file's message. `what` names
+/// the kind of file in a read error ("the URDF file").
+pub(crate) fn parse_file<T>(
+    path: &std::path::Path,
+    what: &str,
+    parse: impl FnOnce(&str) -> Result<T, crate::Error>,
+) -> Result<T, crate::Error> {
+    use crate::Error;
+    let file = path.display().to_string();
+    let text =
+        crate::input::read_capped(path, crate::input::TEXT_CAP).map_err(|e| Error::File {
+            file: file.clone(),
+            message: format!("cannot read {what}: {e}"),
+        })?;
+    parse(&text).map_err(|e| Error::File {
+        file,
+        message: match e {
+            Error::Input(m) => m,
+            other => other.to_string(),
+        },
+    })
+}
 
 /// `name`, or `name_2`, `name_3`, … if taken; records the result as taken.
 fn unique(name: &str, taken: &mut HashSet<String>) -> String {
