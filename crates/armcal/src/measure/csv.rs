@@ -345,7 +345,7 @@ fn configurations(
             line,
             decimal: format.decimal,
         };
-        let q = row.joints(&joints, model)?;
+        let q = format.model_joints(row.joints(&joints, model)?);
         let id = id_col
             .map(|c| row.text(c).to_string())
             .unwrap_or_else(|| format!("{}", r + 1));
@@ -476,7 +476,7 @@ fn read_rows(
             line,
             decimal: format.decimal,
         };
-        let q = row.joints(&layout.joints, model)?;
+        let q = format.model_joints(row.joints(&layout.joints, model)?);
         if limits == Limits::Checked {
             warnings.extend(row.limit_check(&q, model)?);
         }
