@@ -422,7 +422,11 @@ fn mapped_or_own<T>(
     format: &DataFormat,
     read: impl Fn(&DataFormat) -> Result<T, Error>,
 ) -> Result<(T, bool), Error> {
-    let own = DataFormat::armcal();
+    // armcal's own columns, still in the format's angles (controller or model).
+    let own = DataFormat {
+        controller: format.controller.clone(),
+        ..DataFormat::armcal()
+    };
     match read(format) {
         Err(Error::File { file, message }) if message.starts_with("header:") && *format != own => {
             match read(&own) {

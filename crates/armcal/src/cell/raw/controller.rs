@@ -90,3 +90,90 @@ pub(super) fn controller(
         .map_err(|e| fail("robot.controller", e))?;
     Ok(convention)
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::cell::Cell;
+    use crate::measure::csv::read_configurations_format_str;
+    use std::path::Path;
+
+    fn cell(extra: &str) -> Result<Cell, String> {
+        let text = format!("[robot]\nbuiltin = \"kr15\"\n{extra}");
+        Cell::from_toml(&text, "c.toml", Path::new(".")).map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn presets_and_per_joint_maps() {
+        let c = cell("").unwrap();
+        assert!(c.controller.is_identity() && c.controller.source.contains("KUKA"));
+        let c =
+            cell("[robot.controller]\npreset = \"kr15\"\nq2 = { sign = -1, offset_deg = -90 }\n")
+                .unwrap();
+        let m = c.controller.joints[1];
+        assert_eq!(m.sign, -1.0);
+        assert!((m.offset + std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+        assert!(c.controller.source.contains("kr15") && c.controller.source.contains("q2"));
+        let c = cell("[robot.controller]\nq3 = { offset_rad = 0.25 }\n").unwrap();
+        assert_eq!(
+            (c.controller.joints[2].sign, c.controller.joints[2].offset),
+            (1.0, 0.25)
+        );
+    }
+
+    #[test]
+    fn bad_fields_name_the_line_and_field() {
+        for (extra, want) in [
+            (
+                "\n[robot.controller]\nq2 = { sign = 2 }\n",
+                "line 4: `robot.controller.q2`: `sign` must be 1 or -1",
+            ),
+            (
+                "[robot.controller]\nq9 = { sign = -1 }\n",
+                "`robot.controller.q9`: no joint of that name",
+            ),
+            (
+                "[robot.controller]\nq2 = { offset_mm = 3 }\n",
+                "unknown field `offset_mm`",
+            ),
+            (
+                "[robot.controller]\nq2 = -1\n",
+                "`robot.controller.q2`: give",
+            ),
+            (
+                "[robot.controller]\npreset = \"puma560\"\n",
+                "`robot.controller.preset`: `puma560`: no public source",
+            ),
+            ("[data]\nangles = \"vendor\"\n", "`data.angles`: `vendor`"),
+        ] {
+            let e = cell(extra).unwrap_err();
+            assert!(e.contains("c.toml") && e.contains(want), "{e}");
+        }
+    }
+
+    /// A data file in controller angles reads as the model's joints, with the cell's named
+    /// columns and with armcal's own.
+    #[test]
+    fn data_in_controller_angles_read_as_model_angles() {
+        let csv = "pose_id,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg\np1,10,20,30,40,50,60\n";
+        for data in [
+            "[data]\nangles = \"controller\"\n",
+            "[data]\nangles = \"controller\"\njoints = [\"a1\", \"a2\", \"a3\", \"a4\", \"a5\", \"a6\"]\n",
+        ] {
+            let c = cell(&format!("[robot.controller]\nq2 = {{ sign = -1, offset_deg = -90 }}\n{data}"))
+                .unwrap();
+            let rows = read_configurations_format_str(csv, "d.csv", &c.model, &c.data_format()).unwrap();
+            let deg: Vec<f64> = rows[0].1.iter().map(|q| q.to_degrees()).collect();
+            assert!((deg[1] + 110.0).abs() < 1e-9 && (deg[2] - 30.0).abs() < 1e-9, "{deg:?}");
+            assert!(c.data_format().to_toml().contains("angles = \"controller\""));
+        }
+        let model_angles = cell("[data]\nangles = \"model\"\n").unwrap();
+        let rows = read_configurations_format_str(
+            csv,
+            "d.csv",
+            &model_angles.model,
+            &model_angles.data_format(),
+        )
+        .unwrap();
+        assert!((rows[0].1[1].to_degrees() - 20.0).abs() < 1e-9);
+    }
+}
