@@ -255,7 +255,7 @@ fn run_program(a: &Args, path: &Path, limit: JointChangeLimit) -> anyhow::Result
             );
         } else {
             println!(
-                "  line {:>4}  {:<24} {what}: left unchanged: {}",
+                "  line {:>4}  {:<24} left unchanged: {}",
                 t.line, t.name, t.reason
             );
         }
