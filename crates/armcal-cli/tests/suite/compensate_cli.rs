@@ -268,14 +268,14 @@ fn compensation_never_whips_the_wrist() {
 #[test]
 fn compensate_filters_a_controller_program_and_writes_nothing_on_error() {
     let dir = scratch("compensate-program-cli");
-    let est = paper_estimate().1;
+    let est = &paper_estimate().1;
     let run = |program: &Path, out: &Path, extra: &[&str]| {
         let mut args = vec![
             "compensate",
             "--cell",
             "examples/paper-cell.toml",
             "--estimate",
-            &est,
+            est,
             "--program",
             program.to_str().unwrap(),
             "--out",

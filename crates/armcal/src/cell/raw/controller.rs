@@ -150,6 +150,17 @@ mod tests {
         }
     }
 
+    /// An exported cell carries the convention, joint by joint.
+    #[test]
+    fn an_exported_cell_keeps_the_convention() {
+        let c =
+            cell("[robot.controller]\nq2 = { sign = -1, offset_deg = -90 }\nq5 = { sign = -1 }\n")
+                .unwrap();
+        let text = crate::cell::export::to_cell_toml(&c, &c.model, &c.model.spec()).unwrap();
+        let back = Cell::from_toml(&text, "exported.toml", Path::new(".")).unwrap();
+        assert_eq!(back.controller.joints, c.controller.joints, "{text}");
+    }
+
     /// A data file in controller angles reads as the model's joints, with the cell's named
     /// columns and with armcal's own.
     #[test]

@@ -233,8 +233,11 @@ impl Geometry {
                         Self::joint_fits(k, m.sign * (v - m.offset), wanted)
                     })
                     .min_by(|a, b| {
+                        // Within the limits first, then nearest the branch's value (total
+                        // order: a non-finite value sorts last, never panics).
                         let key = |v: f64| (!(j.lower..=j.upper).contains(&v), (v - q[k]).abs());
-                        key(*a).partial_cmp(&key(*b)).expect("finite joints")
+                        let (ka, kb) = (key(*a), key(*b));
+                        ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
                     });
                 match pick {
                     Some(v) => q[k] = v,
