@@ -21,9 +21,9 @@
 //!
 //! KUKA `S` = overhead + 2·elbow + 4·(c₅ ≤ 0); `T` bit k = 1 for `c_{k+1} < 0` (KUKA System
 //! Software 8 operating and programming instructions, "S and T"). ABB `confdata`
-//! `[cf1, cf4, cf6, cfx]`: cfⱼ = ⌊cⱼ / 90°⌋ (the quadrant, −1 for [−90°, 0)), cfx = 4·overhead
-//! + 2·(wrist centre behind the lower arm, i.e. not elbow) + (c₅ < 0) (ABB RAPID reference
-//! manual, "confdata"). A robot without this structure (a UR arm: its wrist is not
+//! `[cf1, cf4, cf6, cfx]`: cfⱼ = ⌊cⱼ / 90°⌋ (the quadrant, −1 for [−90°, 0)), and
+//! cfx = 4·overhead + 2·(wrist centre behind the lower arm, i.e. not elbow) + (c₅ < 0) (ABB
+//! RAPID reference manual, "confdata"). A robot without this structure (a UR arm: its wrist is not
 //! spherical) has no such bits; a program that gives them for it is refused with the reason.
 
 use crate::compensate::closed_form::SphericalWristIk;

@@ -101,17 +101,28 @@ fn bits(code: &Code, span: Range<usize>, field: &str) -> Result<(Bits, Range<usi
     ))
 }
 
-/// The target of aggregate `agg` (`joints`: a joint type, `None`: decided by its fields).
+/// Where an aggregate stands: a declaration of a joint (`AXIS`) or Cartesian type, or inline
+/// in a motion (its fields say which), a `PTP` one taking a joint target in its place.
+#[derive(Clone, Copy)]
+enum Place {
+    Declaration { joints: bool },
+    Inline { ptp: bool },
+}
+
+/// The target of aggregate `agg` at `place`.
 fn target(
     code: &Code,
     at: usize,
     name: String,
     agg: &Aggregate,
     literal: Range<usize>,
-    joints: Option<bool>,
-    inline_ptp: bool,
+    place: Place,
     dof: usize,
 ) -> Result<Target, Error> {
+    let (joints, inline_ptp) = match place {
+        Place::Declaration { joints } => (Some(joints), false),
+        Place::Inline { ptp } => (None, ptp),
+    };
     let axes: Vec<String> = (1..=dof).map(|k| format!("A{k}")).collect();
     let joints = joints.unwrap_or_else(|| axes.iter().any(|a| agg.get(a).is_some()));
     let wanted: Vec<&str> = if joints {
@@ -214,15 +225,16 @@ impl Dialect for Krl {
                             let open = code.skip_space(eq + 1);
                             if open < len && code.code[open] == b'{' {
                                 let (agg, close) = aggregate(code, open)?;
-                                let joints = Some(ty.ends_with("AXIS"));
+                                let place = Place::Declaration {
+                                    joints: ty.ends_with("AXIS"),
+                                };
                                 out.push(target(
                                     code,
                                     at,
                                     code.text[a - name.len()..a].to_string(),
                                     &agg,
                                     open..close,
-                                    joints,
-                                    false,
+                                    place,
                                     dof,
                                 )?);
                             }
@@ -243,7 +255,8 @@ impl Dialect for Krl {
                             declared.to_string()
                         };
                         let ptp = declared.ends_with("PTP");
-                        out.push(target(code, open, name, &agg, open..close, None, ptp, dof)?);
+                        let place = Place::Inline { ptp };
+                        out.push(target(code, open, name, &agg, open..close, place, dof)?);
                         let comma = code.skip_space(close);
                         if comma < len && code.code[comma] == b',' {
                             open = code.skip_space(comma + 1);
