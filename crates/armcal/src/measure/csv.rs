@@ -422,11 +422,8 @@ fn mapped_or_own<T>(
     format: &DataFormat,
     read: impl Fn(&DataFormat) -> Result<T, Error>,
 ) -> Result<(T, bool), Error> {
-    // armcal's own columns, still in the format's angles (controller or model).
-    let own = DataFormat {
-        controller: format.controller.clone(),
-        ..DataFormat::armcal()
-    };
+    // armcal's own columns: a file armcal wrote (`import`), in model angles.
+    let own = DataFormat::armcal();
     match read(format) {
         Err(Error::File { file, message }) if message.starts_with("header:") && *format != own => {
             match read(&own) {

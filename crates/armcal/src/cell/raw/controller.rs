@@ -161,14 +161,17 @@ mod tests {
         assert_eq!(back.controller.joints, c.controller.joints, "{text}");
     }
 
-    /// A data file in controller angles reads as the model's joints, with the cell's named
-    /// columns and with armcal's own.
+    /// A data file in controller angles reads as the model's joints, with armcal's column
+    /// names and with the cell's; a file in armcal's own columns read through a `[data]
+    /// joints` mapping is one armcal wrote (`import`): model angles.
     #[test]
     fn data_in_controller_angles_read_as_model_angles() {
         let csv = "pose_id,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg\np1,10,20,30,40,50,60\n";
-        for data in [
-            "[data]\nangles = \"controller\"\n",
-            "[data]\nangles = \"controller\"\njoints = [\"a1\", \"a2\", \"a3\", \"a4\", \"a5\", \"a6\"]\n",
+        let named = "pose_id,a1,a2,a3,a4,a5,a6\np1,10,20,30,40,50,60\n";
+        let mapping = "joints = [\"a1\", \"a2\", \"a3\", \"a4\", \"a5\", \"a6\"]\njoint_unit = \"deg\"\n";
+        for (data, csv) in [
+            ("[data]\nangles = \"controller\"\n".to_string(), csv),
+            (format!("[data]\nangles = \"controller\"\n{mapping}"), named),
         ] {
             let c = cell(&format!("[robot.controller]\nq2 = {{ sign = -1, offset_deg = -90 }}\n{data}"))
                 .unwrap();
@@ -177,6 +180,12 @@ mod tests {
             assert!((deg[1] + 110.0).abs() < 1e-9 && (deg[2] - 30.0).abs() < 1e-9, "{deg:?}");
             assert!(c.data_format().to_toml().contains("angles = \"controller\""));
         }
+        let c = cell(&format!(
+            "[robot.controller]\nq2 = {{ sign = -1 }}\n[data]\nangles = \"controller\"\n{mapping}"
+        ))
+        .unwrap();
+        let own = read_configurations_format_str(csv, "d.csv", &c.model, &c.data_format()).unwrap();
+        assert!((own[0].1[1].to_degrees() - 20.0).abs() < 1e-9);
         let model_angles = cell("[data]\nangles = \"model\"\n").unwrap();
         let rows = read_configurations_format_str(
             csv,
