@@ -168,17 +168,27 @@ mod tests {
     fn data_in_controller_angles_read_as_model_angles() {
         let csv = "pose_id,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg\np1,10,20,30,40,50,60\n";
         let named = "pose_id,a1,a2,a3,a4,a5,a6\np1,10,20,30,40,50,60\n";
-        let mapping = "joints = [\"a1\", \"a2\", \"a3\", \"a4\", \"a5\", \"a6\"]\njoint_unit = \"deg\"\n";
+        let mapping =
+            "joints = [\"a1\", \"a2\", \"a3\", \"a4\", \"a5\", \"a6\"]\njoint_unit = \"deg\"\n";
         for (data, csv) in [
             ("[data]\nangles = \"controller\"\n".to_string(), csv),
             (format!("[data]\nangles = \"controller\"\n{mapping}"), named),
         ] {
-            let c = cell(&format!("[robot.controller]\nq2 = {{ sign = -1, offset_deg = -90 }}\n{data}"))
-                .unwrap();
-            let rows = read_configurations_format_str(csv, "d.csv", &c.model, &c.data_format()).unwrap();
+            let c = cell(&format!(
+                "[robot.controller]\nq2 = {{ sign = -1, offset_deg = -90 }}\n{data}"
+            ))
+            .unwrap();
+            let rows =
+                read_configurations_format_str(csv, "d.csv", &c.model, &c.data_format()).unwrap();
             let deg: Vec<f64> = rows[0].1.iter().map(|q| q.to_degrees()).collect();
-            assert!((deg[1] + 110.0).abs() < 1e-9 && (deg[2] - 30.0).abs() < 1e-9, "{deg:?}");
-            assert!(c.data_format().to_toml().contains("angles = \"controller\""));
+            assert!(
+                (deg[1] + 110.0).abs() < 1e-9 && (deg[2] - 30.0).abs() < 1e-9,
+                "{deg:?}"
+            );
+            assert!(c
+                .data_format()
+                .to_toml()
+                .contains("angles = \"controller\""));
         }
         let c = cell(&format!(
             "[robot.controller]\nq2 = {{ sign = -1 }}\n[data]\nangles = \"controller\"\n{mapping}"
