@@ -353,3 +353,57 @@ fn drift_check(e: &armcal::identify::Estimate) {
         }
     }
 }
+
+/// The built-in cells a fuzzed controller program is filtered for: the robot each language's
+/// samples are written for (KUKA KR 15 for KRL, ABB IRB 120 for RAPID, UR10 for UR script),
+/// with a calibration that differs from the nominal model so every target is solved.
+fn program_cell(language: armcal::compensate::controller_program::Language) -> &'static (Cell, Vec<f64>) {
+    use armcal::compensate::controller_program::Language;
+    static CELLS: OnceLock<[(Cell, Vec<f64>); 3]> = OnceLock::new();
+    let cells = CELLS.get_or_init(|| {
+        ["kr15", "irb120", "ur10"].map(|name| {
+            let cell = Cell::load(name).expect("a built-in robot");
+            let calibrated = cell
+                .model
+                .registry
+                .iter()
+                .enumerate()
+                .map(|(i, p)| p.nominal + 1e-3 * ((i + 1) as f64).sin())
+                .collect();
+            (cell, calibrated)
+        })
+    });
+    &cells[match language {
+        Language::Krl => 0,
+        Language::Rapid => 1,
+        Language::UrScript => 2,
+    }]
+}
+
+/// A controller program through `armcal compensate --program`: read, every target
+/// compensated (as joints with `to_joints` on odd lengths), written back; the output is read
+/// again and must have as many motion targets as the input.
+pub fn controller_program(text: &str, language: armcal::compensate::controller_program::Language) {
+    use armcal::compensate::controller_program::ProgramSettings;
+    let (cell, calibrated) = program_cell(language);
+    let settings = ProgramSettings {
+        language,
+        to_joints: text.len() % 2 == 1,
+        ik: armcal::IkSettings::default(),
+    };
+    let run = |t: &str| {
+        armcal::filter_controller_program(&cell.model, calibrated, &cell.controller, t, "fuzz", &settings)
+    };
+    let Ok(first) = run(text) else {
+        return;
+    };
+    match run(&first.text) {
+        Ok(second) => assert_eq!(
+            first.targets.len(),
+            second.targets.len(),
+            "the filtered program has another number of targets:\n{}",
+            first.text
+        ),
+        Err(e) => panic!("armcal cannot read the program it wrote: {e}\n{}", first.text),
+    }
+}

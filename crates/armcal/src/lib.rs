@@ -90,6 +90,7 @@ pub use error::{Error, Result};
 
 // The handful of names a program needs; everything else by its module path.
 pub use cell::Cell;
+pub use compensate::controller_program::filter_controller_program;
 pub use compensate::{calibrated_ik, IkSettings, IkStatus, IkTarget};
 pub use design::assess::assess;
 pub use design::plan::{plan, PlanResult, PlanSettings};

@@ -5,6 +5,7 @@
 use super::output::{
     load_cell, load_data, warn_outside_fitted_ranges, with_note, Calibration, NoteStyle, Outputs,
 };
+use armcal::compensate::controller_program::{Language, ProgramSettings};
 use armcal::compensate::joint_change::JointChangeLimit;
 use armcal::compensate::nonparametric::{CorrectionInputs, ResidualCorrection};
 use armcal::compensate::program::{compensate_program, ProgramFile};
@@ -22,8 +23,21 @@ pub struct Args {
     /// robot reaches what the nominal model meant. With `x_mm … yaw_deg` too: Cartesian tool
     /// targets (world frame), corrected for a controller that keeps its nominal model; the
     /// joint columns are then the starting guesses (e.g. the controller's nominal solution).
-    #[arg(long)]
-    pub targets: PathBuf,
+    #[arg(long, required_unless_present = "program", conflicts_with = "program")]
+    pub targets: Option<PathBuf>,
+    /// A robot program in its controller's language to filter instead: KUKA KRL (`.src`,
+    /// `.dat`), ABB RAPID (`.mod`) or Universal Robots script (`.script`). Every motion
+    /// target is compensated in place (its angles are controller angles: the cell's
+    /// `[robot.controller]`), every other byte is kept; `--out` gets the filtered program.
+    #[arg(long, value_name = "PROGRAM")]
+    pub program: Option<PathBuf>,
+    /// The program's language when its extension does not say: `krl`, `rapid` or `urscript`.
+    #[arg(long, requires = "program", value_parser = ["krl", "rapid", "urscript"])]
+    pub language: Option<String>,
+    /// Write a compensated Cartesian target as joints where the language takes joints at that
+    /// place (UR `movej`/`movel`/`movep`, KRL inline `PTP`); elsewhere it stays Cartesian.
+    #[arg(long, requires = "program")]
+    pub to_joints: bool,
     /// Output: the compensated program (CSV: pose_id, the joints to command, for Cartesian
     /// targets the pose to send, then status, position_error_mm, orientation_error_deg,
     /// solution).
@@ -51,7 +65,7 @@ pub struct Args {
     /// the position error the calibrated model leaves (measured − predicted, book §5.4); the
     /// targets are then shifted by its prediction and the output gets `correction_*_mm`
     /// columns (the shift applied to each target, world frame).
-    #[arg(long, value_name = "DATA.csv")]
+    #[arg(long, value_name = "DATA.csv", conflicts_with = "program")]
     pub nonparametric: Option<PathBuf>,
     /// Total degree of the correction polynomials.
     #[arg(long, default_value_t = 3, requires = "nonparametric")]
@@ -72,7 +86,16 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
             anyhow::bail!("{flag} {v}: the joint-change limit must be a positive number");
         }
     }
-    let mut inputs = vec![Path::new(&a.cell), &a.calibration.estimate, &a.targets];
+    let limit = JointChangeLimit {
+        revolute: a.max_joint_change_deg.to_radians(),
+        prismatic: a.max_joint_change_mm,
+    };
+    let targets = match (&a.program, &a.targets) {
+        (Some(program), _) => return run_program(a, program, limit),
+        (None, Some(t)) => t,
+        (None, None) => anyhow::bail!("give --targets or --program"),
+    };
+    let mut inputs = vec![Path::new(&a.cell), &a.calibration.estimate, targets];
     inputs.extend(a.nonparametric.as_deref());
     let outputs = Outputs::plan(a.force, &inputs, &[&a.out])?;
     let cell = load_cell(&a.cell)?;
@@ -81,8 +104,8 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let calibrated = est.params_for(model)?;
     let (payload, payload_how) = est.payload_for(model, a.payload.as_deref())?;
     let program = ProgramFile::read(
-        armcal::input::read_capped(&a.targets, armcal::input::DATA_CAP)?,
-        &a.targets.display().to_string(),
+        armcal::input::read_capped(targets, armcal::input::DATA_CAP)?,
+        &targets.display().to_string(),
         model,
     )?;
     // the rows' joints: the program, or the Cartesian targets' starting configurations
@@ -117,10 +140,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         &program,
         &IkSettings {
             payload,
-            joint_change_limit: JointChangeLimit {
-                revolute: a.max_joint_change_deg.to_radians(),
-                prismatic: a.max_joint_change_mm,
-            },
+            joint_change_limit: limit,
             ..IkSettings::default()
         },
         correction.as_ref(),
@@ -154,6 +174,91 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
             a.max_joint_change_mm,
             comp.beyond_change_limit
         );
+    }
+    if !model.payloads.is_empty() {
+        println!("payload: {payload_how}");
+    }
+    Ok(())
+}
+
+/// `--program`: filter a controller program in place, print what was compensated and what
+/// was left unchanged with its line.
+fn run_program(a: &Args, path: &Path, limit: JointChangeLimit) -> anyhow::Result<()> {
+    let shown = path.display().to_string();
+    let language = match &a.language {
+        Some(name) => Language::from_name(name).expect("clap checks the name"),
+        None => Language::from_extension(&shown).ok_or_else(|| {
+            anyhow::anyhow!(
+                "{shown}: the extension does not say the language (.src/.dat KRL, .mod RAPID, \
+                 .script UR); give --language krl|rapid|urscript"
+            )
+        })?,
+    };
+    let inputs = [Path::new(&a.cell), a.calibration.estimate.as_path(), path];
+    let outputs = Outputs::plan(a.force, &inputs, &[&a.out])?;
+    let cell = load_cell(&a.cell)?;
+    let model = &cell.model;
+    let (est, note) = a.calibration.load(Some(model))?;
+    if let Some(note) = note {
+        anyhow::bail!(
+            "{note}: a controller program carries no note of it, so armcal does not filter \
+             one with this calibration"
+        );
+    }
+    let calibrated = est.params_for(model)?;
+    let (payload, payload_how) = est.payload_for(model, a.payload.as_deref())?;
+    let text = armcal::input::read_capped(path, armcal::input::TEXT_CAP)?;
+    let filtered = armcal::filter_controller_program(
+        model,
+        &calibrated,
+        &cell.controller,
+        &text,
+        &shown,
+        &ProgramSettings {
+            language,
+            to_joints: a.to_joints,
+            ik: IkSettings {
+                payload,
+                joint_change_limit: limit,
+                ..IkSettings::default()
+            },
+        },
+    )?;
+    outputs.commit(&[(&a.out, &filtered.text)])?;
+    let left: Vec<_> = filtered.targets.iter().filter(|t| !t.compensated).collect();
+    println!(
+        "{} ({}): {} motion targets, {} compensated, {} left unchanged → {}",
+        shown,
+        language.name(),
+        filtered.targets.len(),
+        filtered.compensated(),
+        left.len(),
+        a.out.display()
+    );
+    println!("controller angles: {}", cell.controller.source);
+    for t in &filtered.targets {
+        let what = if t.cartesian { "Cartesian" } else { "joints" };
+        if t.compensated {
+            let how = if t.converted_to_joints {
+                ", written as joints"
+            } else {
+                ""
+            };
+            let note = if t.reason.is_empty() {
+                String::new()
+            } else {
+                format!("; {}", t.reason)
+            };
+            println!(
+                "  line {:>4}  {:<24} {what}: compensated, largest joint change {:.4}°{how}{note}",
+                t.line, t.name, t.max_joint_change
+            );
+        } else {
+            println!(
+                "  line {:>4}  {:<24} left unchanged: {}",
+                t.line, t.name, t.reason
+            );
+        }
     }
     if !model.payloads.is_empty() {
         println!("payload: {payload_how}");

@@ -262,3 +262,70 @@ fn compensation_never_whips_the_wrist() {
     );
     assert!(!never.exists());
 }
+
+/// `--program`: a KRL program is filtered in place with a summary per target; a malformed
+/// target, an unknown extension or an unconverged estimate writes nothing.
+#[test]
+fn compensate_filters_a_controller_program_and_writes_nothing_on_error() {
+    let dir = scratch("compensate-program-cli");
+    let est = &paper_estimate().1;
+    let run = |program: &Path, out: &Path, extra: &[&str]| {
+        let mut args = vec![
+            "compensate",
+            "--cell",
+            "examples/paper-cell.toml",
+            "--estimate",
+            est,
+            "--program",
+            program.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        armcal(&args)
+    };
+    let sample = Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/programs/paper.src"
+    ));
+    let out = dir.join("paper.src");
+    let (ok, stdout, err) = run(sample, &out, &[]);
+    assert!(ok, "{err}");
+    assert!(
+        stdout.contains("6 motion targets, 5 compensated, 1 left unchanged"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("line   18  LIN_REL"), "{stdout}");
+    let (a, b) = (
+        std::fs::read_to_string(sample).unwrap(),
+        std::fs::read_to_string(&out).unwrap(),
+    );
+    assert_ne!(a, b);
+    assert_eq!(a.lines().count(), b.lines().count());
+    for (x, y) in a.lines().zip(b.lines()) {
+        if !x.starts_with("PTP {") && !x.starts_with("LIN {") {
+            assert_eq!(x, y);
+        }
+    }
+    // The joint targets written as joints, a Cartesian PTP converted.
+    let joints = dir.join("joints.src");
+    let (ok, stdout, err) = run(sample, &joints, &["--to-joints"]);
+    assert!(ok, "{err}");
+    assert!(stdout.contains("written as joints"), "{stdout}");
+    assert!(stdout.contains("kept Cartesian"), "{stdout}");
+
+    let bad = dir.join("bad.src");
+    std::fs::write(&bad, "DEF bad()\nLIN {X 1,Y 2,Z abc,A 0,B 0,C 0}\nEND\n").unwrap();
+    let none = dir.join("none.src");
+    let (ok, _, err) = run(&bad, &none, &[]);
+    assert!(
+        !ok && err.contains("line 2: `Z`: `abc` is not a number"),
+        "{err}"
+    );
+    assert!(!none.exists());
+    let txt = dir.join("prog.txt");
+    std::fs::write(&txt, "x").unwrap();
+    let (ok, _, err) = run(&txt, &none, &[]);
+    assert!(!ok && err.contains("--language"), "{err}");
+    assert!(!none.exists());
+}

@@ -34,6 +34,25 @@ pub fn to_cell_toml(cell: &Cell, identified: &Model, spec: &ModelSpec) -> Result
             c.radius
         );
     }
+    // The controller convention, joint by joint (a preset's name would not fit the exported
+    // links; the identity is the default).
+    if !cell.controller.is_identity() {
+        let _ = writeln!(s.robot, "[robot.controller]");
+        for (j, m) in exported.joints.iter().zip(&cell.controller.joints) {
+            let unit = match j.kind {
+                crate::model::JointKind::Revolute => "offset_rad",
+                crate::model::JointKind::Prismatic => "offset_mm",
+            };
+            let _ = writeln!(
+                s.robot,
+                "{} = {{ sign = {:?}, {unit} = {:?} }}",
+                toml_text::string(&j.name),
+                m.sign,
+                m.offset
+            );
+        }
+        let _ = writeln!(s.robot);
+    }
     if let Some(i) = &cell.instrument {
         let _ = writeln!(s.instrument, "kind = {}", toml_text::string(&i.kind));
         let noise = match &i.noise {

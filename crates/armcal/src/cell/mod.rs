@@ -254,6 +254,10 @@ pub struct Cell {
     pub declared_free: Vec<usize>,
     /// `[data] joints`: the data-file columns of the joints, if the cell names them.
     pub data_columns: Option<DataColumns>,
+    /// How the controller's axis values map to the model's joints (`[robot.controller]`;
+    /// a built-in robot's public vendor convention, else model angles): the angles of
+    /// controller programs, and of data files with `[data] angles = "controller"`.
+    pub controller: crate::model::controller::ControllerConvention,
     /// Things the user should know that do not stop the cell from loading.
     pub warnings: Vec<String>,
     /// The link form the cell asked for (`[robot] convention`, default `auto`).
@@ -363,6 +367,10 @@ impl Cell {
         let shaped = shape_robot(&mut robot, &given, spec, LinkForm::Auto, &mut Vec::new())?;
         let model = Model::from_spec(&shaped.spec)?;
         let declared_free = model.registry.free();
+        let controller =
+            robots::controller::vendor_convention(name, model.dof()).unwrap_or_else(|_| {
+                crate::model::controller::ControllerConvention::model_angles(model.dof())
+            });
         Ok(Cell {
             name: robot.name.clone(),
             origin: format!("builtin:{name}"),
@@ -378,6 +386,7 @@ impl Cell {
             auto_free: false,
             declared_free,
             data_columns: None,
+            controller,
             warnings: Vec::new(),
             form: LinkForm::Auto,
             form_changes: shaped.changes,

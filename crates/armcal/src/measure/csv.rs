@@ -345,7 +345,7 @@ fn configurations(
             line,
             decimal: format.decimal,
         };
-        let q = row.joints(&joints, model)?;
+        let q = format.model_joints(row.joints(&joints, model)?);
         let id = id_col
             .map(|c| row.text(c).to_string())
             .unwrap_or_else(|| format!("{}", r + 1));
@@ -422,6 +422,7 @@ fn mapped_or_own<T>(
     format: &DataFormat,
     read: impl Fn(&DataFormat) -> Result<T, Error>,
 ) -> Result<(T, bool), Error> {
+    // armcal's own columns: a file armcal wrote (`import`), in model angles.
     let own = DataFormat::armcal();
     match read(format) {
         Err(Error::File { file, message }) if message.starts_with("header:") && *format != own => {
@@ -476,7 +477,7 @@ fn read_rows(
             line,
             decimal: format.decimal,
         };
-        let q = row.joints(&layout.joints, model)?;
+        let q = format.model_joints(row.joints(&layout.joints, model)?);
         if limits == Limits::Checked {
             warnings.extend(row.limit_check(&q, model)?);
         }

@@ -26,6 +26,7 @@
 //! in armcal's own files (`sigma_roll_deg` …) they are already σ of the rotation rows.
 
 use crate::measure::angles::Orientation;
+use crate::model::controller::ControllerConvention;
 use crate::model::{JointKind, Model};
 use crate::toml_text;
 use serde::{Deserialize, Serialize};
@@ -167,6 +168,10 @@ pub struct DataFormat {
     pub sigma_orientation: Option<Columns>,
     /// The air temperature column, °C (`None`: `temperature_c`, if present).
     pub temperature: Option<String>,
+    /// `[data] angles = "controller"`: the joint columns hold the controller's axis values,
+    /// mapped to the model's joints by this convention on reading (`None`: model angles).
+    #[serde(default)]
+    pub controller: Option<ControllerConvention>,
 }
 
 impl Default for DataFormat {
@@ -188,6 +193,17 @@ impl DataFormat {
             sigma_position: None,
             sigma_orientation: None,
             temperature: None,
+            controller: None,
+        }
+    }
+
+    /// A row's joint values as read (the columns' values in internal units) as the model's
+    /// joint variables: through the controller convention if the columns hold controller
+    /// angles.
+    pub fn model_joints(&self, q: Vec<f64>) -> Vec<f64> {
+        match &self.controller {
+            Some(c) => c.to_model(&q),
+            None => q,
         }
     }
 
@@ -217,6 +233,9 @@ impl DataFormat {
         }
         if let Some(u) = self.joint_unit {
             out.push(format!("joint_unit = {:?}", u.name()));
+        }
+        if self.controller.is_some() {
+            out.push("angles = \"controller\"".into());
         }
         let three = |field: &str, c: &Option<Columns>| {
             c.as_ref().map(|c| {

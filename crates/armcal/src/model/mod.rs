@@ -5,6 +5,7 @@ pub mod branch;
 pub mod chain;
 pub mod complete;
 pub mod compliance;
+pub mod controller;
 pub mod convert;
 pub mod export;
 pub mod fixed_kinematics;

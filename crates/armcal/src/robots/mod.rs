@@ -6,6 +6,7 @@
 //! armcal.
 
 pub mod bounding;
+pub mod controller;
 mod irb120;
 mod kuka;
 mod motoman;

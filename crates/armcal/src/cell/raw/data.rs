@@ -5,11 +5,16 @@
 use super::*;
 use crate::measure::angles::Orientation;
 use crate::measure::format::{ColumnUnit, Columns, DataFormat, Decimal, OrientationColumns};
+use crate::model::controller::ControllerConvention;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawData {
+    /// The joint columns (default: armcal's `q1_deg` … by the joints' names).
+    #[serde(default)]
     joints: Vec<String>,
+    /// `model` (default) or `controller`: which angles the joint columns hold.
+    angles: Option<Spanned<String>>,
     joint_unit: Option<Spanned<String>>,
     delimiter: Option<Spanned<String>>,
     decimal: Option<Spanned<String>>,
@@ -93,11 +98,12 @@ pub(super) fn data_columns(
     ctx: &Ctx,
     data: Option<Spanned<RawData>>,
     model: &Model,
+    convention: &ControllerConvention,
 ) -> Result<Option<DataColumns>, Error> {
     let Some(data) = data else { return Ok(None) };
     let span = data.span();
     let d = data.into_inner();
-    if d.joints.len() != model.dof() {
+    if !d.joints.is_empty() && d.joints.len() != model.dof() {
         return Err(Error::File {
             file: ctx.file.to_string(),
             message: format!(
@@ -170,16 +176,28 @@ pub(super) fn data_columns(
             ))
         }
     };
+    let controller = match text(&d.angles) {
+        None | Some((_, "model")) => None,
+        Some((_, "controller")) => Some(convention.clone()),
+        Some((s, v)) => {
+            return Err(ctx.err(
+                s,
+                "data.angles",
+                format!("`{v}`: use \"model\" or \"controller\" (the cell's [robot.controller])"),
+            ))
+        }
+    };
     let format = DataFormat {
         delimiter,
         decimal,
-        joints: Some(d.joints.clone()),
+        joints: (!d.joints.is_empty()).then(|| d.joints.clone()),
         joint_unit,
         position: three(ctx, d.position.as_ref(), "data.position")?,
         orientation,
         sigma_position: three(ctx, d.sigma_position.as_ref(), "data.sigma_position")?,
         sigma_orientation: three(ctx, d.sigma_orientation.as_ref(), "data.sigma_orientation")?,
         temperature,
+        controller,
     };
     format.check(model).map_err(|m| ctx.err(span, "data", m))?;
     Ok(Some(DataColumns {

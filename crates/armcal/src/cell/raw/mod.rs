@@ -12,6 +12,7 @@ use serde::Deserialize;
 use std::collections::BTreeMap;
 use toml::Spanned;
 
+mod controller;
 mod data;
 mod design;
 mod fields;
@@ -74,6 +75,8 @@ struct RawRobot {
     convention: Option<String>,
     /// Direction of gravity in the base frame (any length), default `[0, 0, -1]`.
     gravity: Option<[f64; 3]>,
+    /// `[robot.controller]`: the controller's joint convention ([`controller`]).
+    controller: Option<Spanned<toml::Table>>,
 }
 
 #[derive(Deserialize)]
@@ -227,7 +230,9 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
             });
         }
     }
-    let data_columns = data::data_columns(&ctx, raw.data, &model)?;
+    let controller =
+        controller::controller(&ctx, rr.controller.as_ref(), rr.builtin.as_deref(), &model)?;
+    let data_columns = data::data_columns(&ctx, raw.data, &model, &controller)?;
     let mut cell = Cell {
         name: raw.name.unwrap_or_else(|| robot.name.clone()),
         origin: file.to_string(),
@@ -243,6 +248,7 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
         auto_free,
         declared_free: Vec::new(),
         data_columns,
+        controller,
         warnings,
         form,
         form_changes: shaped.changes,

@@ -196,6 +196,7 @@ fn handeye_format(
         sigma_position: None,
         sigma_orientation: None,
         temperature: None,
+        controller: None,
     }
 }
 
