@@ -36,8 +36,8 @@
 //! targets are exact.
 
 pub mod depth;
-pub mod export;
-pub mod import;
+pub(crate) mod export;
+pub(crate) mod import;
 
 pub use export::to_urdf;
 pub use import::{
