@@ -84,3 +84,24 @@ fn a_module_path_is_found() {
         ["armcal::measure::", "armcal::sim::", "armcal::model::"]
     );
 }
+
+/// `ARMCAL_MAX_INPUT_MIB` is the command line's default of the library's input caps
+/// ([`armcal::set_input_limits`]): 0 MiB refuses any cell file, and the message says how to
+/// raise the cap.
+#[test]
+fn the_environment_sets_the_input_caps() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_armcal"))
+        .args(["model", "examples/paper-cell.toml"])
+        .env("ARMCAL_MAX_INPUT_MIB", "0")
+        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("larger than 0 MiB") && stderr.contains("ARMCAL_MAX_INPUT_MIB"),
+        "{stderr}"
+    );
+    let (ok, _, stderr) = crate::common::armcal(&["model", "examples/paper-cell.toml"]);
+    assert!(ok, "{stderr}");
+}

@@ -365,10 +365,8 @@ pub struct CompensatedRow {
 }
 
 /// Compensates `program` (book §5.1) for `model` with the `calibrated` parameters and the
-/// residual `correction`, if any (book §5.4): joint rows through
-/// [`filter_joint_program_corrected`], Cartesian targets through
-/// [`corrected_cartesian_targets`]. Every row carries its own status; none fails the whole
-/// program.
+/// residual `correction`, if any (book §5.4): [`filter_joint_program_corrected`] or
+/// [`corrected_cartesian_targets`]. Every row has its own status; none fails the program.
 ///
 /// ```
 /// use armcal::{compensate, IkSettings, Program};
