@@ -64,6 +64,18 @@ enum Command {
     Study(commands::study::Args),
 }
 
+/// The environment variable that sets every input cap, in MiB (e.g. `ARMCAL_MAX_INPUT_MIB=4096`
+/// for a larger data file): the command line's default of the library's setting.
+const CAP_VARIABLE: &str = "ARMCAL_MAX_INPUT_MIB";
+
+/// [`CAP_VARIABLE`]'s caps if it holds a whole number of MiB, else the library's defaults.
+fn input_limits_from_env() -> armcal::InputLimits {
+    std::env::var(CAP_VARIABLE)
+        .ok()
+        .and_then(|v| v.trim().parse::<u64>().ok())
+        .map_or_else(armcal::InputLimits::default, armcal::InputLimits::all_mib)
+}
+
 fn main() {
     // Rust ignores SIGPIPE, so a write to a closed pipe makes `println!` panic (exit 101).
     // With the default action restored, `armcal … | head -1` ends quietly when `head` exits,
@@ -76,6 +88,7 @@ fn main() {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
     let cli = Cli::parse();
+    armcal::set_input_limits(input_limits_from_env());
     let result = match cli.command {
         Command::Robots => commands::robots::run(),
         Command::Demo(a) => commands::demo::run(&a),

@@ -2,25 +2,85 @@
 //! file goes through [`read_capped`], so no input (`/dev/zero`, a mistaken multi-GB file) can
 //! exhaust memory (issue 15).
 
+use serde::{Deserialize, Serialize};
 use std::io::Read;
 use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// The cap for text armcal reads whole (cell TOML, URDF, estimate / design / report JSON):
 /// 64 MiB.
 pub const TEXT_CAP: u64 = 64 << 20;
 /// The cap for data files (measurement and joint CSVs, programs): 1 GiB.
 pub const DATA_CAP: u64 = 1 << 30;
-/// The environment variable that sets every cap, in MiB (e.g. `ARMCAL_MAX_INPUT_MIB=4096`
-/// for a larger data file).
-pub const CAP_VARIABLE: &str = "ARMCAL_MAX_INPUT_MIB";
+/// The largest files armcal reads, a setting of the library ([`set_input_limits`]): the
+/// command line sets it from its environment variable `ARMCAL_MAX_INPUT_MIB`, a program
+/// from its own configuration.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct InputLimits {
+    /// The cap of text read whole (cell TOML, URDF, JSON records), bytes.
+    pub text_bytes: u64,
+    /// The cap of data files (measurement and joint CSVs, programs), bytes.
+    pub data_bytes: u64,
+}
 
-/// The cap in force for a file whose default is `default` bytes: [`CAP_VARIABLE`] if it
-/// holds a whole number of MiB, else `default`.
+impl Default for InputLimits {
+    /// [`TEXT_CAP`] and [`DATA_CAP`].
+    fn default() -> Self {
+        InputLimits {
+            text_bytes: TEXT_CAP,
+            data_bytes: DATA_CAP,
+        }
+    }
+}
+
+impl InputLimits {
+    /// Both caps `mib` MiB.
+    pub fn all_mib(mib: u64) -> InputLimits {
+        let bytes = mib.saturating_mul(1 << 20);
+        InputLimits {
+            text_bytes: bytes,
+            data_bytes: bytes,
+        }
+    }
+}
+
+// The setting is process-wide (as rayon's thread pool): every reader of a cell, record or
+// data file consults it, and passing it through each of their signatures would change the
+// whole reading API for one number.
+static TEXT_LIMIT: AtomicU64 = AtomicU64::new(TEXT_CAP);
+static DATA_LIMIT: AtomicU64 = AtomicU64::new(DATA_CAP);
+
+/// Sets the caps every later read of this process uses ([`InputLimits::default`] until
+/// set).
+///
+/// ```
+/// use armcal::{input_limits, set_input_limits, InputLimits};
+/// set_input_limits(InputLimits::all_mib(4096));
+/// assert_eq!(input_limits().data_bytes, 4096 << 20);
+/// set_input_limits(InputLimits::default());
+/// ```
+pub fn set_input_limits(limits: InputLimits) {
+    TEXT_LIMIT.store(limits.text_bytes, Ordering::Relaxed);
+    DATA_LIMIT.store(limits.data_bytes, Ordering::Relaxed);
+}
+
+/// The caps in force ([`set_input_limits`]).
+pub fn input_limits() -> InputLimits {
+    InputLimits {
+        text_bytes: TEXT_LIMIT.load(Ordering::Relaxed),
+        data_bytes: DATA_LIMIT.load(Ordering::Relaxed),
+    }
+}
+
+/// The cap in force for a file whose built-in cap is `default`: the setting's data cap for
+/// [`DATA_CAP`], its text cap for [`TEXT_CAP`], `default` itself for any other number.
 pub fn cap(default: u64) -> u64 {
-    std::env::var(CAP_VARIABLE)
-        .ok()
-        .and_then(|v| v.trim().parse::<u64>().ok())
-        .map_or(default, |mib| mib.saturating_mul(1 << 20))
+    let limits = input_limits();
+    match default {
+        DATA_CAP => limits.data_bytes,
+        TEXT_CAP => limits.text_bytes,
+        other => other,
+    }
 }
 
 /// The text of `path`, read up to [`cap`]`(default)` bytes; a longer file is an
@@ -36,8 +96,9 @@ pub fn read_capped(path: &Path, default: u64) -> std::io::Result<String> {
         return Err(std::io::Error::new(
             std::io::ErrorKind::InvalidData,
             format!(
-                "the file is larger than {} MiB, the most armcal reads (set {CAP_VARIABLE} \
-                 to a larger number of MiB to raise the cap)",
+                "the file is larger than {} MiB, the most armcal reads (set \
+                 ARMCAL_MAX_INPUT_MIB to a larger number of MiB to raise the cap; in a \
+                 program, armcal::set_input_limits)",
                 cap >> 20
             ),
         ));

@@ -67,12 +67,12 @@ pub mod campaign;
 pub mod cell;
 pub mod compensate;
 pub mod design;
-pub mod error;
+pub(crate) mod error;
 pub mod geometry;
 pub mod identify;
 pub mod input;
-pub mod json;
-pub mod linalg;
+pub(crate) mod json;
+pub(crate) mod linalg;
 pub mod measure;
 pub mod model;
 pub mod performance;
@@ -80,27 +80,52 @@ pub mod progress;
 pub mod report;
 pub mod robots;
 pub mod sim;
-pub mod solve;
+pub(crate) mod solve;
 pub mod study;
 pub mod table;
-pub mod toml_text;
+pub(crate) mod toml_text;
 pub mod workflow;
 
 pub use error::{Error, Result};
 
-// The handful of names a program needs; everything else by its module path.
+// The front door: the calls a program (and the Python package to come) makes, with plain
+// inputs (numbers in internal units: mm, rad; names; records) and typed, serde records out.
+// They stay in the module of the concept they compute (one concept per module, the layering
+// test's order) and are named here once; docs/src/reference/library.md lists them.
+
+// A cell and its model.
 pub use cell::Cell;
-pub use compensate::controller_program::filter_controller_program;
-pub use compensate::{calibrated_ik, IkSettings, IkStatus, IkTarget};
-pub use design::assess::assess;
-pub use design::plan::{plan, PlanResult, PlanSettings};
-pub use design::{Criterion, DesignRecord};
-pub use identify::export::export_estimate;
-pub use identify::{identify, Estimate, IdentifySettings};
-pub use measure::Dataset;
 pub use model::Model;
+// Kinematics over many configurations.
+pub use model::kinematics::fk;
+// Measurements: from arrays, from several stations, simulated, predicted.
+pub use measure::{DataArrays, Dataset, RowKind};
+pub use sim::{perturbed_truth, predict, simulate, Perturbation};
+// Identification.
+pub use identify::{identify, Acceptance, Estimate, IdentifySettings};
+// Optimal design: plan, plan from the user's pose pool, assess any design.
+pub use design::assess::{assess, DesignAssessment};
+pub use design::plan::{plan, PlanResult, PlanSettings};
+pub use design::user_pool::{plan_pool, PoolPlan, PoolSettings};
+pub use design::{Criterion, DesignRecord};
+// Compensation: calibrated inverse kinematics, programs from values.
+pub use compensate::program::{compensate, CompensatedRow, Program};
+pub use compensate::{calibrated_ik, IkResult, IkSettings, IkStatus, IkTarget};
+// Robot programs in the controllers' languages (KRL, RAPID, UR script).
+pub use compensate::controller_program::filter_controller_program;
+// Accuracy (ISO 9283 before and after calibration).
+pub use performance::{performance, Calibrated, PerformanceRecord, PerformanceSettings};
+// The adaptive campaign and the drift check.
+pub use campaign::drift::{check, CheckSettings, DriftCheck};
+pub use campaign::{start as campaign_start, step as campaign_step};
+pub use campaign::{CampaignSettings, CampaignState, StepResult};
+// Export and report.
+pub use cell::export::{export_model, ExportFormat, Exported};
+pub use identify::export::export_estimate;
+pub use report::files::{files_report, FilesReport};
+// The shared vocabulary: solver status, progress, the input caps.
+pub use input::{input_limits, set_input_limits, InputLimits};
 /// The linear-algebra crate of the public API.
 pub use nalgebra;
 pub use progress::{Observer, Silent};
-pub use sim::simulate;
 pub use solve::Status;

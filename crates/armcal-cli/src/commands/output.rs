@@ -206,31 +206,17 @@ pub fn station_files(args: &[String]) -> Vec<(Option<String>, PathBuf)> {
         .collect()
 }
 
-/// The data of several files ([`station_files`]) read for a cell ([`load_data`]), each at
-/// its station if it names one, appended in order into one data set.
+/// The data of several files ([`station_files`]) read for a cell ([`load_data`]), merged by
+/// the library's rule ([`armcal::Dataset::merge_stations`]).
 pub fn load_station_data(
     cell: &armcal::cell::Cell,
     files: &[(Option<String>, PathBuf)],
-) -> anyhow::Result<armcal::measure::Dataset> {
-    let mut all = armcal::measure::Dataset::default();
-    let mut sources = Vec::new();
-    for (station, file) in files {
-        let data = load_data(cell, file)?;
-        let data = match station {
-            Some(s) => data.at_station(s)?,
-            None => data,
-        };
-        if files.len() > 1 && data.stations.is_empty() {
-            bail!(
-                "{}: with several data files, give each its station (`--data STATION=FILE`) or a `station` column",
-                file.display()
-            );
-        }
-        sources.push(data.source.clone());
-        all.append(&data);
-    }
-    all.source = sources.join(" + ");
-    Ok(all)
+) -> anyhow::Result<armcal::Dataset> {
+    let parts = files
+        .iter()
+        .map(|(station, file)| Ok((station.clone(), load_data(cell, file)?)))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    Ok(armcal::Dataset::merge_stations(parts)?)
 }
 
 /// The reader's remarks on stderr: ignored columns, then rows read with a warning (the first

@@ -18,6 +18,7 @@ mod estimate_checks;
 mod facing_target_cli;
 mod fitted_ranges_cli;
 mod fixed_priors_export_cli;
+mod front_door;
 mod guide_links;
 mod identifiable_count_cli;
 mod import_cli;

@@ -12,10 +12,10 @@
 
 mod batch;
 pub mod drift;
-pub mod precision;
+pub(crate) mod precision;
 pub mod prior;
 pub mod simulate;
-pub mod state;
+pub(crate) mod state;
 pub mod study;
 
 pub use simulate::{simulate, SimulatedCampaign};

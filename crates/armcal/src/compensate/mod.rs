@@ -4,7 +4,7 @@
 pub mod closed_form;
 pub mod cmac;
 pub mod controller_program;
-pub mod damped_step;
+pub(crate) mod damped_step;
 pub mod ik;
 pub mod joint_change;
 pub mod lqr;

@@ -331,6 +331,99 @@ pub fn corrected_cartesian_targets(
         .collect()
 }
 
+/// A program as values: the input of [`compensate`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum Program {
+    /// Joint rows taught or computed with the nominal model: `(pose_id, q)`, internal units
+    /// (rad, mm).
+    Joints {
+        /// The rows.
+        rows: Vec<(String, Vec<f64>)>,
+    },
+    /// Cartesian tool targets in the world frame (mm, rad), each with the joints its solve
+    /// starts from (the controller's current or nominal joints; internal units).
+    Targets {
+        /// `(pose_id, target, reference joints)` per row.
+        rows: Vec<(String, Pose<f64>, Vec<f64>)>,
+    },
+}
+
+/// One compensated row of [`compensate`].
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct CompensatedRow {
+    /// The row's `pose_id`.
+    pub id: String,
+    /// For Cartesian targets, the pose to send to the controller (world, mm); `None` for a
+    /// joint row (send `result.q`).
+    pub send: Option<Pose<f64>>,
+    /// The calibrated solve: its joints (internal units), status and residual errors.
+    pub result: IkResult,
+    /// The nonparametric correction applied to the target position (world, mm; zero
+    /// without one).
+    pub correction: Vector3<f64>,
+}
+
+/// Compensates `program` (book §5.1) for `model` with the `calibrated` parameters and the
+/// residual `correction`, if any (book §5.4): [`filter_joint_program_corrected`] or
+/// [`corrected_cartesian_targets`]. Every row has its own status; none fails the program.
+///
+/// ```
+/// use armcal::{compensate, IkSettings, Program};
+/// let cell = armcal::cell::builtin::paper_cell()?;
+/// let model = &cell.model;
+/// let program = Program::Joints { rows: vec![("p1".into(), vec![0.1, -0.2, 0.3, 0.0, 0.4, 0.0])] };
+/// // With the nominal parameters as the calibration, every row stays where it is.
+/// let rows = compensate(model, &model.nominal(), &program, &IkSettings::default(), None);
+/// assert!(rows[0].result.status.status().is_converged());
+/// assert!((rows[0].result.q[4] - 0.4).abs() < 1e-9);
+/// # Ok::<(), armcal::Error>(())
+/// ```
+pub fn compensate(
+    model: &Model,
+    calibrated: &[f64],
+    program: &Program,
+    settings: &IkSettings,
+    correction: Option<&ResidualCorrection>,
+) -> Vec<CompensatedRow> {
+    let nominal = model.nominal();
+    match program {
+        Program::Joints { rows } => {
+            filter_joint_program_corrected(model, &nominal, calibrated, rows, settings, correction)
+                .into_iter()
+                .map(|r| CompensatedRow {
+                    id: r.id,
+                    send: None,
+                    result: r.result,
+                    correction: r.correction,
+                })
+                .collect()
+        }
+        Program::Targets { rows } => {
+            let poses: Vec<Pose<f64>> = rows.iter().map(|r| r.1).collect();
+            let references: Vec<Vec<f64>> = rows.iter().map(|r| r.2.clone()).collect();
+            corrected_cartesian_targets(
+                model,
+                &nominal,
+                calibrated,
+                &poses,
+                &references,
+                settings,
+                correction,
+            )
+            .into_iter()
+            .zip(rows)
+            .map(|(r, row)| CompensatedRow {
+                id: row.0.clone(),
+                send: Some(r.pose),
+                result: r.result,
+                correction: r.correction,
+            })
+            .collect()
+        }
+    }
+}
+
 /// A compensated program file.
 #[derive(Clone, Debug)]
 pub struct CompensatedProgram {
@@ -383,9 +476,9 @@ impl ProgramFile {
     }
 }
 
-/// Compensates `program` for `model` with the `calibrated` parameters (and the residual
-/// `correction`, if any): Cartesian targets ([`corrected_cartesian_targets`], the joint
-/// columns their starting guesses) or a joint program ([`filter_joint_program_corrected`]).
+/// Compensates a program file for `model` with the `calibrated` parameters (and the residual
+/// `correction`, if any): the CSV layer on [`compensate`], Cartesian targets (the joint
+/// columns their starting guesses) or a joint program.
 pub fn compensate_program(
     model: &Model,
     calibrated: &[f64],
@@ -393,7 +486,6 @@ pub fn compensate_program(
     settings: &IkSettings,
     correction: Option<&ResidualCorrection>,
 ) -> Result<CompensatedProgram, Error> {
-    let nominal = model.nominal();
     let (text, file, cartesian) = (
         program.text.as_str(),
         program.file.as_str(),
@@ -444,74 +536,58 @@ pub fn compensate_program(
         ]);
         fields
     };
-    let (mut failed, mut beyond, mut priority) = (0, 0, 0);
-    let mut count = |r: &IkResult| {
-        failed += usize::from(!r.status.status().is_converged());
-        beyond += usize::from(r.status == IkStatus::JointChangeLimit);
-        priority += usize::from(r.position_priority);
-    };
-    let out = if cartesian {
+    let values = if cartesian {
         // Read the tool poses with a robot-only model: rows become world-frame poses.
         let mut robot_only = model.spec();
         robot_only.instrument = None;
         robot_only.targets.clear();
         let robot = Model::from_spec(&robot_only)?;
         let data = csv::read_targets_str(text, file, &robot)?;
-        let poses: Vec<Pose<f64>> = data
+        let rows = data
             .measurements
             .iter()
             .map(|m| match &m.kind {
-                MeasurementKind::Pose { value, .. } => Ok(*value),
+                MeasurementKind::Pose { value, .. } => Ok((
+                    data.config_ids[m.config].clone(),
+                    *value,
+                    data.configurations[m.config].clone(),
+                )),
                 _ => Err(Error::Input(format!(
                     "line {}: Cartesian targets need x, y, z, roll, pitch, yaw",
                     m.line
                 ))),
             })
             .collect::<Result<_, Error>>()?;
-        let seeds: Vec<Vec<f64>> = data
-            .measurements
-            .iter()
-            .map(|m| data.configurations[m.config].clone())
-            .collect();
-        let rows = corrected_cartesian_targets(
-            model, &nominal, calibrated, &poses, &seeds, settings, correction,
-        );
-        let mut out = Table::new(header(&[
-            "x_mm",
-            "y_mm",
-            "z_mm",
-            "roll_deg",
-            "pitch_deg",
-            "yaw_deg",
-        ]));
-        for (i, r) in rows.iter().enumerate() {
-            let (xyz, rpy) = r.pose.to_xyz_rpy();
-            count(&r.result);
-            let target = [xyz[0], xyz[1], xyz[2]]
-                .into_iter()
-                .chain(rpy.iter().map(|a| a.to_degrees()))
-                .map(|x| format!("{x:.DECIMALS$}"))
-                .collect();
-            let id = &data.config_ids[data.measurements[i].config];
-            out.row(row(id, &r.result, target, &r.correction));
-        }
-        out
+        Program::Targets { rows }
     } else {
-        let rows = filter_joint_program_corrected(
-            model,
-            &nominal,
-            calibrated,
-            &program.rows,
-            settings,
-            correction,
-        );
-        let mut out = Table::new(header(&[]));
-        for r in &rows {
-            count(&r.result);
-            out.row(row(&r.id, &r.result, Vec::new(), &r.correction));
+        Program::Joints {
+            rows: program.rows.clone(),
         }
-        out
     };
+    let rows = compensate(model, calibrated, &values, settings, correction);
+    let target: &[&str] = if cartesian {
+        &["x_mm", "y_mm", "z_mm", "roll_deg", "pitch_deg", "yaw_deg"]
+    } else {
+        &[]
+    };
+    let mut out = Table::new(header(target));
+    let (mut failed, mut beyond, mut priority) = (0, 0, 0);
+    for r in &rows {
+        failed += usize::from(!r.result.status.status().is_converged());
+        beyond += usize::from(r.result.status == IkStatus::JointChangeLimit);
+        priority += usize::from(r.result.position_priority);
+        let target = match &r.send {
+            Some(pose) => {
+                let (xyz, rpy) = pose.to_xyz_rpy();
+                xyz.into_iter()
+                    .chain(rpy.iter().map(|a| a.to_degrees()))
+                    .map(|x| format!("{x:.DECIMALS$}"))
+                    .collect()
+            }
+            None => Vec::new(),
+        };
+        out.row(row(&r.id, &r.result, target, &r.correction));
+    }
     Ok(CompensatedProgram {
         cartesian,
         rows: program.rows.len(),

@@ -10,12 +10,12 @@ pub mod criteria;
 pub mod exchange;
 pub mod information;
 pub mod objective;
-pub mod order;
+pub(crate) mod order;
 pub mod plan;
 pub mod record;
 pub mod refine;
 pub mod selection;
-pub mod small_cholesky;
+pub(crate) mod small_cholesky;
 pub mod user_pool;
 
 pub use cell_constraints::{

@@ -10,11 +10,6 @@ pub fn travel(a: &[f64], b: &[f64]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Total travel of a sequence.
-pub fn path_length(qs: &[Vec<f64>]) -> f64 {
-    qs.windows(2).map(|w| travel(&w[0], &w[1])).sum()
-}
-
 /// A permutation of `qs` (open path, starting at the first configuration) with shorter
 /// travel.
 pub fn order_for_travel(qs: &[Vec<f64>]) -> Vec<usize> {
@@ -65,6 +60,11 @@ pub fn order_for_travel(qs: &[Vec<f64>]) -> Vec<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Total travel of a sequence.
+    fn path_length(qs: &[Vec<f64>]) -> f64 {
+        qs.windows(2).map(|w| travel(&w[0], &w[1])).sum()
+    }
 
     #[test]
     fn ordering_never_lengthens_the_path() {

@@ -1,6 +1,9 @@
 //! The planner: a feasible candidate pool, multi-start exchange, continuous refinement
 //! under the constraints, a strict feasibility check, travel ordering, and the optimality
 //! bound. Every solver reports its status, iterations and time.
+//!
+//! (Over 600 lines: one algorithm — pool, starts, refinement, checks — with its settings and
+//! its result record.)
 
 use crate::cell::Cell;
 use crate::design::baselines::random_feasible;
@@ -14,6 +17,7 @@ use crate::design::refine::{refine, ConfigurationConstraints, RefineSettings};
 use crate::design::Criterion;
 use crate::linalg::unit_diagonal;
 use crate::progress::{Observer, Shared};
+use crate::solve::Status;
 use crate::Error;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -127,6 +131,11 @@ pub struct PlanResult {
     pub refine_status: Option<String>,
     /// Refinement iterations (0 when it did not run).
     pub refine_iterations: usize,
+    /// How the planner ended, in the shared vocabulary: the refinement's status when its
+    /// design is the result; converged (`exchange`) when the exchange design is (no
+    /// refinement, or its design rejected); infeasible when no feasible pool could be drawn.
+    #[serde(default = "exchange_converged")]
+    pub status: Status,
     /// Optimality bound and efficiency of the design (criteria with [`has_bound`] only).
     pub bound: Option<OptimalityBound>,
     /// When no feasible pool could be drawn: each constraint that blocks random
@@ -134,6 +143,13 @@ pub struct PlanResult {
     pub blocking: Vec<(String, f64)>,
     /// Wall-clock time of the run.
     pub time: Duration,
+}
+
+/// The status of a design the exchange made (no step of it lowers the criterion).
+pub(crate) fn exchange_converged() -> Status {
+    Status::Converged {
+        criterion: "exchange".into(),
+    }
 }
 
 /// The report when the cell's constraints leave (almost) no feasible configuration: which
@@ -198,6 +214,9 @@ fn infeasible_report(
         exchange_sweeps: 0,
         refine_status: None,
         refine_iterations: 0,
+        status: Status::Infeasible {
+            reason: format!("no feasible configuration in {draws} random draws"),
+        },
         bound: None,
         blocking,
         time: t0.elapsed(),
@@ -218,6 +237,8 @@ pub struct PoolDesign {
     pub sweeps: usize,
     /// The refinement's status text and iterations; `None` when it did not run (exchange only).
     pub refine: Option<(String, usize)>,
+    /// How the start ended ([`PlanResult::status`]).
+    pub status: Status,
     /// Whether the design is the refined one (false: the exchange design, the refinement did
     /// not run or its design was rejected).
     pub refined: bool,
@@ -427,6 +448,7 @@ pub fn plan(
         exchange_value,
         sweeps,
         refine: refine_info,
+        status,
         ..
     } = design_from_pool(&d, &set, &pool, settings, measured, observer)?;
     let order = order_for_travel(&design);
@@ -457,6 +479,7 @@ pub fn plan(
         exchange_sweeps: sweeps,
         refine_status: refine_info.as_ref().map(|r| r.0.clone()),
         refine_iterations: refine_info.map(|r| r.1).unwrap_or(0),
+        status,
         bound,
         blocking: Vec::new(),
         time: t0.elapsed(),
@@ -523,6 +546,7 @@ pub fn design_from_pool(
                 exchange_value: ex.value,
                 sweeps: ex.sweeps,
                 refine: None,
+                status: exchange_converged(),
                 refined: false,
             });
         }
@@ -544,6 +568,7 @@ pub fn design_from_pool(
         if ok && r.value <= ex.value {
             Ok(PoolDesign {
                 refine: Some((r.describe(), r.iterations)),
+                status: r.status,
                 design: r.q,
                 value: r.value,
                 exchange_value: ex.value,
@@ -568,6 +593,7 @@ pub fn design_from_pool(
                     ),
                     r.iterations,
                 )),
+                status: exchange_converged(),
                 refined: false,
             })
         }

@@ -17,7 +17,7 @@ use crate::design::exchange::{exchange, pool_jacobians, value_of, ExchangeSettin
 use crate::design::information::DesignModel;
 use crate::design::objective::DesignObjective;
 use crate::design::order::order_for_travel;
-use crate::design::plan::{constraint_set, CellConstraints, PlanResult};
+use crate::design::plan::{constraint_set, exchange_converged, CellConstraints, PlanResult};
 use crate::design::refine::{refine_in_boxes, ConfigurationConstraints, RefineSettings};
 use crate::design::selection::{select_d, SelectionSettings};
 use crate::design::{ConstraintKind, ConstraintSet, Criterion};
@@ -162,6 +162,23 @@ fn minimum_poses(n: usize, rows: usize, prior_rank: usize) -> usize {
     n.saturating_sub(prior_rank).div_ceil(rows).max(1)
 }
 
+/// Plans `settings.poses` poses for `cell` from the user's pose pool given as values: its
+/// joint rows (internal units: rad, mm), named `1`, `2`, … in messages and in the record
+/// ([`plan_from_pool`] with the rows of a file).
+pub fn plan_pool(
+    cell: &Cell,
+    pool: &[Vec<f64>],
+    settings: &PoolSettings,
+    observer: &mut dyn Observer,
+) -> Result<PoolPlan, Error> {
+    let rows: Vec<(String, Vec<f64>)> = pool
+        .iter()
+        .enumerate()
+        .map(|(i, q)| ((i + 1).to_string(), q.clone()))
+        .collect();
+    plan_from_pool(cell, &rows, "pose pool", settings, &[], observer)
+}
+
 /// Plans `settings.poses` poses for `cell` from the rows of `pool` (pose id and joint values,
 /// internal units, as [`read_configurations`](crate::measure::csv::read_configurations)
 /// returns them) of the file `file`, augmenting the `measured` poses; `observer` follows
@@ -188,6 +205,14 @@ pub fn plan_from_pool(
     let mut feasible_rows: Vec<usize> = Vec::new();
     let mut infeasible = Vec::new();
     for (r, (id, q)) in pool.iter().enumerate() {
+        if q.len() != cell.model.dof() {
+            return Err(Error::Input(format!(
+                "{file}: row {} (`{id}`): {} joint values, the robot has {} joints",
+                r + 1,
+                q.len(),
+                cell.model.dof()
+            )));
+        }
         if let Some(joint) = cell
             .model
             .joints
@@ -312,8 +337,14 @@ pub fn plan_from_pool(
     };
     let selection_value = value_of(&d, settings.criterion, &jp, prior, &chosen)?;
     let start: Vec<Vec<f64>> = chosen.iter().map(|&i| candidates[i].clone()).collect();
-    let (design, value, refine_status, refine_iterations) = match settings.refine_radius {
-        None => (start.clone(), selection_value, None, 0),
+    let (design, value, refine_status, refine_iterations, status) = match settings.refine_radius {
+        None => (
+            start.clone(),
+            selection_value,
+            None,
+            0,
+            exchange_converged(),
+        ),
         Some(radius) => {
             let (lower, upper) = boxes(&d, &start, radius);
             let r = refine_in_boxes(
@@ -332,7 +363,8 @@ pub fn plan_from_pool(
             }) && r.q.len() * k == lower.len();
             let ok = r.q.iter().all(|q| cons.feasible(q));
             if ok && inside && r.value <= selection_value {
-                (r.q.clone(), r.value, Some(r.describe()), r.iterations)
+                let describe = r.describe();
+                (r.q, r.value, Some(describe), r.iterations, r.status)
             } else {
                 let why = if !ok {
                     "infeasible"
@@ -346,6 +378,7 @@ pub fn plan_from_pool(
                     selection_value,
                     Some(format!("{} (refined design rejected: {why})", r.describe())),
                     r.iterations,
+                    exchange_converged(),
                 )
             }
         }
@@ -394,6 +427,7 @@ pub fn plan_from_pool(
         exchange_sweeps: sweeps,
         refine_status,
         refine_iterations,
+        status,
         bound,
         blocking: Vec::new(),
         time: t0.elapsed(),

@@ -2,9 +2,8 @@
 //! linearised covariance of the fitted axis — the geometry of circle point analysis
 //! ([`crate::identify::circle_point`], book §4.6):
 //!
-//! * [`fit_plane`]: total least squares plane through the centred points (SVD, book
-//!   §4.6.2's principal axis method);
-//! * [`fit_circle`]: plane fit and the algebraic (Kåsa) circle in the plane — linear least
+//! * [`fit_circle`]: total least squares plane through the centred points (SVD, book
+//!   §4.6.2's principal axis method) and the algebraic (Kåsa) circle in the plane — linear least
 //!   squares on `x² + y² + D x + E y + F = 0` — as the start, then Gauss–Newton on Stone's
 //!   geometric residuals (book eqs. 4.284–4.290): the 3-D distance of each point from the
 //!   circle, split into its out-of-plane part `hᵢ` and its in-plane radial part `eᵢ`, over
@@ -163,15 +162,6 @@ fn check_finite(points: &[Vector3<f64>], min: usize, what: &str) -> Result<(), E
         )));
     }
     Ok(())
-}
-
-/// Total least squares plane: `(unit normal, centroid, rms distance)`. The normal is the
-/// right singular vector of the smallest singular value of the centred points; its sign is
-/// arbitrary. Needs at least 3 points.
-pub fn fit_plane(points: &[Vector3<f64>]) -> Result<(Vector3<f64>, Vector3<f64>, f64), Error> {
-    check_finite(points, 3, "a plane fit")?;
-    let (centroid, axes, s) = principal_axes(points);
-    Ok((axes[2], centroid, s[2] / (points.len() as f64).sqrt()))
 }
 
 /// The orthonormal basis `(x, y = u × x)` across the unit vector `u`, `x` the part of `v`
@@ -585,8 +575,5 @@ pub(crate) mod tests {
         assert!(fit_circle(&line).is_err());
         let l = fit_line(&line).unwrap();
         assert!((l.direction - Vector3::x()).norm() < 1e-12 && l.rms < 1e-12);
-        let (n, c, rms) = fit_plane(&pts).unwrap();
-        assert!(n.cross(&Vector3::z()).norm() < 1e-12 && (c.z - 3.0).abs() < 1e-12);
-        assert!(rms < 1e-12);
     }
 }

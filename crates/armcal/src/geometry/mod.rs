@@ -13,9 +13,9 @@
 //! The constraint set of a cell built from these (incidence, capsule–capsule, capsule–box, half-space,
 //! line of sight) is design work: [`crate::design::cell_constraints`].
 
-pub mod box_distance;
-pub mod cone_distance;
-pub mod fit;
+pub(crate) mod box_distance;
+pub(crate) mod cone_distance;
+pub(crate) mod fit;
 pub mod segment_distance;
 
 pub use box_distance::{segment_box_distance, Cuboid, SegmentBoxDistance};

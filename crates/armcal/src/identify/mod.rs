@@ -4,32 +4,32 @@
 //! axes by circle point analysis.
 
 pub mod circle_point;
-pub mod estimate;
+pub(crate) mod estimate;
 pub mod export;
-pub mod fingerprint;
+pub(crate) mod fingerprint;
 pub mod fit_checks;
 pub mod fitted_ranges;
 mod frames_first;
 mod free_set;
-pub mod gauss_newton;
+pub(crate) mod gauss_newton;
 pub mod held_out;
-pub mod kalman;
-pub mod lm;
+pub(crate) mod kalman;
+pub(crate) mod lm;
 pub mod model_floor;
-pub mod nongeometric_choice;
-pub mod nongeometric_gate;
+pub(crate) mod nongeometric_choice;
+pub(crate) mod nongeometric_gate;
 pub mod pivot;
 pub mod prediction_sigma;
-pub mod problem;
-pub mod refit;
+pub(crate) mod problem;
+pub(crate) mod refit;
 pub mod residuals;
-pub mod robust;
-pub mod sign_diagnosis;
-pub mod solver;
+pub(crate) mod robust;
+pub(crate) mod sign_diagnosis;
+pub(crate) mod solver;
 mod split;
 pub mod uncertainty;
-pub mod unit_check;
-pub mod verdicts;
+pub(crate) mod unit_check;
+pub(crate) mod verdicts;
 mod weak_gain;
 
 pub use estimate::{

@@ -75,9 +75,6 @@ pub struct UnitFinding {
 /// The data's scale against the nominal model's ([`data_scale`]).
 #[derive(Clone, Debug, Default)]
 pub struct DataScale {
-    /// Median of the measured over the model's distances between pairs of measurements;
-    /// `None` with fewer than two position measurements of one target at one station.
-    pub ratio: Option<f64>,
     /// The unit mistakes found (at most one).
     pub findings: Vec<UnitFinding>,
     /// With the scale right: the measurements (indices into the data's measurements) whose
@@ -270,7 +267,6 @@ pub fn data_scale(model: &Model, params: &[f64], data: &Dataset, tolerance_mm: f
     let in_band = s.ln().abs() <= SCALE_BAND.ln();
     if in_band {
         return DataScale {
-            ratio: Some(s),
             findings: Vec::new(),
             blunders: blunders(data, &all, s, tolerance_mm),
         };
@@ -342,7 +338,6 @@ pub fn data_scale(model: &Model, params: &[f64], data: &Dataset, tolerance_mm: f
 /// A data scale with one finding.
 fn finding(s: f64, subject: &str, unit: &str, message: String) -> DataScale {
     DataScale {
-        ratio: Some(s),
         findings: vec![UnitFinding {
             subject: subject.to_string(),
             ratio: s,

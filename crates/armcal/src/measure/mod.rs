@@ -9,13 +9,15 @@
 //! in one least-squares problem.
 
 pub mod angles;
+mod arrays;
 mod columns;
 pub mod csv;
 pub mod format;
-pub mod noise;
-pub mod residual;
+pub(crate) mod noise;
+pub(crate) mod residual;
 pub mod stations;
 
+pub use arrays::{DataArrays, RowKind};
 pub use noise::NoiseModel;
 
 use crate::model::{Observed, Pose, Rows};

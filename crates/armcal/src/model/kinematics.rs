@@ -7,6 +7,7 @@ use crate::model::chain::{Model, Step};
 use crate::model::joint_correction::CorrectionData;
 use crate::model::link::Motion;
 use crate::model::pose::{rot_axis, Pose, Twist};
+use crate::Error;
 use nalgebra::{convert, RealField, Vector3};
 
 /// Reusable buffers for one evaluation of a [`Model`] (pinocchio's `Data`). Generic over
@@ -159,6 +160,59 @@ pub fn tool_pose(model: &Model, params: &[f64], q: &[f64]) -> Pose<f64> {
     let mut data = Data::new(model);
     forward_kinematics(model, &mut data, params, q);
     *data.tool()
+}
+
+/// The tool frame's world pose at every configuration of `configurations` (internal units:
+/// rad, mm) with the parameters `params`, as 4×4 homogeneous matrices (translation in mm):
+/// `T(q) = B · ∏ A_i(q_i) · E`, base, links and tool multiplied out (book ch. 2; the chain
+/// of [`forward_kinematics`], the pose [`tool_pose`] gives). A row of
+/// the wrong length or with a non-finite value is an error naming the row (1-based); joint
+/// limits are not checked (the pose is defined anywhere).
+///
+/// ```
+/// let cell = armcal::cell::builtin::paper_cell()?;
+/// let model = &cell.model;
+/// let q = vec![0.1, -0.2, 0.3, 0.0, 0.4, 0.0];
+/// let t = armcal::fk(model, &model.nominal(), &[q.clone(), q])?;
+/// assert_eq!(t.len(), 2);
+/// assert_eq!(t[0], t[1]);
+/// let p = armcal::model::tool_pose(model, &model.nominal(), &[0.1, -0.2, 0.3, 0.0, 0.4, 0.0]);
+/// assert_eq!(t[0].fixed_view::<3, 1>(0, 3), p.trans);
+/// assert_eq!(t[0][(3, 3)], 1.0);
+/// let e = armcal::fk(model, &model.nominal(), &[vec![0.0; 5]]).unwrap_err();
+/// assert!(e.to_string().starts_with("configuration 1:"), "{e}");
+/// # Ok::<(), armcal::Error>(())
+/// ```
+pub fn fk(
+    model: &Model,
+    params: &[f64],
+    configurations: &[Vec<f64>],
+) -> Result<Vec<nalgebra::Matrix4<f64>>, Error> {
+    if params.len() != model.registry.len() {
+        return Err(Error::Input(format!(
+            "model `{}` has {} parameters, got {}",
+            model.name,
+            model.registry.len(),
+            params.len()
+        )));
+    }
+    let mut data = Data::new(model);
+    configurations
+        .iter()
+        .enumerate()
+        .map(|(i, q)| {
+            if q.len() != model.dof() || q.iter().any(|v| !v.is_finite()) {
+                return Err(Error::Input(format!(
+                    "configuration {}: {} finite joint values expected (rad, mm), got {:?}",
+                    i + 1,
+                    model.dof(),
+                    q
+                )));
+            }
+            forward_kinematics(model, &mut data, params, q);
+            Ok(nalgebra::Matrix4::from(data.tool().to_matrix()).transpose())
+        })
+        .collect()
 }
 
 #[inline]

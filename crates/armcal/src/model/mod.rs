@@ -1,7 +1,7 @@
 //! Kinematic models: conventions, chain, parameter registry, forward kinematics, exact
 //! Jacobians, identifiability, configuration sampling, conversions and URDF.
 
-pub mod branch;
+pub(crate) mod branch;
 pub mod chain;
 pub mod complete;
 pub mod compliance;
@@ -12,17 +12,17 @@ pub mod fixed_kinematics;
 pub mod frames;
 pub mod identifiability;
 pub mod jacobian;
-pub mod jacobian_dq_along;
-pub mod joint_correction;
-pub mod kinematics;
-pub mod link;
+pub(crate) mod jacobian_dq_along;
+pub(crate) mod joint_correction;
+pub(crate) mod kinematics;
+pub(crate) mod link;
 pub mod periodic;
 pub mod pose;
-pub mod prior;
-pub mod rank_deficit;
-pub mod registry;
+pub(crate) mod prior;
+pub(crate) mod rank_deficit;
+pub(crate) mod registry;
 pub mod sampling;
-pub mod station;
+pub(crate) mod station;
 pub mod tcp_shift;
 pub mod ur_kinematics;
 pub mod urdf;

@@ -8,26 +8,26 @@
 //! [`parameter_charts`] draw plain data to SVG; [`html`] assembles the page. A design (and
 //! the estimate made from it) keeps one colour in every figure ([`design_key`]).
 
-pub mod campaign;
+pub(crate) mod campaign;
 pub mod cell_view;
-pub mod check;
+pub(crate) mod check;
 pub mod compensation;
-pub mod decimate;
-pub mod demo_summary;
-pub mod design;
-pub mod documents;
+pub(crate) mod decimate;
+pub(crate) mod demo_summary;
+pub(crate) mod design;
+pub(crate) mod documents;
 pub mod ellipse;
-pub mod estimate;
+pub(crate) mod estimate;
 pub mod figures;
 pub mod files;
-pub mod font;
-pub mod held_out;
+pub(crate) mod font;
+pub(crate) mod held_out;
 pub mod html;
 pub mod parameter_charts;
 pub mod parameter_view;
-pub mod study;
-pub mod tcp;
-pub mod temperature;
+pub(crate) mod study;
+pub(crate) mod tcp;
+pub(crate) mod temperature;
 pub mod verdict;
 
 pub use documents::Document;

@@ -12,7 +12,7 @@ mod kuka;
 mod motoman;
 mod paper;
 pub mod puma560;
-pub mod skeleton;
+pub(crate) mod skeleton;
 mod ur10;
 
 use crate::model::{Joint, JointKind, LinkGeometry, LinkSpec, ModelSpec};

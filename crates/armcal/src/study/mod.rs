@@ -1,5 +1,5 @@
 //! Reproductions of the sources' experiments.
 
-pub mod demo;
+pub(crate) mod demo;
 pub mod paper;
 pub mod puma;

@@ -97,6 +97,7 @@ mod report {
     mod verdict;
 }
 mod repository {
+    mod api_surface;
     mod builtin_cells;
     mod file_size;
     mod layering;

@@ -37,8 +37,8 @@
 
 pub mod calibration;
 pub mod depth;
-pub mod export;
-pub mod import;
+pub(crate) mod export;
+pub(crate) mod import;
 pub mod joint_corrections;
 
 pub use export::to_urdf;

@@ -13,8 +13,8 @@
 //! **Units.** armcal works in mm and rad; the book's Chapter 6 in inches and degrees
 //! (Table 6.4 in mm and rad). The study's tables are in the book's units.
 
-pub mod book;
-pub mod poses;
+pub(crate) mod book;
+pub(crate) mod poses;
 pub mod record;
 
 pub use book::*;

@@ -94,6 +94,11 @@ fn an_obstacle_over_the_tracker_gives_a_clear_report_and_the_best_design() {
     )
     .unwrap();
     assert!(!rep.feasible);
+    assert!(
+        matches!(rep.status, armcal::Status::Infeasible { .. }),
+        "{}",
+        rep.status
+    );
     assert_eq!(rep.design.len(), 10);
     assert_eq!(rep.blocking[0].0, "beam / crate-over-tracker");
     assert!(rep.blocking[0].1 > 0.99);

@@ -160,6 +160,18 @@ fn refine_radius_keeps_every_joint_within_the_radius_of_its_pool_pose() {
     let p = plan_from_pool(&cell, &read, "pool.csv", &settings, &[], &mut Silent).unwrap();
     let status = p.plan.refine_status.clone().unwrap();
     assert!(!status.contains("rejected"), "{status}");
+    // The refined design is the result: its status is the refinement's, not the exchange's.
+    assert_ne!(
+        p.plan.status,
+        armcal::Status::Converged {
+            criterion: "exchange".into()
+        }
+    );
+    // The same pool given as values plans the same design.
+    let rows: Vec<Vec<f64>> = read.iter().map(|r| r.1.clone()).collect();
+    let by_value = armcal::plan_pool(&cell, &rows, &settings, &mut Silent).unwrap();
+    assert_eq!(by_value.plan.design, p.plan.design);
+    assert_eq!(by_value.plan.status, p.plan.status);
     assert!(
         p.plan.value < p.pool.selection_value,
         "the refinement gains"
@@ -231,6 +243,14 @@ fn bad_pools_give_clear_errors() {
     .unwrap_err()
     .to_string();
     assert!(e.contains("pool.csv") && e.contains("q6"), "{e}");
+    // A row of five joints given as values.
+    let e = armcal::plan_pool(&cell, &[vec![0.0; 5]], &settings, &mut Silent)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("row 1 (`1`): 5 joint values, the robot has 6 joints"),
+        "{e}"
+    );
     // Too few feasible rows: 8 feasible (27 parameters need 9 poses) among 40 rows.
     let (text, _, _) = pool(&cell, 8, 30, 2, 3);
     let read = csv::read_configurations_str(&text, "pool.csv", &cell.model, None).unwrap();
