@@ -22,6 +22,7 @@ pub mod rank_deficit;
 pub mod registry;
 pub mod sampling;
 pub mod station;
+pub mod tree;
 pub mod urdf;
 
 pub use chain::{LimitTolerance, Link, LinkSpec, Model, ModelSpec, MEASURED_LIMIT_TOLERANCE};
