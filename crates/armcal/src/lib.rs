@@ -89,6 +89,7 @@ pub mod workflow;
 pub use error::{Error, Result};
 
 // The handful of names a program needs; everything else by its module path.
+pub use cell::tree::{analyze_tree_file, TreeAnalysis, TreeCell};
 pub use cell::Cell;
 pub use compensate::{calibrated_ik, IkSettings, IkStatus, IkTarget};
 pub use design::assess::assess;
