@@ -591,3 +591,31 @@ fn random_tree_configurations(tree: &Tree, n: usize) -> Vec<Vec<f64>> {
     let mut r = rng(77);
     (0..n).map(|_| random_tree_q(tree, &mut r)).collect()
 }
+
+#[test]
+fn a_one_branch_tree_is_its_serial_chain() {
+    // The same configurations, the same rows: the tree's analysis of a chain is the serial
+    // analysis (rank, identifiable set, reasons), its measurement the serial measurement.
+    let tree = Tree::from_spec(&random_tree("", &["RRPRRR"], false, 3)).unwrap();
+    let serial = &tree.branches[0].model;
+    assert_eq!(tree.param_count(), serial.param_count());
+    let opts = IdentifiabilitySettings {
+        measurement: Measurement::Position,
+        poses: 30,
+        ..Default::default()
+    };
+    let qs = random_tree_configurations(&tree, 30);
+    let t = analyze_tree(&tree, &tree.nominal(), Some(&qs), &opts).unwrap();
+    let s =
+        armcal::model::identifiability::analyze_at(serial, &serial.nominal(), &qs, &opts).unwrap();
+    assert_eq!(t.rank_svd, s.rank_svd);
+    assert_eq!(t.identifiable, s.identifiable);
+    assert_eq!(
+        t.completeness.expected_for_measurement,
+        s.completeness.expected_for_measurement
+    );
+    let q = &qs[0];
+    let p = pose_of(&tree, &tree.nominal(), q, 0);
+    let m = measure(serial, &serial.nominal(), q, Observed::Target(0));
+    assert_eq!(p.trans, m.trans);
+}
