@@ -96,6 +96,8 @@ pub use error::{Error, Result};
 // A cell and its model.
 pub use cell::Cell;
 pub use model::Model;
+// Kinematic trees and coupled joints (analysis only, for now).
+pub use cell::tree::{analyze_tree_file, TreeAnalysis, TreeCell};
 // Kinematics over many configurations.
 pub use model::kinematics::fk;
 // Measurements: from arrays, from several stations, simulated, predicted.

@@ -33,6 +33,10 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
+    let path = std::path::Path::new(&a.target);
+    if path.is_file() && armcal::cell::tree::describes_tree(path)? {
+        return run_tree(a, path);
+    }
     let cell = super::output::load_cell(&a.target)?;
     let measurement = a
         .measurement
@@ -82,11 +86,169 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         );
     }
     println!();
+    print_parameters(&model.registry, report);
+    print_joints(&model.joints);
+    let c = &report.completeness;
+    println!(
+        "\ncompleteness (book §2.3): {} revolute, {} prismatic joints → complete pose model 4R + 2P + 6 = {}",
+        c.revolute, c.prismatic, c.complete_pose_model
+    );
+    match c.expected_for_measurement {
+        Some(n) => println!(
+            "expected identifiable from {} measurements in generic geometry: {n}",
+            measurement.words()
+        ),
+        None => {
+            println!(
+                "no closed-form count for {} measurements of several targets",
+                measurement.words()
+            )
+        }
+    }
+    print_rank(report, a.seed);
+    println!(
+        "identifiable: {} at these random configurations and the nominal, condition number of the column-scaled Jacobian {:.1}",
+        report.count(model),
+        report.condition_number
+    );
+    println!("  {}", report.identifiable.join(", "));
+    println!("  (`identify` counts again, by the same rule, at the data's configurations and at the fit: data that move some joints little, or terms they cannot separate, give fewer, and it says why)");
+    if let Some(d) = &deficit {
+        println!("below the generic count: {d}");
+    }
+    print_excluded(report);
+    Ok(())
+}
+
+/// `armcal model` of a tree cell: its branches, coupled joints, parameters and the
+/// identifiability over every target (`armcal::analyze_tree_file`).
+fn run_tree(a: &Args, path: &std::path::Path) -> anyhow::Result<()> {
+    if a.convention.is_some() {
+        anyhow::bail!("--convention converts a serial chain; this cell describes a tree");
+    }
+    let measurement = a.measurement.as_deref().and_then(Measurement::from_name);
+    let analysis = armcal::analyze_tree_file(path, measurement, a.poses as usize, a.seed)?;
+    let (cell, report) = (&analysis.cell, &analysis.identifiability);
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(report)?);
+        return Ok(());
+    }
+    let tree = &cell.tree;
+    println!("{} ({})", cell.name, cell.origin);
+    let branches = match tree.branches.len() {
+        1 => "1 branch".to_string(),
+        n => format!("{n} branches"),
+    };
+    let forks = match tree.forks.is_empty() {
+        true => "no fork".to_string(),
+        false => format!("forks at {}", tree.forks.join(", ")),
+    };
+    println!(
+        "a tree: {branches}, {} joints a data row carries, {forks}",
+        tree.dof()
+    );
+    for b in &tree.branches {
+        let links: Vec<&str> = b.model.links.iter().map(|l| l.spec.name.as_str()).collect();
+        let targets: Vec<&str> = b
+            .model
+            .targets
+            .iter()
+            .map(|t| t.spec.name.as_str())
+            .collect();
+        println!("  branch {} → {}", links.join(" → "), targets.join(", "));
+    }
+    for c in &tree.coupled {
+        if let Some(text) = tree.coupling_of(&c.link) {
+            println!("coupled: {text} (link `{}`; not a data column)", c.link);
+        }
+    }
+    for w in tree.incomplete_forks() {
+        println!("incomplete: {w}");
+    }
+    println!();
+    // what the analysis leaves out is held at nominal (as `armcal model` shows a chain)
+    let mut registry = tree.registry.clone();
+    for e in &report.excluded {
+        if let Some(i) = registry.index_of(&e.name) {
+            registry.set_status(i, Status::Fixed);
+        }
+    }
+    print_parameters(&registry, report);
+    print_joints(&tree.joints);
+    let c = &report.completeness;
+    match c.expected_for_measurement {
+        Some(n) => println!(
+            "\nexpected identifiable from {} measurements in generic geometry: {n} (4R + 2P + {} per target: {} revolute, {} prismatic joints)",
+            cell.measurement.words(),
+            if cell.measurement == Measurement::Pose { 6 } else { 3 },
+            c.revolute,
+            c.prismatic
+        ),
+        None => println!(
+            "\nno closed-form count for this tree (a coupled joint, several points on one link, or a fork the tree cannot place apart)"
+        ),
+    }
+    print_rank(report, a.seed);
+    println!(
+        "identifiable: {} at these random configurations and the nominal, condition number of the column-scaled Jacobian {:.1}",
+        report.identifiable.len(),
+        report.condition_number
+    );
+    println!("  {}", report.identifiable.join(", "));
+    print_excluded(report);
+    Ok(())
+}
+
+fn print_rank(report: &armcal::model::identifiability::Identifiability, seed: u64) {
+    println!(
+        "numerical analysis over {} random configurations (seed {}): {} candidate parameters, rank {} (SVD), {} (pivoted QR)",
+        report.poses, seed, report.candidates.len(), report.rank_svd, report.rank_qr
+    );
+}
+
+fn print_excluded(report: &armcal::model::identifiability::Identifiability) {
+    if !report.excluded.is_empty() {
+        println!("not identifiable ({}):", report.excluded.len());
+        for e in &report.excluded {
+            println!("  - {}", e.reason);
+        }
+    }
+    if !report.fixed.is_empty() {
+        println!(
+            "fixed by the cell ({}): {}",
+            report.fixed.len(),
+            report.fixed.join(", ")
+        );
+    }
+}
+
+fn print_joints(joints: &[armcal::model::Joint]) {
+    println!("\njoints:");
+    for j in joints {
+        let f = j.kind.unit().display_factor();
+        println!(
+            "  {:<6} {} [{:.2}, {:.2}] {}",
+            j.name,
+            match j.kind {
+                armcal::model::JointKind::Revolute => "revolute",
+                armcal::model::JointKind::Prismatic => "prismatic",
+            },
+            j.lower * f,
+            j.upper * f,
+            j.kind.unit().display_name()
+        );
+    }
+}
+
+fn print_parameters(
+    registry: &armcal::model::Registry,
+    report: &armcal::model::identifiability::Identifiability,
+) {
     println!(
         "{:<4} {:<14} {:>14} {:<4} status",
         "#", "parameter", "nominal", "unit"
     );
-    for (i, p) in model.registry.iter().enumerate() {
+    for (i, p) in registry.iter().enumerate() {
         let status = match p.status {
             Status::Free => "free".to_string(),
             Status::Fixed if report.excluded.iter().any(|e| e.name == p.name) => {
@@ -107,64 +269,4 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
             p.unit.display_name()
         );
     }
-    println!("\njoints:");
-    for j in &model.joints {
-        let f = j.kind.unit().display_factor();
-        println!(
-            "  {:<6} {} [{:.2}, {:.2}] {}",
-            j.name,
-            match j.kind {
-                armcal::model::JointKind::Revolute => "revolute",
-                armcal::model::JointKind::Prismatic => "prismatic",
-            },
-            j.lower * f,
-            j.upper * f,
-            j.kind.unit().display_name()
-        );
-    }
-    let c = &report.completeness;
-    println!(
-        "\ncompleteness (book §2.3): {} revolute, {} prismatic joints → complete pose model 4R + 2P + 6 = {}",
-        c.revolute, c.prismatic, c.complete_pose_model
-    );
-    match c.expected_for_measurement {
-        Some(n) => println!(
-            "expected identifiable from {} measurements in generic geometry: {n}",
-            measurement.words()
-        ),
-        None => {
-            println!(
-                "no closed-form count for {} measurements of several targets",
-                measurement.words()
-            )
-        }
-    }
-    println!(
-        "numerical analysis over {} random configurations (seed {}): {} candidate parameters, rank {} (SVD), {} (pivoted QR)",
-        report.poses, a.seed, report.candidates.len(), report.rank_svd, report.rank_qr
-    );
-    println!(
-        "identifiable: {} at these random configurations and the nominal, condition number of the column-scaled Jacobian {:.1}",
-        report.count(model),
-        report.condition_number
-    );
-    println!("  {}", report.identifiable.join(", "));
-    println!("  (`identify` counts again, by the same rule, at the data's configurations and at the fit: data that move some joints little, or terms they cannot separate, give fewer, and it says why)");
-    if let Some(d) = &deficit {
-        println!("below the generic count: {d}");
-    }
-    if !report.excluded.is_empty() {
-        println!("not identifiable ({}):", report.excluded.len());
-        for e in &report.excluded {
-            println!("  - {}", e.reason);
-        }
-    }
-    if !report.fixed.is_empty() {
-        println!(
-            "fixed by the cell ({}): {}",
-            report.fixed.len(),
-            report.fixed.join(", ")
-        );
-    }
-    Ok(())
 }

@@ -439,7 +439,64 @@ pub fn analyze_at(
     // configurations at a time: memory and time stay flat in the number of configurations.
     let (factor, m) = stacked_factor(model, params, qs, opts, &candidates);
     let name = |i: usize| model.registry.get(i).name.clone();
+    let names: Vec<String> = candidates.iter().map(|&i| name(i)).collect();
+    let s = select(factor, m, &names, opts.measurement, opts.tolerance);
+    let mut identifiable: Vec<(usize, f64)> =
+        s.kept.iter().map(|&(k, v)| (candidates[k], v)).collect();
+    identifiable.sort_by_key(|&(i, _)| i);
+    let (rv, pr) = joint_counts(model);
+    Ok(Identifiability {
+        measurement: opts.measurement,
+        poses: qs.len(),
+        completeness: Completeness {
+            revolute: rv,
+            prismatic: pr,
+            complete_pose_model: 4 * rv + 2 * pr + 6,
+            expected_for_measurement: expected_count(model, opts.measurement),
+        },
+        candidates: {
+            let mut c = candidates.clone();
+            c.sort();
+            c.into_iter().map(name).collect()
+        },
+        fixed,
+        rank_svd: s.rank_svd,
+        rank_qr: s.rank_qr,
+        singular_values: s.singular_values,
+        variance_inflation: identifiable.iter().map(|&(_, v)| v).collect(),
+        identifiable: identifiable.into_iter().map(|(i, _)| name(i)).collect(),
+        condition_number: s.condition_number,
+        excluded: s.excluded,
+    })
+}
 
+/// What the analysis of a stacked factor finds, by position in the candidate list (shared by
+/// serial models and trees, [`crate::model::tree::identifiability`]).
+pub(crate) struct Selection {
+    /// Rank by SVD of the column-normalised factor.
+    pub rank_svd: usize,
+    /// Rank by QR with column pivoting.
+    pub rank_qr: usize,
+    /// Singular values, descending.
+    pub singular_values: Vec<f64>,
+    /// Kept candidates (position in the candidate list) with their variance inflation.
+    pub kept: Vec<(usize, f64)>,
+    /// Condition number of the kept columns.
+    pub condition_number: f64,
+    /// The candidates left out, with the reason.
+    pub excluded: Vec<Exclusion>,
+}
+
+/// The rank, the greedy minimal set (candidates in preference order, `names`), the
+/// explanation of every left-out candidate and the variance inflation of every kept one,
+/// from the triangular factor of the stacked Jacobian (`m` rows stacked).
+pub(crate) fn select(
+    factor: DMatrix<f64>,
+    m: usize,
+    names: &[String],
+    measurement: Measurement,
+    tolerance: f64,
+) -> Selection {
     // Column scaling to unit norm; zero columns stay zero.
     let norms: Vec<f64> = (0..factor.ncols())
         .map(|c| factor.column(c).norm())
@@ -458,13 +515,13 @@ pub fn analyze_at(
     let smax = sv.first().copied().unwrap_or(0.0);
     let rank_svd = sv
         .iter()
-        .filter(|&&s| s > opts.tolerance * smax.max(1e-300))
+        .filter(|&&s| s > tolerance * smax.max(1e-300))
         .count();
     let rank_qr = if scaled.ncols() > 0 && m > 0 {
         let r = scaled.clone().col_piv_qr().r();
         let d0 = r[(0, 0)].abs();
         (0..m.min(r.ncols()))
-            .filter(|&i| r[(i, i)].abs() > opts.tolerance * d0.max(1e-300))
+            .filter(|&i| r[(i, i)].abs() > tolerance * d0.max(1e-300))
             .count()
     } else {
         0
@@ -487,7 +544,7 @@ pub fn analyze_at(
             }
         }
         let n = v.norm();
-        if n > opts.tolerance.sqrt() {
+        if n > tolerance.sqrt() {
             basis.push(v / n);
             kept.push(c);
         } else {
@@ -507,12 +564,12 @@ pub fn analyze_at(
     let vif_by_kept = variance_inflation(&r);
     let mut excluded = Vec::new();
     for &c in &dropped {
-        let pname = name(candidates[c]);
+        let pname = names[c].clone();
         if norms[c] <= 1e-12 * max_norm.max(1e-300) {
             excluded.push(Exclusion {
                 reason: format!(
                     "`{pname}` has no effect on the {} measurement",
-                    measurement_name(opts.measurement)
+                    measurement_name(measurement)
                 ),
                 name: pname,
                 partners: Vec::new(),
@@ -527,7 +584,7 @@ pub fn analyze_at(
             .iter()
             .enumerate()
             .filter(|(_, x)| x.abs() > 1e-6)
-            .map(|(k, &x)| (name(candidates[kept[k]]), x))
+            .map(|(k, &x)| (names[kept[k]].clone(), x))
             .collect();
         partners.sort_by(|a, b| {
             b.1.abs()
@@ -549,13 +606,13 @@ pub fn analyze_at(
         let reason = if shown.is_empty() {
             format!(
                 "`{pname}` cannot be separated from the other parameters numerically: its effect on the {} measurement is lost in rounding",
-                measurement_name(opts.measurement)
+                measurement_name(measurement)
             )
         } else {
             format!(
                 "`{pname}` cannot be separated from {}{more}: its effect on the {} measurement is a combination of theirs",
                 shown.join(", "),
-                measurement_name(opts.measurement)
+                measurement_name(measurement)
             )
         };
         excluded.push(Exclusion {
@@ -564,36 +621,14 @@ pub fn analyze_at(
             partners,
         });
     }
-    let mut identifiable: Vec<(usize, f64)> = kept
-        .iter()
-        .zip(&vif_by_kept)
-        .map(|(&k, &v)| (candidates[k], v))
-        .collect();
-    identifiable.sort_by_key(|&(i, _)| i);
-    let (rv, pr) = joint_counts(model);
-    Ok(Identifiability {
-        measurement: opts.measurement,
-        poses: qs.len(),
-        completeness: Completeness {
-            revolute: rv,
-            prismatic: pr,
-            complete_pose_model: 4 * rv + 2 * pr + 6,
-            expected_for_measurement: expected_count(model, opts.measurement),
-        },
-        candidates: {
-            let mut c = candidates.clone();
-            c.sort();
-            c.into_iter().map(name).collect()
-        },
-        fixed,
+    Selection {
         rank_svd,
         rank_qr,
         singular_values: sv,
-        variance_inflation: identifiable.iter().map(|&(_, v)| v).collect(),
-        identifiable: identifiable.into_iter().map(|(i, _)| name(i)).collect(),
+        kept: kept.into_iter().zip(vif_by_kept).collect(),
         condition_number,
         excluded,
-    })
+    }
 }
 
 /// The variance inflation of every column of a matrix with unit-norm columns from the

@@ -24,6 +24,7 @@ pub(crate) mod registry;
 pub mod sampling;
 pub(crate) mod station;
 pub mod tcp_shift;
+pub mod tree;
 pub mod ur_kinematics;
 pub mod urdf;
 

@@ -13,6 +13,7 @@ mod model {
     mod fixed_kinematics;
     mod identifiability;
     mod robots;
+    mod tree;
 }
 mod identify {
     mod compliance;

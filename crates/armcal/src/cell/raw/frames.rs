@@ -21,8 +21,11 @@ pub(super) fn base_and_tool(
 }
 
 /// `[[targets]]`: a point (`xyz_mm`) or, with `rpy`, a frame; named `smr1`, `smr2`, … by
-/// default.
-pub(super) fn targets(ctx: &Ctx, tables: &[Spanned<toml::Table>]) -> Result<Vec<LinkSpec>, Error> {
+/// default; with the `link` it hangs from, if it names one (a tree cell's, `raw/tree.rs`).
+pub(super) fn targets(
+    ctx: &Ctx,
+    tables: &[Spanned<toml::Table>],
+) -> Result<Vec<(LinkSpec, Option<String>)>, Error> {
     let mut targets = Vec::new();
     let mut seen = Vec::new();
     for (i, t) in tables.iter().enumerate() {
@@ -36,21 +39,27 @@ pub(super) fn targets(ctx: &Ctx, tables: &[Spanned<toml::Table>]) -> Result<Vec<
             .map_err(|e| ctx.err(t.span(), &field, e))?;
         let is_frame = tt.keys().any(|k| k.starts_with("rpy"));
         let geometry = if is_frame {
-            frame(tt, &["name"]).map_err(|e| ctx.err(t.span(), &field, e))?
+            frame(tt, &["name", "link"]).map_err(|e| ctx.err(t.span(), &field, e))?
         } else {
-            let mut used = vec!["name".to_string()];
+            let mut used = vec!["name".to_string(), "link".to_string()];
             let valid = [unit_spellings("xyz", Unit::Mm)];
             let xyz = unit_triple(tt, "xyz", Unit::Mm, &mut used)
-                .and_then(|v| v.ok_or_else(|| missing(tt, &["name"], &valid, "missing `xyz_mm`")))
+                .and_then(|v| {
+                    v.ok_or_else(|| missing(tt, &["name", "link"], &valid, "missing `xyz_mm`"))
+                })
                 .map_err(|e| ctx.err(t.span(), &field, e))?;
             check_unused(tt, &used, &[], &valid).map_err(|e| ctx.err(t.span(), &field, e))?;
             LinkGeometry::point(xyz)
         };
-        targets.push(LinkSpec {
+        let link = string_field(tt, "link")
+            .map_err(|e| ctx.err(t.span(), &format!("{field}.link"), e))?
+            .map(str::to_string);
+        let target = LinkSpec {
             name,
             geometry,
             joint: None,
-        });
+        };
+        targets.push((target, link));
     }
     Ok(targets)
 }

@@ -22,6 +22,7 @@ mod obstacles;
 mod parameters;
 mod payloads;
 mod robot;
+mod tree;
 mod working;
 
 #[derive(Deserialize)]
@@ -149,6 +150,8 @@ impl Ctx<'_> {
     }
 }
 
+pub(super) use tree::parse_tree;
+
 /// Parses a cell file section by section (in the order errors are reported).
 pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
     let ctx = Ctx { file, text };
@@ -158,12 +161,23 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
     })?;
     let rspan = raw.robot.span();
     let rr = raw.robot.into_inner();
+    if let Some((span, field)) = tree::tree_field(&rr.links, &raw.targets) {
+        return Err(ctx.err(
+            span,
+            &field,
+            "this cell describes a kinematic tree (or a coupled joint): `armcal model` \
+             analyses it; the other commands take a serial chain for now (issue 32)",
+        ));
+    }
 
     let (mut robot, shapes) = robot::robot(&ctx, &rr, rspan.clone(), dir)?;
     let (instrument, instrument_geometry, instrument_name) =
         instrument::instrument(&ctx, raw.instrument)?;
     let (base, tool) = frames::base_and_tool(&ctx, &raw.base, &raw.tool)?;
-    let targets = frames::targets(&ctx, &raw.targets)?;
+    let targets = frames::targets(&ctx, &raw.targets)?
+        .into_iter()
+        .map(|(t, _)| t)
+        .collect();
     let spec = assemble_spec(
         &robot,
         instrument_geometry,

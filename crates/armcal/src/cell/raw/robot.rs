@@ -329,7 +329,7 @@ fn limit_order(j: &Joint) -> Result<(), String> {
 
 /// Every value of `links` within the range a model holds
 /// ([`crate::model::LinkSpec::check_values`]), after unit conversion; the error is at `field`.
-fn check_values(
+pub(super) fn check_values(
     ctx: &Ctx,
     links: &[crate::model::LinkSpec],
     span: Range<usize>,
@@ -378,7 +378,7 @@ pub(super) fn tool_capsules(
 /// optional `joint = "revolute" | "prismatic" | "fixed"` (default fixed; `limits` without
 /// `joint` is an error), `limits = [lo, hi]` (deg or mm),
 /// `axis = [x, y, z]` for URDF-convention links.
-fn inline_link(
+pub(super) fn inline_link(
     t: &toml::Table,
     default_name: String,
     joint_index: usize,
@@ -431,6 +431,9 @@ fn inline_link(
         "limits",
         "axis",
         "joint_name",
+        // a tree cell's (raw/tree.rs; a serial cell refuses them first)
+        "parent",
+        "coupled",
     ];
     let mut used = Vec::new();
     let mut values = Vec::new();
