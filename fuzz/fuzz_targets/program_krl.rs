@@ -5,7 +5,7 @@ libfuzzer_sys::fuzz_target!(|data: &[u8]| {
     if let Ok(text) = std::str::from_utf8(data) {
         armcal_fuzz::controller_program(
             text,
-            armcal::compensate::controller_program::Language::Krl,
+            armcal::ProgramLanguage::Krl,
         );
     }
 });

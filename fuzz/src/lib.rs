@@ -357,8 +357,8 @@ fn drift_check(e: &armcal::identify::Estimate) {
 /// The built-in cells a fuzzed controller program is filtered for: the robot each language's
 /// samples are written for (KUKA KR 15 for KRL, ABB IRB 120 for RAPID, UR10 for UR script),
 /// with a calibration that differs from the nominal model so every target is solved.
-fn program_cell(language: armcal::compensate::controller_program::Language) -> &'static (Cell, Vec<f64>) {
-    use armcal::compensate::controller_program::Language;
+fn program_cell(language: armcal::ProgramLanguage) -> &'static (Cell, Vec<f64>) {
+    use armcal::ProgramLanguage as Language;
     static CELLS: OnceLock<[(Cell, Vec<f64>); 3]> = OnceLock::new();
     let cells = CELLS.get_or_init(|| {
         ["kr15", "irb120", "ur10"].map(|name| {
@@ -383,8 +383,8 @@ fn program_cell(language: armcal::compensate::controller_program::Language) -> &
 /// A controller program through `armcal compensate --program`: read, every target
 /// compensated (as joints with `to_joints` on odd lengths), written back; the output is read
 /// again and must have as many motion targets as the input.
-pub fn controller_program(text: &str, language: armcal::compensate::controller_program::Language) {
-    use armcal::compensate::controller_program::ProgramSettings;
+pub fn controller_program(text: &str, language: armcal::ProgramLanguage) {
+    use armcal::ProgramSettings;
     let (cell, calibrated) = program_cell(language);
     let settings = ProgramSettings {
         language,

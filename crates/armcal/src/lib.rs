@@ -97,7 +97,7 @@ pub use error::{Error, Result};
 pub use cell::Cell;
 pub use model::Model;
 // Kinematic trees and coupled joints (analysis only, for now).
-pub use cell::tree::{analyze_tree_file, TreeAnalysis, TreeCell};
+pub use cell::tree::{analyze_tree_file, describes_tree, TreeAnalysis, TreeCell};
 // Kinematics over many configurations.
 pub use model::kinematics::fk;
 // Measurements: from arrays, from several stations, simulated, predicted.
@@ -114,7 +114,10 @@ pub use design::{Criterion, DesignRecord};
 pub use compensate::program::{compensate, CompensatedRow, Program};
 pub use compensate::{calibrated_ik, IkResult, IkSettings, IkStatus, IkTarget};
 // Robot programs in the controllers' languages (KRL, RAPID, UR script).
-pub use compensate::controller_program::filter_controller_program;
+pub use compensate::controller_program::{
+    filter_controller_program, FilteredControllerProgram, Language as ProgramLanguage,
+    ProgramSettings, TargetOutcome,
+};
 // Accuracy (ISO 9283 before and after calibration).
 pub use performance::{performance, Calibrated, PerformanceRecord, PerformanceSettings};
 // The adaptive campaign and the drift check.

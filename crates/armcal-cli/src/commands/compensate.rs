@@ -5,7 +5,7 @@
 use super::output::{
     load_cell, load_data, warn_outside_fitted_ranges, with_note, Calibration, NoteStyle, Outputs,
 };
-use armcal::compensate::controller_program::{Language, ProgramSettings};
+use armcal::{ProgramLanguage as Language, ProgramSettings};
 use armcal::compensate::joint_change::JointChangeLimit;
 use armcal::compensate::nonparametric::{CorrectionInputs, ResidualCorrection};
 use armcal::compensate::program::{compensate_program, ProgramFile};

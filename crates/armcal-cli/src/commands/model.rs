@@ -34,7 +34,7 @@ pub struct Args {
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let path = std::path::Path::new(&a.target);
-    if path.is_file() && armcal::cell::tree::describes_tree(path)? {
+    if path.is_file() && armcal::describes_tree(path)? {
         return run_tree(a, path);
     }
     let cell = super::output::load_cell(&a.target)?;

@@ -7,7 +7,7 @@ pub mod builtin;
 pub mod export;
 pub mod model_analysis;
 mod raw;
-pub mod tree;
+pub(crate) mod tree;
 
 pub use crate::measure::NoiseModel;
 use crate::model::complete::{self, FormChange, Formed, LinkForm};

@@ -3,7 +3,7 @@
 
 pub mod closed_form;
 pub mod cmac;
-pub mod controller_program;
+pub(crate) mod controller_program;
 pub(crate) mod damped_step;
 pub mod ik;
 pub mod joint_change;

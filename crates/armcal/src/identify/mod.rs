@@ -5,7 +5,7 @@
 
 pub mod circle_point;
 pub(crate) mod estimate;
-pub mod export;
+pub(crate) mod export;
 pub(crate) mod fingerprint;
 pub mod fit_checks;
 pub mod fitted_ranges;

@@ -356,7 +356,7 @@ fn dual_arm_cell(extra: &str, left_parent: &str, target_link: &str) -> String {
 
 #[test]
 fn a_tree_cell_loads_as_one_registry_and_identifies_the_tree_count() {
-    use armcal::cell::tree::TreeCell;
+    use armcal::TreeCell;
     let cell = TreeCell::from_toml(&dual_arm_cell("", "t1", "l3"), "dual.toml").unwrap();
     let tree = &cell.tree;
     assert_eq!(tree.branches.len(), 2);
@@ -413,7 +413,7 @@ fn a_tree_cell_loads_as_one_registry_and_identifies_the_tree_count() {
 
 #[test]
 fn a_malformed_tree_cell_says_file_line_and_field() {
-    use armcal::cell::tree::TreeCell;
+    use armcal::TreeCell;
     let err = |text: String| {
         TreeCell::from_toml(&text, "dual.toml")
             .unwrap_err()
