@@ -5,11 +5,12 @@
 use super::output::{
     load_cell, load_data, warn_outside_fitted_ranges, with_note, Calibration, NoteStyle, Outputs,
 };
-use armcal::{ProgramLanguage as Language, ProgramSettings};
 use armcal::compensate::joint_change::JointChangeLimit;
 use armcal::compensate::nonparametric::{CorrectionInputs, ResidualCorrection};
 use armcal::compensate::program::{compensate_program, ProgramFile};
 use armcal::compensate::IkSettings;
+use armcal::input::{read_capped, DATA_CAP, TEXT_CAP};
+use armcal::{ProgramLanguage as Language, ProgramSettings};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -104,7 +105,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let calibrated = est.params_for(model)?;
     let (payload, payload_how) = est.payload_for(model, a.payload.as_deref())?;
     let program = ProgramFile::read(
-        armcal::input::read_capped(targets, armcal::input::DATA_CAP)?,
+        read_capped(targets, DATA_CAP)?,
         &targets.display().to_string(),
         model,
     )?;
@@ -207,7 +208,7 @@ fn run_program(a: &Args, path: &Path, limit: JointChangeLimit) -> anyhow::Result
     }
     let calibrated = est.params_for(model)?;
     let (payload, payload_how) = est.payload_for(model, a.payload.as_deref())?;
-    let text = armcal::input::read_capped(path, armcal::input::TEXT_CAP)?;
+    let text = read_capped(path, TEXT_CAP)?;
     let filtered = armcal::filter_controller_program(
         model,
         &calibrated,

@@ -7,8 +7,8 @@
 use super::digits::fixed;
 use armcal::cell::model_analysis::{analyze_model, ModelRecord};
 use armcal::model::complete::LinkForm;
-use armcal::model::identifiability::{IdentifiabilitySettings, Measurement};
-use armcal::model::Status;
+use armcal::model::identifiability::{Identifiability, IdentifiabilitySettings, Measurement};
+use armcal::model::{Joint, JointKind, Registry, Status};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -199,14 +199,14 @@ fn run_tree(a: &Args, path: &std::path::Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn print_rank(report: &armcal::model::identifiability::Identifiability, seed: u64) {
+fn print_rank(report: &Identifiability, seed: u64) {
     println!(
         "numerical analysis over {} random configurations (seed {}): {} candidate parameters, rank {} (SVD), {} (pivoted QR)",
         report.poses, seed, report.candidates.len(), report.rank_svd, report.rank_qr
     );
 }
 
-fn print_excluded(report: &armcal::model::identifiability::Identifiability) {
+fn print_excluded(report: &Identifiability) {
     if !report.excluded.is_empty() {
         println!("not identifiable ({}):", report.excluded.len());
         for e in &report.excluded {
@@ -222,7 +222,7 @@ fn print_excluded(report: &armcal::model::identifiability::Identifiability) {
     }
 }
 
-fn print_joints(joints: &[armcal::model::Joint]) {
+fn print_joints(joints: &[Joint]) {
     println!("\njoints:");
     for j in joints {
         let f = j.kind.unit().display_factor();
@@ -230,8 +230,8 @@ fn print_joints(joints: &[armcal::model::Joint]) {
             "  {:<6} {} [{:.2}, {:.2}] {}",
             j.name,
             match j.kind {
-                armcal::model::JointKind::Revolute => "revolute",
-                armcal::model::JointKind::Prismatic => "prismatic",
+                JointKind::Revolute => "revolute",
+                JointKind::Prismatic => "prismatic",
             },
             j.lower * f,
             j.upper * f,
@@ -240,10 +240,7 @@ fn print_joints(joints: &[armcal::model::Joint]) {
     }
 }
 
-fn print_parameters(
-    registry: &armcal::model::Registry,
-    report: &armcal::model::identifiability::Identifiability,
-) {
+fn print_parameters(registry: &Registry, report: &Identifiability) {
     println!(
         "{:<4} {:<14} {:>14} {:<4} status",
         "#", "parameter", "nominal", "unit"
