@@ -95,6 +95,7 @@ pub use error::{Error, Result};
 
 // A cell and its model.
 pub use cell::Cell;
+pub use model::registry::ParameterStatus;
 pub use model::Model;
 // Kinematic trees and coupled joints (analysis only, for now).
 pub use cell::tree::{analyze_tree_file, describes_tree, TreeAnalysis, TreeCell};

@@ -8,7 +8,8 @@ use super::digits::fixed;
 use armcal::cell::model_analysis::{analyze_model, ModelRecord};
 use armcal::model::complete::LinkForm;
 use armcal::model::identifiability::{Identifiability, IdentifiabilitySettings, Measurement};
-use armcal::model::{Joint, JointKind, Registry, Status};
+use armcal::model::{Joint, JointKind, Registry};
+use armcal::ParameterStatus;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -170,7 +171,7 @@ fn run_tree(a: &Args, path: &std::path::Path) -> anyhow::Result<()> {
     let mut registry = tree.registry.clone();
     for e in &report.excluded {
         if let Some(i) = registry.index_of(&e.name) {
-            registry.set_status(i, Status::Fixed);
+            registry.set_status(i, ParameterStatus::Fixed);
         }
     }
     print_parameters(&registry, report);
@@ -247,12 +248,12 @@ fn print_parameters(registry: &Registry, report: &Identifiability) {
     );
     for (i, p) in registry.iter().enumerate() {
         let status = match p.status {
-            Status::Free => "free".to_string(),
-            Status::Fixed if report.excluded.iter().any(|e| e.name == p.name) => {
+            ParameterStatus::Free => "free".to_string(),
+            ParameterStatus::Fixed if report.excluded.iter().any(|e| e.name == p.name) => {
                 "fixed (not identifiable, see below)".to_string()
             }
-            Status::Fixed => "fixed".to_string(),
-            Status::Prior { sigma } => format!(
+            ParameterStatus::Fixed => "fixed".to_string(),
+            ParameterStatus::Prior { sigma } => format!(
                 "prior σ = {:.4} {}",
                 sigma * p.unit.display_factor(),
                 p.unit.display_name()

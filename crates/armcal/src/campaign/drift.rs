@@ -26,7 +26,7 @@
 use crate::cell::Cell;
 use crate::identify::{Estimate, Problem};
 use crate::measure::Dataset;
-use crate::model::Status;
+use crate::model::ParameterStatus;
 use crate::Error;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
@@ -174,9 +174,9 @@ pub fn check(
     for i in 0..model.registry.len() {
         let name = model.registry.get(i).name.clone();
         let status = if estimate.free.contains(&name) {
-            Status::Free
+            ParameterStatus::Free
         } else {
-            Status::Fixed
+            ParameterStatus::Fixed
         };
         model.registry.set_status(i, status);
     }

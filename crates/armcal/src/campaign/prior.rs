@@ -16,7 +16,7 @@ use crate::campaign::precision;
 use crate::cell::Cell;
 use crate::identify::Estimate;
 use crate::model::prior::CorrelatedPrior;
-use crate::model::Status;
+use crate::model::ParameterStatus;
 use crate::Error;
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
@@ -102,11 +102,11 @@ impl CampaignPrior {
         }
         for (i, &v) in self.params.iter().enumerate() {
             registry.set_nominal(i, v);
-            registry.set_status(i, Status::Fixed);
+            registry.set_status(i, ParameterStatus::Fixed);
         }
         for name in &self.free {
             let i = registry.require(name)?;
-            registry.set_status(i, Status::Free);
+            registry.set_status(i, ParameterStatus::Free);
         }
         registry.set_correlated_prior(Some(self.prior.clone()))?;
         at.auto_free = false;

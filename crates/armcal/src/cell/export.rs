@@ -9,7 +9,7 @@
 use super::{Cell, NoiseModel, Obstacle};
 use crate::model::complete::LinkForm;
 use crate::model::export::{self as model_export, to_cell_toml_with, CellSections};
-use crate::model::{urdf, Model, ModelSpec, Status};
+use crate::model::{urdf, Model, ModelSpec, ParameterStatus};
 use crate::robots::transfer_capsules;
 use crate::toml_text;
 use crate::Error;
@@ -155,14 +155,14 @@ fn parameters(cell: &Cell, exported: &Model) -> String {
             continue;
         }
         match p.status {
-            Status::Fixed => fixed.push(toml_text::string(&p.name)),
-            Status::Prior { sigma } => priors.push(format!(
+            ParameterStatus::Fixed => fixed.push(toml_text::string(&p.name)),
+            ParameterStatus::Prior { sigma } => priors.push(format!(
                 "{} = {{ sigma{} = {:?} }}",
                 toml_text::string(&p.name),
                 model_export::suffix(p.unit),
                 sigma * p.unit.display_factor()
             )),
-            Status::Free => {}
+            ParameterStatus::Free => {}
         }
     }
     let free = if cell.auto_free { "auto" } else { "all" };

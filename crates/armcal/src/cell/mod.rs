@@ -13,7 +13,7 @@ pub use crate::measure::NoiseModel;
 use crate::model::complete::{self, FormChange, Formed, LinkForm};
 use crate::model::identifiability::{self, IdentifiabilitySettings, Measurement};
 use crate::model::rank_deficit::{rank_deficit, RankDeficit};
-use crate::model::{LinkGeometry, LinkSpec, Model, ModelSpec, Status};
+use crate::model::{LinkGeometry, LinkSpec, Model, ModelSpec, ParameterStatus};
 use crate::robots::{self, Capsule, Robot};
 use crate::Error;
 use serde::{Deserialize, Serialize};
@@ -442,7 +442,7 @@ impl Cell {
         let mut declared = self.model.clone();
         for &i in &self.declared_free {
             if !declared.registry.get(i).status.is_free() {
-                declared.registry.set_status(i, Status::Free);
+                declared.registry.set_status(i, ParameterStatus::Free);
             }
         }
         declared
@@ -537,13 +537,13 @@ pub(crate) fn apply_statuses(
     priors: &[(String, f64)],
 ) -> Result<(), Error> {
     for p in fixed {
-        model.set_status(p, Status::Fixed)?;
+        model.set_status(p, ParameterStatus::Fixed)?;
     }
     for p in free {
-        model.set_status(p, Status::Free)?;
+        model.set_status(p, ParameterStatus::Free)?;
     }
     for (p, sigma) in priors {
-        model.set_status(p, Status::Prior { sigma: *sigma })?;
+        model.set_status(p, ParameterStatus::Prior { sigma: *sigma })?;
     }
     Ok(())
 }

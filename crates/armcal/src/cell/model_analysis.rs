@@ -16,7 +16,7 @@ use super::Cell;
 use crate::model::complete::{in_form, FormChange, LinkForm};
 use crate::model::identifiability::{self, Identifiability, IdentifiabilitySettings};
 use crate::model::rank_deficit::{rank_deficit, RankDeficit};
-use crate::model::{Joint, Model, Segment, Status};
+use crate::model::{Joint, Model, ParameterStatus, Segment};
 use crate::Error;
 use serde::Serialize;
 
@@ -42,16 +42,16 @@ pub fn converted(cell: &Cell, form: LinkForm) -> Result<Model, Error> {
     for i in 0..model.param_count() {
         let p = model.registry.get(i);
         let status = match p.segment {
-            Segment::Chain => Status::Free,
+            Segment::Chain => ParameterStatus::Free,
             Segment::Instrument | Segment::Target(_) => {
                 let k = original.registry.require(&p.name)?;
                 if cell.declared_free.contains(&k) {
                     match original.registry.get(k).status {
-                        Status::Prior { sigma } => Status::Prior { sigma },
-                        _ => Status::Free,
+                        ParameterStatus::Prior { sigma } => ParameterStatus::Prior { sigma },
+                        _ => ParameterStatus::Free,
                     }
                 } else {
-                    Status::Fixed
+                    ParameterStatus::Fixed
                 }
             }
         };
@@ -107,7 +107,7 @@ pub struct ParameterRecord {
     /// Its nominal value in that unit.
     pub nominal: f64,
     /// Free, fixed or with a prior.
-    pub status: Status,
+    pub status: ParameterStatus,
 }
 
 /// What `armcal model --json` prints.

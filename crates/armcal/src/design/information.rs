@@ -66,7 +66,9 @@ impl DesignModel {
         // A planned pose carries no payload: the payload terms are not designed for (measure
         // the plan with and without the payload to identify them).
         for (i, _) in crate::identify::payload_terms(&cell.model) {
-            model.registry.set_status(i, crate::model::Status::Fixed);
+            model
+                .registry
+                .set_status(i, crate::model::ParameterStatus::Fixed);
         }
         let params = model.nominal();
         let free = model.registry.free();

@@ -7,7 +7,7 @@ use super::{
 };
 use crate::measure::Dataset;
 use crate::model::identifiability::IdentifiabilitySettings;
-use crate::model::{Model, Segment, Status as ParamStatus};
+use crate::model::{Model, ParameterStatus, Segment};
 use crate::progress::Silent;
 use crate::Error;
 
@@ -54,7 +54,7 @@ pub fn frames_first_start(
     let mut rest = fit.model;
     for &i in &held {
         start[i] = nominal[i];
-        rest.registry.set_status(i, ParamStatus::Fixed);
+        rest.registry.set_status(i, ParameterStatus::Fixed);
     }
     let mut problem = Problem::new(&rest, data, noise)?;
     if problem.free.is_empty() {
@@ -208,7 +208,7 @@ pub fn frames_only(model: &Model) -> Model {
     let mut m = model.clone();
     for i in 0..m.param_count() {
         if m.registry.get(i).status.is_free() && !is_frame_parameter(&m, i) {
-            m.registry.set_status(i, ParamStatus::Fixed);
+            m.registry.set_status(i, ParameterStatus::Fixed);
         }
     }
     m

@@ -54,7 +54,7 @@ pub(super) fn fit_free_set(
             let reasons = dropped
                 .iter()
                 .map(|(i, why)| {
-                    model.registry.set_status(*i, ParamStatus::Fixed);
+                    model.registry.set_status(*i, ParameterStatus::Fixed);
                     (model.registry.get(*i).name.clone(), why.clone())
                 })
                 .collect();

@@ -13,9 +13,10 @@
 
 use super::problem::Problem;
 use super::solver::{
-    gradient_cosine, no_decrease_status, Iterate, SolverResult, Status, ToleranceSettings,
+    gradient_cosine, no_decrease_status, Iterate, SolverResult, ToleranceSettings,
 };
 use crate::progress::Observer;
+use crate::solve::Status;
 use crate::Error;
 use nalgebra::DVector;
 use std::time::Instant;

@@ -20,9 +20,10 @@
 //! changed by more than 10⁻⁷ of its posterior standard deviation.
 
 use super::problem::Problem;
-use super::solver::{Iterate, SolverResult, Status, ToleranceSettings};
+use super::solver::{Iterate, SolverResult, ToleranceSettings};
 use crate::model::Unit;
 use crate::progress::Observer;
+use crate::solve::Status;
 use crate::Error;
 use nalgebra::{DMatrix, DVector};
 use std::time::Instant;

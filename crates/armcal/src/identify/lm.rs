@@ -40,9 +40,10 @@
 
 use super::problem::Problem;
 use super::solver::{
-    gradient_cosine, no_decrease_status, Iterate, SolverResult, Status, ToleranceSettings,
+    gradient_cosine, no_decrease_status, Iterate, SolverResult, ToleranceSettings,
 };
 use crate::progress::Observer;
+use crate::solve::Status;
 use crate::Error;
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use std::time::Instant;

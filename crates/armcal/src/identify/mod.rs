@@ -48,14 +48,14 @@ pub use lm::{levenberg_marquardt, LmSettings};
 pub use problem::Problem;
 pub use refit::{FramesRefit, RefitRecord};
 pub use robust::{robust_fit, Loss, Outlier};
-pub use solver::{SolverResult, Status, ToleranceSettings};
+pub use solver::{SolverResult, ToleranceSettings};
 pub use uncertainty::{Chi2Outcome, Observability, ParameterUncertainty, TcpCovariance};
 pub use verdicts::{Chi2Verdict, IdentifiabilityVerdict, Verdicts};
 
 use crate::cell::Cell;
 use crate::measure::{Dataset, MeasurementKind};
 use crate::model::identifiability::{Identifiability, IdentifiabilitySettings, Measurement};
-use crate::model::{Model, Status as ParamStatus};
+use crate::model::{Model, ParameterStatus};
 use crate::progress::Observer;
 use crate::Error;
 use free_set::{fit_free_set, FreeSetFit};
@@ -205,7 +205,7 @@ fn identifiable_model_given(
     }
     let mut declared = cell.declared_model();
     for &(i, _) in dropped {
-        declared.registry.set_status(i, ParamStatus::Fixed);
+        declared.registry.set_status(i, ParameterStatus::Fixed);
     }
     let settings = IdentifiabilitySettings {
         stations: data.config_stations.clone(),

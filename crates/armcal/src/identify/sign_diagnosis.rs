@@ -30,7 +30,7 @@ use super::{
     frames_model, frames_only, levenberg_marquardt, LmSettings, Problem, ToleranceSettings,
 };
 use crate::measure::{Dataset, NoiseModel};
-use crate::model::{JointKind, Model, Status};
+use crate::model::{JointKind, Model, ParameterStatus};
 use crate::progress::Silent;
 use crate::Error;
 use rayon::prelude::*;
@@ -174,7 +174,7 @@ fn quick_model(model: &Model, data: &Dataset) -> Result<Model, Error> {
         };
         quick
             .registry
-            .set_status(l.first_param + field, Status::Free);
+            .set_status(l.first_param + field, ParameterStatus::Free);
     }
     let (quick, _) = frames_model(&quick, data, &quick.nominal())?;
     Ok(quick)

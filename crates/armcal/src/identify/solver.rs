@@ -1,7 +1,7 @@
 //! What every identification solver reports ([`SolverResult`], with the shared
 //! [`crate::solve::Status`]) and the stopping rules they share.
 
-pub use crate::solve::Status;
+use crate::solve::Status;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 use std::time::Duration;

@@ -4,11 +4,11 @@
 //! consumers of an estimate refuse one whose fit did not converge
 //! ([`super::Estimate::check_usable`]).
 
-use super::solver::Status;
 use super::uncertainty::{Chi2Outcome, ParameterUncertainty};
 use crate::model::identifiability::{expected_count, Measurement};
 use crate::model::rank_deficit::RankDeficit;
 use crate::model::Model;
+use crate::solve::Status;
 use serde::{Deserialize, Serialize};
 
 /// The verdicts an estimate records.

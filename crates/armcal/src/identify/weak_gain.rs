@@ -25,7 +25,7 @@
 use super::DETERMINED_VIF;
 use crate::model::identifiability::{analyze_at, Identifiability, IdentifiabilitySettings};
 use crate::model::rank_deficit::{last_axis_distances, ON_AXIS_MM};
-use crate::model::{Model, Status as ParamStatus};
+use crate::model::{Model, ParameterStatus};
 use crate::Error;
 
 /// The analysis of `model`'s free set at `at` over the configurations `qs`, with every
@@ -56,7 +56,7 @@ pub(super) fn analyze_holding_weak(
             return Ok((report, held));
         };
         let i = model.registry.require(name)?;
-        model.registry.set_status(i, ParamStatus::Fixed);
+        model.registry.set_status(i, ParameterStatus::Fixed);
         held.push((name.clone(), reason(model, at, nominal, name, vif)));
     }
 }

@@ -39,7 +39,7 @@
 
 use crate::model::convert::wrap;
 use crate::model::link::{Convention, JointKind};
-use crate::model::registry::{Status, Unit};
+use crate::model::registry::{ParameterStatus, Unit};
 use crate::model::{Link, Model};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -192,7 +192,7 @@ fn cost(model: &Model, link: &Link, params: &[f64], f: &Form, respect_status: bo
             Unit::Rad => wrap(v - params[i]).abs() > 1e-12,
             _ => (v - params[i]).abs() > 1e-12 * (1.0 + params[i].abs()),
         };
-        if respect_status && changed && !matches!(p.status, Status::Free) {
+        if respect_status && changed && !matches!(p.status, ParameterStatus::Free) {
             return None;
         }
         if p.unit == Unit::Rad {
@@ -301,7 +301,7 @@ fn mapped(model: &Model, params: &[f64], respect_status: bool) -> (Vec<f64>, Vec
         }
     }
     for (i, p) in model.registry.iter().enumerate() {
-        if p.unit == Unit::Rad && (matches!(p.status, Status::Free) || !respect_status) {
+        if p.unit == Unit::Rad && (matches!(p.status, ParameterStatus::Free) || !respect_status) {
             out[i] = p.nominal + wrap(out[i] - p.nominal);
         } else if p.unit == Unit::Rad {
             // A fixed angle keeps its value up to a whole turn.
@@ -334,7 +334,7 @@ pub fn nearest_branch(model: &Model, params: &[f64]) -> NearestBranch {
         let blocking: Vec<&str> = (0..params.len())
             .filter(|&i| {
                 let p = model.registry.get(i);
-                !matches!(p.status, Status::Free)
+                !matches!(p.status, ParameterStatus::Free)
                     && (free_of_status[i] - params[i]).abs() > 1e-12 * (1.0 + params[i].abs())
             })
             .map(|i| model.registry.get(i).name.as_str())
@@ -631,8 +631,8 @@ mod tests {
         assert!((free.params[index(&m, "j3.a")] - truth[index(&m, "j3.a")]).abs() < 1e-9);
         assert_eq!(free.far.len(), 1, "{:?}", free.far);
         assert_eq!(free.far[0].name, "j4.theta");
-        m.registry.set_status(t4, Status::Fixed);
-        m.registry.set_status(t5, Status::Fixed);
+        m.registry.set_status(t4, ParameterStatus::Fixed);
+        m.registry.set_status(t5, ParameterStatus::Fixed);
         let b = nearest_branch(&m, &flipped);
         assert!(
             same(&m, &b.params, &flipped),

@@ -5,7 +5,7 @@
 use crate::model::compliance::{Compliance, ComplianceSpec, Payload};
 use crate::model::link::{Convention, Joint, JointKind, LinkGeometry, Motion};
 use crate::model::periodic::{CompiledPeriodic, PeriodicSpec};
-use crate::model::registry::{Registry, Segment, Status, Unit};
+use crate::model::registry::{ParameterStatus, Registry, Segment, Unit};
 use crate::Error;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -515,7 +515,7 @@ impl Model {
     }
 
     /// Sets the status of every parameter matching `pattern` (see [`Registry::matching`]).
-    pub fn set_status(&mut self, pattern: &str, status: Status) -> Result<(), Error> {
+    pub fn set_status(&mut self, pattern: &str, status: ParameterStatus) -> Result<(), Error> {
         for i in self.registry.matching(pattern)? {
             self.registry.set_status(i, status);
         }

@@ -24,7 +24,7 @@ use crate::model::chain::Model;
 use crate::model::jacobian::{identification_jacobian, Observed, Rows};
 use crate::model::kinematics::{forward_kinematics, Data};
 use crate::model::link::JointKind;
-use crate::model::registry::{Segment, Status};
+use crate::model::registry::{ParameterStatus, Segment};
 use crate::model::sampling::random_configurations;
 use crate::Error;
 use nalgebra::{DMatrix, DVector};
@@ -430,7 +430,7 @@ pub fn analyze_at(
     }
     let mut candidates: Vec<usize> = model.registry.free();
     let fixed: Vec<String> = (0..model.param_count())
-        .filter(|&i| model.registry.get(i).status == Status::Fixed)
+        .filter(|&i| model.registry.get(i).status == ParameterStatus::Fixed)
         .map(|i| model.registry.get(i).name.clone())
         .collect();
     candidates.sort_by_key(|&i| preference(model, i));
@@ -656,7 +656,7 @@ impl Identifiability {
     pub fn apply(&self, model: &mut Model) -> Result<(), Error> {
         for e in &self.excluded {
             let i = model.registry.require(&e.name)?;
-            model.registry.set_status(i, Status::Fixed);
+            model.registry.set_status(i, ParameterStatus::Fixed);
         }
         Ok(())
     }

@@ -37,5 +37,6 @@ pub use jacobian_dq_along::{identification_jacobian_dq_along, AlongWorkspace};
 pub use kinematics::{forward_kinematics, tool_pose, Data};
 pub use link::{Convention, Joint, JointKind, LinkGeometry, Motion};
 pub use pose::{Pose, Twist};
-pub use registry::{Parameter, Registry, Segment, Status, Unit};
+pub use registry::{Parameter, Registry, Segment, Unit};
+pub(crate) use registry::ParameterStatus;
 pub use sampling::random_configurations;

@@ -1,5 +1,5 @@
 //! Prior information on a model's parameters, as whitened rows: the per-parameter Gaussian
-//! priors of the cell (`Status::Prior`) and a correlated Gaussian prior over named
+//! priors of the cell (`ParameterStatus::Prior`) and a correlated Gaussian prior over named
 //! parameters — an earlier calibration's estimate and covariance carried into a new fit
 //! (issue 16 item 2: the campaign after a drift check starts from what the robot was).
 //!
@@ -10,7 +10,7 @@
 //! parameters only: a parameter of the prior that a fit holds fixed is marginalised out
 //! (its rows and columns of `C` dropped), and a name the model does not have is ignored.
 
-use crate::model::registry::{Parameter, Registry, Status, Unit};
+use crate::model::registry::{Parameter, ParameterStatus, Registry, Unit};
 use crate::Error;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
@@ -131,7 +131,7 @@ impl FixedPrior {
 /// The prior information of `registry` over the columns `free` (registry indices, the
 /// order of the rows' columns): whitened rows `W` and offsets `W μ` such that the prior adds
 /// `½ ‖W p_free − W μ‖²` to the cost (module notes). First one row `1/σ` per free parameter
-/// with [`Status::Prior`] (not in the correlated prior), then `L⁻¹` of the correlated
+/// with [`ParameterStatus::Prior`] (not in the correlated prior), then `L⁻¹` of the correlated
 /// prior's marginal covariance over its free parameters.
 pub fn prior_rows(
     registry: &Registry,
@@ -143,7 +143,7 @@ pub fn prior_rows(
     let mut rows: Vec<(Vec<(usize, f64)>, f64)> = Vec::new();
     for (column, &i) in free.iter().enumerate() {
         let p = registry.get(i);
-        if let Status::Prior { sigma } = p.status {
+        if let ParameterStatus::Prior { sigma } = p.status {
             if !in_correlated(&p.name) {
                 rows.push((vec![(column, 1.0 / sigma)], p.nominal / sigma));
             }

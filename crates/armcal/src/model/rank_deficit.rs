@@ -18,7 +18,7 @@ use crate::model::convert::axes_at_zero;
 use crate::model::identifiability::{self, expected_count, IdentifiabilitySettings, Measurement};
 use crate::model::kinematics::{forward_kinematics, Data};
 use crate::model::link::JointKind;
-use crate::model::registry::Status;
+use crate::model::registry::ParameterStatus;
 use crate::Error;
 use serde::{Deserialize, Serialize};
 
@@ -196,12 +196,12 @@ pub fn rank_deficit(
 
     // Parameters the cell fixed.
     let fixed: Vec<usize> = (0..model.param_count())
-        .filter(|&i| model.registry.get(i).status == Status::Fixed)
+        .filter(|&i| model.registry.get(i).status == ParameterStatus::Fixed)
         .collect();
     if causes.is_empty() && !fixed.is_empty() {
         let mut all = model.clone();
         for &i in &fixed {
-            all.registry.set_status(i, Status::Free);
+            all.registry.set_status(i, ParameterStatus::Free);
         }
         let unfixed = identifiability::analyze(&all, params, &opts)?;
         if unfixed.count(&all).geometric > identifiable {

@@ -86,7 +86,7 @@ impl Unit {
 /// Whether a parameter is estimated.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase", tag = "status")]
-pub enum Status {
+pub enum ParameterStatus {
     /// Estimated from the data.
     Free,
     /// Held at its nominal value.
@@ -98,10 +98,10 @@ pub enum Status {
     },
 }
 
-impl Status {
-    /// True unless [`Status::Fixed`]: free and prior parameters are both estimated.
+impl ParameterStatus {
+    /// True unless [`ParameterStatus::Fixed`]: free and prior parameters are both estimated.
     pub fn is_free(&self) -> bool {
-        !matches!(self, Status::Fixed)
+        !matches!(self, ParameterStatus::Fixed)
     }
 }
 
@@ -128,7 +128,7 @@ pub struct Parameter {
     /// Nominal value in internal units (mm, rad).
     pub nominal: f64,
     /// Whether the identification estimates it, holds it, or estimates it with a prior.
-    pub status: Status,
+    pub status: ParameterStatus,
     /// Instrument, chain or target: which targets it moves.
     pub segment: Segment,
 }
@@ -177,7 +177,7 @@ impl Registry {
             name,
             unit,
             nominal,
-            status: Status::Free,
+            status: ParameterStatus::Free,
             segment,
         });
         Ok(i)
@@ -264,7 +264,7 @@ impl Registry {
     }
 
     /// Sets whether parameter `i` is free, fixed or has a prior.
-    pub fn set_status(&mut self, i: usize, status: Status) {
+    pub fn set_status(&mut self, i: usize, status: ParameterStatus) {
         self.params[i].status = status;
     }
 

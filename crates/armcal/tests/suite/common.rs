@@ -3,6 +3,7 @@
 
 use armcal::cell::Cell;
 use armcal::model::*;
+use armcal::ParameterStatus;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::Path;
@@ -268,7 +269,7 @@ pub fn unplaced_tracker_paper_cell(frames_only: bool, seed: u64) -> (Cell, Vec<f
     let mut cell = Cell::from_toml(&text, "paper-cell.toml", Path::new(".")).unwrap();
     for i in 0..cell.model.param_count() {
         if frames_only && !armcal::identify::is_frame_parameter(&placed.model, i) {
-            cell.model.registry.set_status(i, Status::Fixed);
+            cell.model.registry.set_status(i, ParameterStatus::Fixed);
         }
     }
     if frames_only {

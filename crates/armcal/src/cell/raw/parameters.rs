@@ -59,11 +59,11 @@ pub(super) fn parameters(
             // An explicit free list: everything else is fixed, but the compliance and periodic
             // terms the section asks for stay free (unless `fixed` names them).
             model
-                .set_status("*", Status::Fixed)
+                .set_status("*", ParameterStatus::Fixed)
                 .expect("every model has parameters");
             let terms: Vec<usize> = model.joint_corrections().map(|(p, _)| p).collect();
             for i in terms {
-                model.registry.set_status(i, Status::Free);
+                model.registry.set_status(i, ParameterStatus::Free);
             }
         }
         apply_statuses(model, &p.fixed, &free, &priors)

@@ -34,7 +34,7 @@ use crate::model::identifiability::{
 };
 use crate::model::jacobian::Rows;
 use crate::model::link::JointKind;
-use crate::model::registry::{Segment, Status};
+use crate::model::registry::{ParameterStatus, Segment};
 use crate::model::sampling::random_joint_values;
 use crate::model::tree::kinematics::{branch_kinematics, tree_identification_jacobian, TreeData};
 use crate::model::tree::Tree;
@@ -228,7 +228,7 @@ pub fn analyze_tree(
         },
         candidates: sorted.into_iter().map(name).collect(),
         fixed: (0..tree.param_count())
-            .filter(|&i| tree.registry.get(i).status == Status::Fixed)
+            .filter(|&i| tree.registry.get(i).status == ParameterStatus::Fixed)
             .map(name)
             .collect(),
         rank_svd: s.rank_svd,

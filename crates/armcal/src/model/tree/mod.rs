@@ -39,7 +39,7 @@
 
 use crate::model::chain::{LinkSpec, Model, ModelSpec};
 use crate::model::link::{Joint, JointKind};
-use crate::model::registry::{Registry, Segment, Status};
+use crate::model::registry::{ParameterStatus, Registry, Segment};
 use crate::Error;
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
@@ -394,7 +394,7 @@ impl Tree {
     }
 
     /// Sets the status of every parameter matching `pattern` ([`Registry::matching`]).
-    pub fn set_status(&mut self, pattern: &str, status: Status) -> Result<(), Error> {
+    pub fn set_status(&mut self, pattern: &str, status: ParameterStatus) -> Result<(), Error> {
         for i in self.registry.matching(pattern)? {
             self.registry.set_status(i, status);
         }

@@ -2,7 +2,7 @@
 //! PUMA 560 models built from them, and Table 6.13's accuracies.
 
 use crate::measure::NoiseModel;
-use crate::model::{LinkGeometry, LinkSpec, Model, ModelSpec, Status};
+use crate::model::{LinkGeometry, LinkSpec, Model, ModelSpec, ParameterStatus};
 use crate::robots::puma560::book_dh_spec;
 use crate::Error;
 use serde::{Deserialize, Serialize};
@@ -72,8 +72,8 @@ pub fn with_tcp(spec: &ModelSpec) -> Result<Model, Error> {
         joint: None,
     });
     let mut m = Model::from_spec(&spec)?;
-    m.set_status("tool", Status::Fixed)?;
-    m.set_status("tcp", Status::Fixed)?;
+    m.set_status("tool", ParameterStatus::Fixed)?;
+    m.set_status("tcp", ParameterStatus::Fixed)?;
     Ok(m)
 }
 

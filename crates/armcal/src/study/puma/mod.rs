@@ -24,7 +24,7 @@ use crate::identify::{solve, IdentifySettings, Problem};
 use crate::measure::{Dataset, NoiseModel};
 use crate::model::convert::zrp_to_dh;
 use crate::model::identifiability::{analyze_at, IdentifiabilitySettings, Measurement};
-use crate::model::{Convention, LinkGeometry, Model, ModelSpec, Status};
+use crate::model::{Convention, LinkGeometry, Model, ModelSpec, ParameterStatus};
 use crate::progress::Observer;
 use crate::robots::puma560::{book_dh_spec, book_zrp_spec, MM_PER_IN};
 use crate::sim::simulate;
@@ -291,8 +291,8 @@ pub fn run(s: &PumaSettings, observer: &mut dyn Observer) -> Result<PumaStudy, E
     // (b) Zero reference from Table 6.2 / eq. 6.11: u, p, offsets and T₀ free as the
     // data identify them; the base is the CMM frame (identity, fixed).
     let mut zrp = with_tcp(&book_zrp_spec("table-6.2", TABLE_6_2, EQ_6_11)?)?;
-    zrp.set_status("tool", Status::Free)?;
-    zrp.set_status("base", Status::Fixed)?;
+    zrp.set_status("tool", ParameterStatus::Free)?;
+    zrp.set_status("base", ParameterStatus::Fixed)?;
     let zrp_fixed = fix_unidentifiable(&mut zrp, &train)?;
     let (zrp_params, zrp_summary, _) = fit(
         "zero reference (Table 6.2, eq. 6.11)",

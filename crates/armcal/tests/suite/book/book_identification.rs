@@ -29,6 +29,7 @@ use armcal::study::puma::{
     self, arm_configuration, book_poses, pose_errors, table_6_4_noise, Configurations,
     CONFIGURATIONS, GRID_X, GRID_Y, GRID_Z,
 };
+use armcal::ParameterStatus;
 use nalgebra::Vector3;
 use std::path::Path;
 use std::sync::OnceLock;
@@ -46,7 +47,7 @@ macro_rules! table {
 /// 30 parameters (B→0 4, joints 1–5 4 each, 5→6 Type 3 6).
 fn puma_30(spec: &ModelSpec) -> Model {
     let mut m = Model::from_spec(spec).unwrap();
-    m.set_status("tool", Status::Fixed).unwrap();
+    m.set_status("tool", ParameterStatus::Fixed).unwrap();
     assert_eq!(m.registry.free().len(), 30);
     m
 }

@@ -9,6 +9,7 @@ use armcal::identify::*;
 use armcal::measure::{Dataset, NoiseModel};
 use armcal::model::random_configurations;
 use armcal::progress::Silent;
+use armcal::Status;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use common::example_cell;
 use std::path::Path;

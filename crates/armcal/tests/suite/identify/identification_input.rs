@@ -6,6 +6,7 @@ use armcal::identify::*;
 use armcal::measure::{csv, MeasurementKind};
 use armcal::model::random_configurations;
 use armcal::progress::Silent;
+use armcal::Status;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use nalgebra::Vector3;
 use std::path::Path;

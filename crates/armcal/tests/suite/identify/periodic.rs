@@ -7,9 +7,10 @@
 
 use super::compliance::{assert_recovered, fit, paper_cell_with};
 use armcal::identify::*;
-use armcal::model::{random_configurations, Status, Unit};
+use armcal::model::{random_configurations, Unit};
 use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
+use armcal::ParameterStatus;
 
 const BOTH: &str = "compliance = [\"q2\", \"q3\"]\n\
                     periodic = { joints = [\"q1\", \"q2\", \"q3\"], harmonics = [1, 2] }";
@@ -51,7 +52,7 @@ fn the_cell_names_the_periodic_terms() {
     )
     .unwrap();
     let i = cell.model.registry.index_of("q1.periodic.sin1").unwrap();
-    let Status::Prior { sigma } = cell.model.registry.get(i).status else {
+    let ParameterStatus::Prior { sigma } = cell.model.registry.get(i).status else {
         panic!("a prior: {:?}", cell.model.registry.get(i).status)
     };
     assert!((sigma * Unit::Arcsec.display_factor() - 30.0).abs() < 1e-9);

@@ -4,9 +4,9 @@ use armcal::cell::Cell;
 use armcal::identify::*;
 use armcal::measure::{csv, NoiseModel};
 use armcal::model::random_configurations;
-use armcal::model::Status as ParamStatus;
 use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
+use armcal::ParameterStatus;
 use std::path::Path;
 
 fn root() -> std::path::PathBuf {
@@ -21,7 +21,7 @@ fn a_prior_pulls_a_weak_parameter_toward_its_nominal_value() {
     let qs = random_configurations(&cell.model, 40, 3);
     let data = simulate(&cell.model, &truth, &qs, Some(&noise), 8).unwrap();
     let i = cell.model.registry.index_of("j5.d").unwrap();
-    let fit = |status: ParamStatus| {
+    let fit = |status: ParameterStatus| {
         let mut model = cell.model.clone();
         model.registry.set_status(i, status);
         let mut problem = Problem::new(&model, &data, &noise).unwrap();
@@ -36,9 +36,9 @@ fn a_prior_pulls_a_weak_parameter_toward_its_nominal_value() {
         sol.params[i]
     };
     let nominal = cell.model.registry.get(i).nominal;
-    let free = fit(ParamStatus::Free);
-    let loose = fit(ParamStatus::Prior { sigma: 1e6 });
-    let tight = fit(ParamStatus::Prior { sigma: 1e-6 });
+    let free = fit(ParameterStatus::Free);
+    let loose = fit(ParameterStatus::Prior { sigma: 1e6 });
+    let tight = fit(ParameterStatus::Prior { sigma: 1e-6 });
     assert!(
         (loose - free).abs() < 1e-6,
         "a very loose prior changes nothing"
@@ -47,7 +47,7 @@ fn a_prior_pulls_a_weak_parameter_toward_its_nominal_value() {
         (tight - nominal).abs() < 1e-4,
         "a very tight prior holds the nominal value"
     );
-    let medium = fit(ParamStatus::Prior { sigma: 0.3 });
+    let medium = fit(ParameterStatus::Prior { sigma: 0.3 });
     assert!(
         (medium - nominal).abs() < (free - nominal).abs(),
         "a prior shrinks toward nominal"

@@ -1,7 +1,7 @@
 //! Cell files: a full inline example loads; every kind of mistake gives file, line and field.
 
 use armcal::cell::{Cell, NoiseModel, Obstacle};
-use armcal::model::Status;
+use armcal::ParameterStatus;
 use std::path::Path;
 
 fn parse(text: &str) -> Result<Cell, String> {
@@ -65,12 +65,12 @@ fn inline_robot_with_units_loads() {
     assert_eq!(get("tracker.x").nominal, 2000.0);
     assert_eq!(
         get("j2.alpha").status,
-        Status::Fixed,
+        ParameterStatus::Fixed,
         "not in the free list"
     );
-    assert_eq!(get("j2.a").status, Status::Free);
+    assert_eq!(get("j2.a").status, ParameterStatus::Free);
     match get("j1.alpha").status {
-        Status::Prior { sigma } => assert!((sigma - 0.1f64.to_radians()).abs() < 1e-15),
+        ParameterStatus::Prior { sigma } => assert!((sigma - 0.1f64.to_radians()).abs() < 1e-15),
         s => panic!("expected a prior, got {s:?}"),
     }
     // Prismatic working value stays in mm; revolute in degrees → rad.

@@ -203,7 +203,7 @@ fn a_nongeometric_calibration_exported_as_a_cell_keeps_its_terms_and_its_deflect
             .get(m.registry.index_of("q3.compliance.wrist").unwrap());
         assert_eq!(
             prior.status,
-            armcal::model::Status::Prior { sigma: 5e-6 },
+            armcal::ParameterStatus::Prior { sigma: 5e-6 },
             "{form:?}"
         );
         let mut rigid = identified.nominal();
