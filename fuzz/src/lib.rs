@@ -6,7 +6,6 @@
 //! armcal's own promise that every file it writes, it can read (issue 12).
 
 use armcal::cell::export::{export_model, ExportFormat};
-use armcal::cell::model_analysis::analyze_model;
 use armcal::design::assess::evaluate_design;
 use armcal::design::cell_constraints::unmeasurable_poses;
 use armcal::design::user_pool::{plan_from_pool, PoolSettings};
@@ -17,7 +16,7 @@ use armcal::model::identifiability::IdentifiabilitySettings;
 use armcal::model::{random_configurations, tool_pose};
 use armcal::progress::Silent;
 use armcal::report::{page, Document, Input, ReportContent};
-use armcal::{Cell, Model};
+use armcal::{analyze_model, Cell, Model};
 use std::path::Path;
 use std::sync::OnceLock;
 
@@ -343,11 +342,11 @@ fn drift_check(e: &armcal::identify::Estimate) {
     let Ok(data) = armcal::sim::simulate(&cell.model, &params, &qs, None, 0) else {
         return;
     };
-    let settings = armcal::campaign::drift::CheckSettings::default();
-    if let Ok(c) = armcal::campaign::drift::check(cell, e, &data, &settings) {
+    let settings = armcal::CheckSettings::default();
+    if let Ok(c) = armcal::check(cell, e, &data, &settings) {
         let released = c.moved_groups().into_iter().take(1).collect::<Vec<_>>();
         if let Ok(p) =
-            armcal::campaign::prior::CampaignPrior::from_estimate(cell, e, "fuzz.json", &released)
+            armcal::CampaignPrior::from_estimate(cell, e, "fuzz.json", &released)
         {
             let _ = p.apply(cell);
         }

@@ -3,16 +3,19 @@
 //!
 //! `measure` stands in for the laser tracker: here it measures a virtual robot that differs
 //! from its drawing; on a real cell it drives the robot to each planned pose and records
-//! the reflector's position. Everything else is what a real campaign does: `campaign::start`
-//! plans the fewest poses that identify the free parameters, `campaign::step` fits what has
+//! the reflector's position. Everything else is what a real campaign does: `campaign_start`
+//! plans the fewest poses that identify the free parameters, `campaign_step` fits what has
 //! been measured, states every working pose's TCP σ, and decides whether to stop.
 //!
 //! Run: `cargo run --release -p armcal --example adaptive_campaign`
 //! (the same as `armcal campaign start` / `campaign step`; guide: "Campaigns and drift checks").
 
-use armcal::campaign::{self, CampaignSettings, Decision};
 use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, Perturbation};
+use armcal::{
+    campaign_largest_sigma, campaign_start, campaign_step, CampaignDecision as Decision,
+    CampaignSettings, CampaignState,
+};
 use armcal::{simulate, Dataset};
 
 fn main() -> armcal::Result<()> {
@@ -25,14 +28,14 @@ fn main() -> armcal::Result<()> {
         budget: Some(80),
         ..CampaignSettings::default()
     };
-    let mut state = campaign::start(&cell, "paper-cell (built in)", &settings, &mut Silent)?;
+    let mut state = campaign_start(&cell, "paper-cell (built in)", &settings, &mut Silent)?;
     println!(
         "first batch: {} poses (the fewest that identify the free parameters)",
         state.next.len()
     );
 
     // The instrument: measures the planned poses, keeping their ids.
-    let measure = |state: &campaign::CampaignState, batch: u64| -> armcal::Result<Dataset> {
+    let measure = |state: &CampaignState, batch: u64| -> armcal::Result<Dataset> {
         let qs: Vec<Vec<f64>> = state.next.iter().map(|p| p.q(model)).collect();
         let mut data = simulate(model, &truth, &qs, Some(&cell.noise()), 100 + batch)?;
         data.config_ids = state.next.iter().map(|p| p.id.clone()).collect();
@@ -41,9 +44,9 @@ fn main() -> armcal::Result<()> {
 
     while state.decision == Decision::Measure {
         let batch = measure(&state, state.steps.len() as u64)?;
-        state = campaign::step(&cell, &state, &batch, &mut Silent)?.state;
+        state = campaign_step(&cell, &state, &batch, &mut Silent)?.state;
         let last = state.steps.last().expect("a step was just taken");
-        let worst = campaign::largest_sigma(&last.working);
+        let worst = campaign_largest_sigma(&last.working);
         println!(
             "{:3} poses measured: largest working-pose σ {worst:.3} mm → {}",
             last.measured,

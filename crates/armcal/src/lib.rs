@@ -63,14 +63,14 @@
 #![warn(missing_docs)]
 
 pub mod accuracy;
-pub mod campaign;
+pub(crate) mod campaign;
 pub mod cell;
 pub mod compensate;
 pub mod design;
 pub(crate) mod error;
 pub mod geometry;
 pub mod identify;
-pub mod input;
+pub(crate) mod input;
 pub(crate) mod json;
 pub(crate) mod linalg;
 pub mod measure;
@@ -82,9 +82,9 @@ pub mod robots;
 pub mod sim;
 pub(crate) mod solve;
 pub mod study;
-pub mod table;
+pub(crate) mod table;
 pub(crate) mod toml_text;
-pub mod workflow;
+pub(crate) mod workflow;
 
 pub use error::{Error, Result};
 
@@ -93,18 +93,24 @@ pub use error::{Error, Result};
 // They stay in the module of the concept they compute (one concept per module, the layering
 // test's order) and are named here once; docs/src/reference/library.md lists them.
 
-// A cell and its model.
+// A cell and its model; the model's parameters, completeness and identifiability.
+pub use cell::model_analysis::{analyze_model, ModelAnalysis, ModelRecord, ParameterRecord};
 pub use cell::Cell;
 pub use model::registry::ParameterStatus;
 pub use model::Model;
 // Kinematic trees and coupled joints (analysis only, for now).
 pub use cell::tree::{analyze_tree_file, describes_tree, TreeAnalysis, TreeCell};
-// Kinematics over many configurations.
+// Kinematics over many configurations; every frame at one configuration.
+pub use model::frames::{frames, FramesRecord, PoseRecord};
 pub use model::kinematics::fk;
 // Measurements: from arrays, from several stations, simulated, predicted.
 pub use measure::{DataArrays, Dataset, RowKind};
 pub use sim::{perturbed_truth, predict, simulate, Perturbation};
-// Identification.
+// Identification, its checks, the prediction σ of any configuration, joint axes by circle
+// point analysis.
+pub use identify::circle_point::record::{axes_record, AxesRecord};
+pub use identify::fit_checks::FitChecks;
+pub use identify::prediction_sigma::{csv_with_sigmas, prediction_sigmas, RowSigma};
 pub use identify::{identify, Acceptance, Estimate, IdentifySettings};
 // Optimal design: plan, plan from the user's pose pool, assess any design.
 pub use design::assess::{assess, DesignAssessment};
@@ -121,16 +127,41 @@ pub use compensate::controller_program::{
 };
 // Accuracy (ISO 9283 before and after calibration).
 pub use performance::{performance, Calibrated, PerformanceRecord, PerformanceSettings};
-// The adaptive campaign and the drift check.
-pub use campaign::drift::{check, CheckSettings, DriftCheck};
+// The adaptive campaign (start, step, simulate), the drift check and the campaign after a
+// drift (the calibration as the prior).
+pub use campaign::drift::{check, CheckSettings, DriftCheck, DriftVerdict, GroupScore};
+pub use campaign::precision::WorkingSigma;
+pub use campaign::prior::CampaignPrior;
+pub use campaign::simulate::{
+    measure_until_stopped as campaign_measure_until_stopped, SimulatedCampaign,
+};
+pub use campaign::{
+    fewest_poses as campaign_fewest_poses, largest_sigma as campaign_largest_sigma,
+    simulate as campaign_simulate, start_after_check as campaign_start_after_check,
+    step_with as campaign_step_with,
+};
 pub use campaign::{start as campaign_start, step as campaign_step};
-pub use campaign::{CampaignSettings, CampaignState, StepResult};
+pub use campaign::{
+    CampaignPose, CampaignSettings, CampaignState, CampaignStep, Decision as CampaignDecision,
+    FitSummary as CampaignFitSummary, Planner as CampaignPlanner, StepResult,
+    StepSettings as CampaignStepSettings, JOINT_TOLERANCE as CAMPAIGN_JOINT_TOLERANCE,
+};
+// The seeded campaign study: adaptive against one-shot and random designs.
+pub use campaign::study::{
+    coverage as campaign_coverage, coverage_with_floor as campaign_coverage_with_floor,
+    poses_summary as campaign_poses_summary, run as campaign_study, CampaignStudyRecord,
+    RunOutcome as CampaignRunOutcome, StudySettings as CampaignStudySettings,
+};
 // Export and report.
 pub use cell::export::{export_model, ExportFormat, Exported};
 pub use identify::export::export_estimate;
 pub use report::files::{files_report, FilesReport};
+// The one CSV writer behind every table armcal writes.
+pub use table::Table;
+// The whole workflow on the built-in paper cell.
+pub use workflow::demo::{demo, DemoFiles, FILES as DEMO_FILES};
 // The shared vocabulary: solver status, progress, the input caps.
-pub use input::{input_limits, set_input_limits, InputLimits};
+pub use input::{input_limits, read_capped, set_input_limits, InputLimits, DATA_CAP, TEXT_CAP};
 /// The linear-algebra crate of the public API.
 pub use nalgebra;
 pub use progress::{Observer, Silent};

@@ -9,8 +9,8 @@ use super::progress::Progress;
 use armcal::accuracy::iso9283::ISO_CYCLES;
 use armcal::accuracy::report::{AccuracyReport, Orientation, PoseFigures};
 use armcal::accuracy::same_pose::{GroupingSummary, SamePose};
-use armcal::performance::{performance, Calibrated, PerformanceRecord, PerformanceSettings};
-use armcal::table::Table;
+use armcal::Table;
+use armcal::{performance, Calibrated, PerformanceRecord, PerformanceSettings};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]

@@ -3,7 +3,7 @@
 //! axis in mm), compared with the cell's nominal axes; warnings for axes not to be trusted.
 
 use super::output::{load_cell, load_data, Outputs};
-use armcal::identify::circle_point::record::axes_record;
+use armcal::axes_record;
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]

@@ -6,10 +6,18 @@
 use super::output::{load_cell, load_cell_to_measure, load_data, with_note, NoteStyle, Outputs};
 use super::progress::Progress;
 use anyhow::Context;
-use armcal::campaign::study::{coverage, coverage_with_floor, poses_summary, StudySettings};
-use armcal::campaign::{self, CampaignSettings, CampaignState, CampaignStep, Decision, Planner};
 use armcal::measure::csv;
-use armcal::sim::Perturbation;
+use armcal::Perturbation;
+use armcal::{
+    campaign_coverage as coverage, campaign_coverage_with_floor as coverage_with_floor,
+    campaign_poses_summary as poses_summary, campaign_study, CampaignRunOutcome,
+    CampaignStudySettings as StudySettings,
+};
+use armcal::{
+    campaign_simulate, campaign_start, campaign_step_with, CampaignDecision as Decision,
+    CampaignPlanner as Planner, CampaignSettings, CampaignState, CampaignStep,
+    CampaignStepSettings, StepResult, CAMPAIGN_JOINT_TOLERANCE,
+};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Subcommand)]
@@ -100,7 +108,7 @@ pub struct StepArgs {
     pub data: PathBuf,
     /// How far a measured joint value may be from the planned one in DIR/next.csv (deg; mm
     /// for a prismatic joint): the resolution the controller reports its joints with.
-    #[arg(long, default_value_t = campaign::JOINT_TOLERANCE)]
+    #[arg(long, default_value_t = CAMPAIGN_JOINT_TOLERANCE)]
     pub joint_tolerance_deg: f64,
     /// Poses of DIR/next.csv the instrument could not measure (ids, comma-separated: the
     /// beam blocked, the reflector turned too far): the data file lacks them, the state
@@ -229,7 +237,7 @@ fn run_start(a: &StartArgs) -> anyhow::Result<()> {
         &[&files.state, &files.next],
     )?;
     let cell = load_cell_to_measure(&a.target.cell)?;
-    let state = campaign::start(
+    let state = campaign_start(
         &cell,
         &a.target.source(),
         &a.target.settings(a.seed),
@@ -268,7 +276,7 @@ fn first_batch(state: &CampaignState) -> String {
 
 fn read_state(dir: &Path) -> anyhow::Result<CampaignState> {
     let path = Files::of(dir).state;
-    let text = armcal::input::read_capped(&path, armcal::input::TEXT_CAP).with_context(|| {
+    let text = armcal::read_capped(&path, armcal::TEXT_CAP).with_context(|| {
         format!(
             "reading {} (is {} a campaign directory?)",
             path.display(),
@@ -291,11 +299,11 @@ fn run_step(a: &StepArgs) -> anyhow::Result<()> {
     )?;
     let cell = load_cell(&state.cell_source)?;
     let batch = load_data(&cell, &a.data)?;
-    let settings = campaign::StepSettings {
+    let settings = CampaignStepSettings {
         joint_tolerance: a.joint_tolerance_deg,
         unmeasurable: a.unmeasurable.clone(),
     };
-    let r = campaign::step_with(
+    let r = campaign_step_with(
         &cell,
         &state,
         &batch,
@@ -316,7 +324,7 @@ fn run_step(a: &StepArgs) -> anyhow::Result<()> {
 /// fit) the estimate.
 pub(super) fn step_files(
     cell: &armcal::Cell,
-    r: &campaign::StepResult,
+    r: &StepResult,
     files: &Files,
 ) -> anyhow::Result<Vec<(PathBuf, String)>> {
     let mut written = vec![
@@ -489,7 +497,7 @@ fn run_simulate(a: &SimulateArgs) -> anyhow::Result<()> {
         );
     }
     let cell = load_cell_to_measure(&a.target.cell)?;
-    let sim = campaign::simulate(
+    let sim = campaign_simulate(
         &cell,
         &a.target.source(),
         &a.target.settings(a.seed),
@@ -532,7 +540,7 @@ fn run_simulate(a: &SimulateArgs) -> anyhow::Result<()> {
 fn run_study(a: &StudyArgs) -> anyhow::Result<()> {
     let outputs = Outputs::plan(a.force, &[Path::new(&a.cell)], &[&a.out])?;
     let cell = load_cell(&a.cell)?;
-    let record = campaign::study::run(
+    let record = campaign_study(
         &cell,
         &StudySettings {
             targets: a.targets.clone(),
@@ -552,14 +560,14 @@ fn run_study(a: &StudyArgs) -> anyhow::Result<()> {
     for r in &record.rows {
         let (am, amin, amax) = poses_summary(&r.adaptive);
         let (rm, rmin, rmax) = poses_summary(&r.random);
-        let reached = |runs: &[campaign::study::RunOutcome]| {
+        let reached = |runs: &[CampaignRunOutcome]| {
             format!(
                 "{}/{}",
                 runs.iter().filter(|x| x.reached).count(),
                 runs.len()
             )
         };
-        let cover = |runs: &[campaign::study::RunOutcome]| {
+        let cover = |runs: &[CampaignRunOutcome]| {
             let (c, n) = coverage(runs);
             let (f, _) = coverage_with_floor(runs);
             format!(

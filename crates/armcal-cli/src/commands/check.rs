@@ -6,10 +6,10 @@ use super::campaign::{print_last_step, step_files, Files};
 use super::output::{
     load_cell, load_data, warn_outside_fitted_ranges, with_note, Calibration, NoteStyle, Outputs,
 };
-use armcal::campaign::drift::{check, CheckSettings, DriftVerdict};
-use armcal::campaign::prior::CampaignPrior;
-use armcal::campaign::{self, CampaignSettings};
-use armcal::progress::Silent;
+use armcal::Silent;
+use armcal::{
+    campaign_start_after_check, check, CampaignPrior, CampaignSettings, CheckSettings, DriftVerdict,
+};
 use std::path::{Path, PathBuf};
 
 /// Groups printed, smallest p-value first (the record holds them all).
@@ -101,8 +101,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
             let cell_source = std::fs::canonicalize(&a.cell)
                 .map(|p| p.display().to_string())
                 .unwrap_or_else(|_| a.cell.clone());
-            let r =
-                campaign::start_after_check(&cell, &cell_source, &settings, &data, &mut Silent)?;
+            let r = campaign_start_after_check(&cell, &cell_source, &settings, &data, &mut Silent)?;
             written.extend(step_files(&cell, &r, f)?);
             Some((r.state, release))
         }

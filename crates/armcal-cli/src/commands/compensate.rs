@@ -8,9 +8,9 @@ use super::output::{
 use armcal::compensate::joint_change::JointChangeLimit;
 use armcal::compensate::nonparametric::{CorrectionInputs, ResidualCorrection};
 use armcal::compensate::program::{compensate_program, ProgramFile};
-use armcal::compensate::IkSettings;
-use armcal::input::{read_capped, DATA_CAP, TEXT_CAP};
-use armcal::{ProgramLanguage as Language, ProgramSettings};
+use armcal::{
+    read_capped, IkSettings, ProgramLanguage as Language, ProgramSettings, DATA_CAP, TEXT_CAP,
+};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]

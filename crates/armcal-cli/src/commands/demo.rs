@@ -3,7 +3,7 @@
 use super::output::Outputs;
 use super::progress::Progress;
 use anyhow::Context;
-use armcal::workflow::demo::{demo, FILES};
+use armcal::{demo, DEMO_FILES as FILES};
 use std::path::{Path, PathBuf};
 
 /// Marks a folder as written by `armcal demo`, which may then overwrite it.

@@ -1,8 +1,8 @@
 //! `armcal fk <robot-or-cell> --joints ...`
 
 use anyhow::{bail, Context};
-use armcal::model::frames::{frames, PoseRecord};
 use armcal::model::JointKind;
+use armcal::{frames, PoseRecord};
 
 #[derive(clap::Args)]
 pub struct Args {

@@ -372,14 +372,14 @@ pub fn print_summary(e: &Estimate) {
 
 /// What the checks of the fit found: units, blunders, a gross misfit, a robot far from its
 /// drawing, the sign and zero diagnosis, and whether a refused fit was accepted.
-fn print_fit_checks(fit: &armcal::identify::FitChecks) {
+fn print_fit_checks(fit: &armcal::FitChecks) {
     for u in &fit.units {
         println!("UNITS ({}): {}", u.subject, u.message);
     }
     if !fit.blunders.is_empty() {
         println!(
             "BLUNDERS: {} lie farther from the other measurements than the model allows by more than the plausible model error ({:.1} mm): remove them, or fit with --robust huber",
-            armcal::identify::fit_checks::rows_words(&fit.blunders),
+            fit.blunder_rows(),
             fit.plausible_mm
         );
     }

@@ -1,15 +1,14 @@
 //! `armcal model <robot-or-cell>`: parameters, completeness and identifiability.
 //!
 //! With `--convention dh|mdh|zrp` the model is first converted (forward kinematics
-//! unchanged; `armcal::cell::model_analysis` says how and with which statuses); the table
+//! unchanged; `armcal::analyze_model` says how and with which statuses); the table
 //! and the identifiability analysis are then those of the converted model.
 
 use super::digits::fixed;
-use armcal::cell::model_analysis::{analyze_model, ModelRecord};
 use armcal::model::complete::LinkForm;
 use armcal::model::identifiability::{Identifiability, IdentifiabilitySettings, Measurement};
 use armcal::model::{Joint, JointKind, Registry};
-use armcal::ParameterStatus;
+use armcal::{analyze_model, ModelRecord, ParameterStatus};
 
 #[derive(clap::Args)]
 pub struct Args {

@@ -9,7 +9,7 @@
 //! the directories it made are removed again, so a failed command leaves no new file behind.
 
 use anyhow::{bail, Context};
-use armcal::identify::Estimate;
+use armcal::Estimate;
 use std::path::{Path, PathBuf};
 
 /// The files a command will write, checked before it computes anything.
@@ -159,8 +159,8 @@ fn check_writable(path: &Path) -> anyhow::Result<()> {
 }
 
 /// Loads a cell and prints its warnings to stderr.
-pub fn load_cell(name_or_path: &str) -> anyhow::Result<armcal::cell::Cell> {
-    let cell = armcal::cell::Cell::load(name_or_path)?;
+pub fn load_cell(name_or_path: &str) -> anyhow::Result<armcal::Cell> {
+    let cell = armcal::Cell::load(name_or_path)?;
     for w in &cell.warnings {
         eprintln!("warning: {w}");
     }
@@ -171,7 +171,7 @@ pub fn load_cell(name_or_path: &str) -> anyhow::Result<armcal::cell::Cell> {
 /// campaign) and notes on stderr when its line of sight and incidence go unchecked because
 /// the cell does not place its instrument
 /// ([`armcal::design::cell_constraints::unplaced_instrument`]).
-pub fn load_cell_to_measure(name_or_path: &str) -> anyhow::Result<armcal::cell::Cell> {
+pub fn load_cell_to_measure(name_or_path: &str) -> anyhow::Result<armcal::Cell> {
     let cell = load_cell(name_or_path)?;
     if let Some(note) = armcal::design::cell_constraints::unplaced_instrument(&cell) {
         eprintln!("note: {note}");
@@ -181,10 +181,7 @@ pub fn load_cell_to_measure(name_or_path: &str) -> anyhow::Result<armcal::cell::
 
 /// Reads a data file for a cell (its `[data]` column mapping), with the reader's remarks
 /// ([`print_read_report`]) and a note when the cell's noise model does not use the σ columns.
-pub fn load_data(
-    cell: &armcal::cell::Cell,
-    path: &Path,
-) -> anyhow::Result<armcal::measure::Dataset> {
+pub fn load_data(cell: &armcal::Cell, path: &Path) -> anyhow::Result<armcal::Dataset> {
     let (data, report) = armcal::measure::csv::read_with(path, &cell.model, &cell.data_format())?;
     print_read_report(&report);
     if let Some(note) = cell.noise().unused_sigmas(&data) {
@@ -209,7 +206,7 @@ pub fn station_files(args: &[String]) -> Vec<(Option<String>, PathBuf)> {
 /// The data of several files ([`station_files`]) read for a cell ([`load_data`]), merged by
 /// the library's rule ([`armcal::Dataset::merge_stations`]).
 pub fn load_station_data(
-    cell: &armcal::cell::Cell,
+    cell: &armcal::Cell,
     files: &[(Option<String>, PathBuf)],
 ) -> anyhow::Result<armcal::Dataset> {
     let parts = files
@@ -248,8 +245,8 @@ pub struct AcceptUnconverged {
 
 impl AcceptUnconverged {
     /// The library's acceptance, in this CLI's flags.
-    pub fn acceptance(&self) -> armcal::identify::Acceptance<'static> {
-        armcal::identify::Acceptance {
+    pub fn acceptance(&self) -> armcal::Acceptance<'static> {
+        armcal::Acceptance {
             accepted: self.accept_unconverged,
             accept: "--accept-unconverged",
             raise_iterations: "--max-iterations",
@@ -263,10 +260,10 @@ impl AcceptUnconverged {
 pub fn load_estimate(
     path: &Path,
     accept: &AcceptUnconverged,
-    model: Option<&armcal::model::Model>,
-) -> anyhow::Result<(armcal::identify::Estimate, Option<String>)> {
+    model: Option<&armcal::Model>,
+) -> anyhow::Result<(armcal::Estimate, Option<String>)> {
     let file = |e: armcal::Error| anyhow::anyhow!("{}: {e}", path.display());
-    let est = armcal::identify::Estimate::from_file(path)?;
+    let est = armcal::Estimate::from_file(path)?;
     let usable = est.check_usable(&accept.acceptance()).map_err(file)?;
     if let Some(m) = model {
         est.check_model(m).map_err(file)?;
@@ -304,7 +301,7 @@ impl Calibration {
     /// made with it must carry.
     pub fn load(
         &self,
-        model: Option<&armcal::model::Model>,
+        model: Option<&armcal::Model>,
     ) -> anyhow::Result<(Estimate, Option<String>)> {
         load_estimate(&self.estimate, &self.accept, model)
     }
@@ -324,12 +321,12 @@ impl CalibrationOrNominal {
     /// The parameters of the estimate for `model` ([`load_estimate`]), or the nominal ones
     /// without an estimate, with the line every output made with them must carry, and the
     /// payload the robot carries: `name` checked against the estimate
-    /// ([`armcal::identify::Estimate::payload_for`]) — the payload index and the sentence
+    /// ([`armcal::Estimate::payload_for`]) — the payload index and the sentence
     /// saying how it is predicted (`None` for a model without payloads and no `--payload`).
     /// Without an estimate, the nominal model at payload `name`.
     pub fn load_at_payload(
         &self,
-        model: &armcal::model::Model,
+        model: &armcal::Model,
         name: Option<&str>,
     ) -> anyhow::Result<ParamsAtPayload> {
         let quiet = name.is_none() && model.payloads.is_empty();
@@ -358,7 +355,7 @@ impl CalibrationOrNominal {
 /// ([`Estimate::outside_fitted_ranges`]).
 pub fn warn_outside_fitted_ranges(
     est: &Estimate,
-    model: &armcal::model::Model,
+    model: &armcal::Model,
     configurations: &[(String, Vec<f64>)],
 ) {
     if let Some(w) = est.outside_fitted_ranges(model, configurations) {

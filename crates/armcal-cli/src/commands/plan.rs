@@ -7,12 +7,10 @@ use super::progress::Progress;
 use anyhow::bail;
 use armcal::design::assess::{evaluate_design, PathPrecision};
 use armcal::design::cell_constraints::TrackerShift;
-use armcal::design::plan::PlanSettings;
 use armcal::design::record::KindMargin;
-use armcal::design::user_pool::{PoolReport, PoolSettings};
-use armcal::design::Criterion;
-use armcal::design::DesignRecord;
+use armcal::design::user_pool::PoolReport;
 use armcal::measure::csv;
+use armcal::{Criterion, DesignAssessment, DesignRecord, PlanSettings, PoolSettings};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -287,7 +285,7 @@ fn orientation_note(t: &armcal::identify::uncertainty::TcpCovariance) -> String 
 
 /// `; model floor … mm² (…; not in the KPI)` for
 /// the working pose `name`, or nothing without a floor.
-fn floor_note(a: &armcal::design::assess::DesignAssessment, name: &str) -> String {
+fn floor_note(a: &DesignAssessment, name: &str) -> String {
     match a.model_floor.as_ref().and_then(|f| f.at(name)) {
         Some(f) => format!(
             "; model floor (1/3) tr C_floor = {} mm² (fixed parameters at their stated prior; not in the KPI)",

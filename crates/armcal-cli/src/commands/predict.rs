@@ -3,9 +3,9 @@
 use super::output::{
     load_cell, warn_outside_fitted_ranges, with_note, CalibrationOrNominal, NoteStyle, Outputs,
 };
-use armcal::identify::prediction_sigma::{csv_with_sigmas, prediction_sigmas, RowSigma};
 use armcal::measure::csv;
-use armcal::sim::predict;
+use armcal::predict;
+use armcal::{csv_with_sigmas, prediction_sigmas, RowSigma};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]

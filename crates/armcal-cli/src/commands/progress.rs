@@ -2,7 +2,7 @@
 //! when stderr is a terminal and `--quiet` is not given (so nothing is printed when the
 //! output is captured).
 
-use armcal::progress::Observer;
+use armcal::Observer;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::time::Duration;

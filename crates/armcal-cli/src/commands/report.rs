@@ -3,8 +3,7 @@
 
 use super::output::{AcceptUnconverged, Outputs};
 use super::progress::Progress;
-use armcal::progress::Observer;
-use armcal::report::files::files_report;
+use armcal::{files_report, Observer};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]

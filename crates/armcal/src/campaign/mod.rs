@@ -16,9 +16,9 @@ pub(crate) mod precision;
 pub mod prior;
 pub mod simulate;
 pub(crate) mod state;
-pub mod study;
+pub(crate) mod study;
 
-pub use simulate::{simulate, SimulatedCampaign};
+pub use simulate::simulate;
 pub use state::{
     CampaignPose, CampaignSettings, CampaignState, CampaignStep, Decision, FitSummary, Planner,
 };
@@ -47,21 +47,21 @@ pub fn fewest_poses(cell: &Cell) -> Result<usize, Error> {
 /// constraint.
 ///
 /// ```
-/// use armcal::campaign::{self, CampaignSettings, Decision};
+/// use armcal::{campaign_start, campaign_step, CampaignDecision as Decision, CampaignSettings};
 /// use armcal::progress::Silent;
 /// use armcal::sim::{perturbed_truth, Perturbation};
 ///
 /// # fn main() -> armcal::Result<()> {
 /// let cell = armcal::cell::builtin::paper_cell()?;
 /// let settings = CampaignSettings { target_sigma_mm: 0.6, ..CampaignSettings::default() };
-/// let state = campaign::start(&cell, "paper-cell", &settings, &mut Silent)?;
+/// let state = campaign_start(&cell, "paper-cell", &settings, &mut Silent)?;
 /// assert_eq!(state.decision, Decision::Measure);
 /// // Measure the poses it asks for (here on a virtual robot), keeping their ids, and step.
 /// let truth = perturbed_truth(&cell.model, &Perturbation::default(), 1);
 /// let qs: Vec<Vec<f64>> = state.next.iter().map(|p| p.q(&cell.model)).collect();
 /// let mut batch = armcal::simulate(&cell.model, &truth, &qs, Some(&cell.noise()), 2)?;
 /// batch.config_ids = state.next.iter().map(|p| p.id.clone()).collect();
-/// let step = campaign::step(&cell, &state, &batch, &mut Silent)?;
+/// let step = campaign_step(&cell, &state, &batch, &mut Silent)?;
 /// assert_eq!(step.state.measured(), qs.len());
 /// // Every working pose's TCP σ from the fit, and what to do next.
 /// let last = step.state.steps.last().unwrap();

@@ -5,7 +5,7 @@
 
 pub mod builtin;
 pub mod export;
-pub mod model_analysis;
+pub(crate) mod model_analysis;
 mod raw;
 pub(crate) mod tree;
 

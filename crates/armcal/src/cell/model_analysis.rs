@@ -36,7 +36,7 @@ pub struct ModelAnalysis {
 
 /// The cell's model converted to `form`, with the statuses of the module documentation
 /// (before any automatic reduction).
-pub fn converted(cell: &Cell, form: LinkForm) -> Result<Model, Error> {
+pub(crate) fn converted(cell: &Cell, form: LinkForm) -> Result<Model, Error> {
     let original = &cell.model;
     let mut model = Model::from_spec(&in_form(&original.spec(), form)?.spec)?;
     for i in 0..model.param_count() {

@@ -185,6 +185,12 @@ pub struct FitChecks {
 }
 
 impl FitChecks {
+    /// The blunders in words (each row's line, pose id and error, joined for a sentence), as
+    /// the refusal names them.
+    pub fn blunder_rows(&self) -> String {
+        rows_words(&self.blunders)
+    }
+
     /// Whether the fit is refused: a gross misfit, a robot far from its drawing or a unit
     /// mistake.
     pub fn refuses(&self) -> bool {

@@ -7,7 +7,7 @@ pub mod circle_point;
 pub(crate) mod estimate;
 pub(crate) mod export;
 pub(crate) mod fingerprint;
-pub mod fit_checks;
+pub(crate) mod fit_checks;
 pub mod fitted_ranges;
 mod frames_first;
 mod free_set;
@@ -19,7 +19,7 @@ pub mod model_floor;
 pub(crate) mod nongeometric_choice;
 pub(crate) mod nongeometric_gate;
 pub mod pivot;
-pub mod prediction_sigma;
+pub(crate) mod prediction_sigma;
 pub(crate) mod problem;
 pub(crate) mod refit;
 pub mod residuals;
@@ -37,7 +37,7 @@ pub use estimate::{
     ParameterEstimate, ResidualReport, SolverReport, Usability, Validation,
 };
 pub use fingerprint::ModelFingerprint;
-pub use fit_checks::FitChecks;
+pub(crate) use fit_checks::FitChecks;
 use frames_first::frames_model;
 pub use frames_first::{
     frames_first_start, frames_only, frames_only_fit, is_frame_parameter, DETERMINED_VIF,

@@ -25,9 +25,6 @@ use crate::Error;
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
-/// What the σ columns mean, for the file's readers.
-pub const SIGMA_DEFINITION: &str = "sigma_mm = √((1/3) tr J C_p Jᵀ), the RMS of the three axis σ's of the row's predicted point from the estimate's C_p (not scaled by σ̂₀²); floor_sigma_mm the same of the model floor K Σ_f Kᵀ (the fixed parameters' stated prior); total_sigma_mm = √(sigma² + floor²); the _deg columns the same of a pose row's orientation (rotation vector); the tcp_ columns the same of the TCP (tool origin) at the row's configuration when the row is a target's.";
-
 /// The σ's of one predicted point.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PredictionSigma {
@@ -144,10 +141,16 @@ fn point_jacobian(
     j
 }
 
-/// The prediction `data` as a data file ([`csv::write_string`]) with the σ columns of
-/// [`SIGMA_DEFINITION`]: `sigma_mm`, `floor_sigma_mm`, `total_sigma_mm` (the floor's two only
-/// if the estimate states a floor), the same in `_deg` if a row is a pose, and the same with
-/// `tcp_` if a row is a target's; a data file's reader ignores them.
+/// The prediction `data` as a data file ([`csv::write_string`]) with the σ columns
+/// `sigma_mm`, `floor_sigma_mm`, `total_sigma_mm` (the floor's two only if the estimate states
+/// a floor), the same in `_deg` if a row is a pose, and the same with `tcp_` if a row is a
+/// target's; a data file's reader ignores them.
+///
+/// sigma_mm = √((1/3) tr J C_p Jᵀ), the RMS of the three axis σ's of the row's predicted point
+/// from the estimate's C_p (not scaled by σ̂₀²); floor_sigma_mm the same of the model floor
+/// K Σ_f Kᵀ (the fixed parameters' stated prior); total_sigma_mm = √(sigma² + floor²); the
+/// `_deg` columns the same of a pose row's orientation (rotation vector); the `tcp_` columns the
+/// same of the TCP (tool origin) at the row's configuration when the row is a target's.
 pub fn csv_with_sigmas(
     data: &Dataset,
     model: &Model,

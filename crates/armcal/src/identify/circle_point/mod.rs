@@ -10,7 +10,7 @@
 //! The plane, circle and line fits and the covariance of a fitted axis are geometry:
 //! [`crate::geometry::fit`].
 
-pub mod record;
+pub(crate) mod record;
 
 use crate::geometry::fit::{fit_circle, fit_line, planned_circle_covariance, AxisCovariance};
 use crate::model::chain::{LinkSpec, Model, ModelSpec};

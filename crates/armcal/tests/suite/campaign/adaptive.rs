@@ -4,10 +4,14 @@
 //! a converged fit, its state resumes, and a batch that is not the planned one is refused
 //! without changing the state.
 
-use armcal::campaign::{self, CampaignSettings, CampaignState, Decision};
 use armcal::progress::Silent;
 use armcal::sim::Perturbation;
 use armcal::Cell;
+use armcal::{
+    campaign_fewest_poses, campaign_largest_sigma, campaign_simulate, campaign_start,
+    campaign_step, CampaignDecision as Decision, CampaignPose, CampaignSettings, CampaignState,
+    CampaignStep,
+};
 
 /// The paper cell with the default `[design]` margins: with the paper's zero margins, the
 /// poses a campaign plans sit on the 30° limit and the virtual instrument cannot measure some
@@ -26,7 +30,7 @@ fn a_simulated_campaign_stops_at_the_target_and_resumes() {
         ..CampaignSettings::default()
     };
     let t0 = std::time::Instant::now();
-    let run = campaign::simulate(
+    let run = campaign_simulate(
         &cell,
         "paper",
         &settings,
@@ -55,7 +59,7 @@ fn a_simulated_campaign_stops_at_the_target_and_resumes() {
     if s.steps.len() > 1 {
         let before = &s.steps[s.steps.len() - 2];
         assert_eq!(before.decision, Decision::Measure);
-        let worst = campaign::largest_sigma(&before.working);
+        let worst = campaign_largest_sigma(&before.working);
         assert!(
             worst > target || worst.is_nan() || !before.fit.as_ref().unwrap().status.is_converged()
         );
@@ -63,13 +67,13 @@ fn a_simulated_campaign_stops_at_the_target_and_resumes() {
     // The first batch is the fewest poses that identify the free set; later batches 5.
     assert_eq!(
         s.steps[0].poses.len(),
-        campaign::fewest_poses(&cell).unwrap()
+        campaign_fewest_poses(&cell).unwrap()
     );
     assert!(s.steps[1..].iter().all(|st| st.poses.len() == 5));
     // The σ's shrink as poses are added (more information never loses precision; the
     // variance-factor scale may move them a little).
-    let first = campaign::largest_sigma(&s.steps[1].working);
-    assert!(campaign::largest_sigma(&last.working) < first);
+    let first = campaign_largest_sigma(&s.steps[1].working);
+    assert!(campaign_largest_sigma(&last.working) < first);
 
     // Resume: the state written as JSON and read back, its second step replayed from the
     // state after the first one gives the same decision and σ's.
@@ -82,12 +86,12 @@ fn a_simulated_campaign_stops_at_the_target_and_resumes() {
     after_first.next = back.steps[1]
         .poses
         .iter()
-        .map(|p| campaign::CampaignPose {
+        .map(|p| CampaignPose {
             id: p.id.clone(),
             joints: p.joints.clone(),
         })
         .collect();
-    let again = campaign::step(&cell, &after_first, &back.steps[1].data, &mut Silent).unwrap();
+    let again = campaign_step(&cell, &after_first, &back.steps[1].data, &mut Silent).unwrap();
     let replayed = &again.state.steps[1];
     assert_eq!(replayed.decision, s.steps[1].decision);
     for (a, b) in replayed.working.iter().zip(&s.steps[1].working) {
@@ -100,13 +104,13 @@ fn a_simulated_campaign_stops_at_the_target_and_resumes() {
     let mut wrong = back.steps[1].data.clone();
     wrong.config_ids[0] = "999".into();
     let before = after_first.to_json().unwrap();
-    let e = campaign::step(&cell, &after_first, &wrong, &mut Silent)
+    let e = campaign_step(&cell, &after_first, &wrong, &mut Silent)
         .unwrap_err()
         .to_string();
     assert!(e.contains("missing poses") && e.contains("999"), "{e}");
     assert_eq!(after_first.to_json().unwrap(), before);
     // A stopped campaign takes no more batches.
-    let e = campaign::step(&cell, &back, &back.steps[1].data, &mut Silent)
+    let e = campaign_step(&cell, &back, &back.steps[1].data, &mut Silent)
         .unwrap_err()
         .to_string();
     assert!(e.contains("stopped"), "{e}");
@@ -129,7 +133,7 @@ fn the_next_batch_is_planned_at_the_estimate_not_the_nominal() {
         batch: 5,
         ..CampaignSettings::default()
     };
-    let state = campaign::start(&cell, "unplaced", &settings, &mut Silent).unwrap();
+    let state = campaign_start(&cell, "unplaced", &settings, &mut Silent).unwrap();
     let qs: Vec<Vec<f64>> = state.next.iter().map(|p| p.q(model)).collect();
     // Many more poses than the fewest, so that the first fit converges from afar.
     let mut qs2 = qs.clone();
@@ -138,12 +142,12 @@ fn the_next_batch_is_planned_at_the_estimate_not_the_nominal() {
     state.next = qs2
         .iter()
         .enumerate()
-        .map(|(i, q)| campaign::CampaignPose::of(model, (i + 1).to_string(), q))
+        .map(|(i, q)| CampaignPose::of(model, (i + 1).to_string(), q))
         .collect();
     let noise = cell.noise();
     let mut batch = armcal::sim::simulate(model, &truth, &qs2, Some(&noise), 7).unwrap();
     batch.config_ids = state.next.iter().map(|p| p.id.clone()).collect();
-    let r = campaign::step(&cell, &state, &batch, &mut Silent).unwrap();
+    let r = campaign_step(&cell, &state, &batch, &mut Silent).unwrap();
     let step = r.state.steps.last().unwrap();
     let fit = step.fit.as_ref().unwrap();
     assert!(fit.status.is_converged(), "{:?}", fit.status);
@@ -181,7 +185,7 @@ fn the_next_batch_is_planned_at_the_estimate_not_the_nominal() {
 #[test]
 fn the_fewest_poses_batch_is_fittable_at_the_robot_measured() {
     let cell = paper_cell();
-    let first = campaign::fewest_poses(&cell).unwrap();
+    let first = campaign_fewest_poses(&cell).unwrap();
     for seed in [1, 3] {
         let settings = CampaignSettings {
             target_sigma_mm: 0.7,
@@ -190,7 +194,7 @@ fn the_fewest_poses_batch_is_fittable_at_the_robot_measured() {
             seed,
             ..CampaignSettings::default()
         };
-        let run = campaign::simulate(
+        let run = campaign_simulate(
             &cell,
             "paper",
             &settings,
@@ -234,7 +238,7 @@ fn a_pose_the_instrument_cannot_measure_is_left_out_and_recorded() {
         };
         // a batch with no measurable pose, or one in collision, stops a run: not this test's
         let Ok(run) =
-            campaign::simulate(&cell, "paper", &settings, &perturbation, seed, &mut Silent)
+            campaign_simulate(&cell, "paper", &settings, &perturbation, seed, &mut Silent)
         else {
             continue;
         };
@@ -273,7 +277,7 @@ fn a_pose_the_instrument_cannot_measure_is_left_out_and_recorded() {
         if s.steps.iter().any(|st| !st.unmeasurable.is_empty()) {
             skipped_runs += 1;
             let back = CampaignState::from_json(&s.to_json().unwrap(), "state").unwrap();
-            let ids = |st: &campaign::CampaignStep| {
+            let ids = |st: &CampaignStep| {
                 st.unmeasurable
                     .iter()
                     .map(|p| p.id.clone())

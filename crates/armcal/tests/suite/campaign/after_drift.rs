@@ -3,16 +3,17 @@
 //! campaign measures until the TCP at the working pose is as precise as asked — with far
 //! fewer poses than a campaign from the nominal model, and with the moved parameter found.
 
-use armcal::campaign::drift::{check, CheckSettings, DriftVerdict};
-use armcal::campaign::prior::CampaignPrior;
-use armcal::campaign::simulate::measure_until_stopped;
-use armcal::campaign::{simulate, start_after_check, CampaignSettings, Decision};
 use armcal::cell::builtin::PAPER_CELL;
 use armcal::identify::{identify, IdentifySettings};
 use armcal::model::sampling::random_configurations;
 use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, Perturbation};
 use armcal::Cell;
+use armcal::{
+    campaign_measure_until_stopped as measure_until_stopped, campaign_simulate as simulate,
+    campaign_start_after_check as start_after_check, check, CampaignDecision as Decision,
+    CampaignPrior, CampaignSettings, CheckSettings, DriftVerdict,
+};
 
 #[test]
 fn a_campaign_from_the_old_calibration_needs_only_what_moved() {

@@ -3,13 +3,13 @@
 //! covariance is part of it: without it the rate is higher), and a joint offset or a moved
 //! tracker after the calibration is detected, with the moved group ranked first.
 
-use armcal::campaign::drift::{check, CheckSettings, DriftCheck, DriftVerdict};
 use armcal::cell::builtin::PAPER_CELL;
 use armcal::identify::{identify, Estimate, IdentifySettings};
 use armcal::model::sampling::random_configurations;
 use armcal::progress::Silent;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
 use armcal::Cell;
+use armcal::{check, CheckSettings, DriftCheck, DriftVerdict};
 
 fn paper_cell() -> Cell {
     Cell::from_toml(PAPER_CELL, "paper-cell.toml", ".".as_ref()).unwrap()

@@ -13,7 +13,7 @@ use armcal::measure::{csv, Covariates, Dataset, Measurement, MeasurementKind};
 use armcal::model::{export, Model, Observed};
 use armcal::sim::{perturbed_truth, Perturbation};
 use armcal::study::paper::{StudyRecord, StudyRow};
-use armcal::table::Table;
+use armcal::Table;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use std::path::Path;

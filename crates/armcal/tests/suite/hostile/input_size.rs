@@ -3,9 +3,9 @@
 
 use armcal::cell::Cell;
 use armcal::identify::Estimate;
-use armcal::input::{read_capped, TEXT_CAP};
 use armcal::model::urdf::read_urdf;
 use armcal::report::Document;
+use armcal::{read_capped, TEXT_CAP};
 use std::path::Path;
 
 const ZERO: &str = "/dev/zero";

@@ -9,8 +9,8 @@ use armcal::identify::*;
 use armcal::measure::{Dataset, NoiseModel};
 use armcal::model::random_configurations;
 use armcal::progress::Silent;
-use armcal::Status;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
+use armcal::Status;
 use common::example_cell;
 use std::path::Path;
 

@@ -6,8 +6,8 @@ use armcal::identify::*;
 use armcal::measure::{csv, MeasurementKind};
 use armcal::model::random_configurations;
 use armcal::progress::Silent;
-use armcal::Status;
 use armcal::sim::{perturbed_truth, simulate, Perturbation};
+use armcal::Status;
 use nalgebra::Vector3;
 use std::path::Path;
 

@@ -612,7 +612,7 @@ fn the_tcp_section_shows_every_working_pose() {
 /// the verdict and the groups' score tests with the likeliest mover marked.
 #[test]
 fn a_drift_check_record_is_a_report_input() {
-    use armcal::campaign::drift::{DriftCheck, DriftVerdict, GroupScore};
+    use armcal::{DriftCheck, DriftVerdict, GroupScore};
     let check = DriftCheck {
         cell: "paper-650-600".into(),
         calibrated_on: "data.csv".into(),
