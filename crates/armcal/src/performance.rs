@@ -73,6 +73,32 @@ pub const BEFORE: &str = "nominal robot, frames fitted to these data";
 
 /// The ISO 9283 test of `data` (measured on `cell`'s robot) before calibration and, given
 /// `calibrated`, after it.
+///
+/// ```
+/// use armcal::model::random_configurations;
+/// use armcal::{performance, perturbed_truth, simulate, Calibrated, PerformanceSettings};
+/// use armcal::{Perturbation, Silent};
+///
+/// # fn main() -> armcal::Result<()> {
+/// let cell = armcal::cell::builtin::paper_cell()?;
+/// let model = &cell.model;
+/// // A robot unlike its drawing visits 5 commanded poses 6 times each (measured
+/// // without noise).
+/// let truth = perturbed_truth(model, &Perturbation::default(), 3);
+/// let poses = random_configurations(model, 5, 1);
+/// let visits: Vec<Vec<f64>> = (0..6).flat_map(|_| poses.clone()).collect();
+/// let data = simulate(model, &truth, &visits, None, 2)?;
+/// let calibrated = Calibrated { name: "the true parameters".into(), params: &truth };
+/// let settings = PerformanceSettings::default();
+/// let record = performance(&cell, &data, Some(calibrated), &settings, &mut Silent)?;
+/// assert_eq!(record.grouping.poses, 5);
+/// // The true parameters predict what was measured; the drawing, frames fitted, does not.
+/// let after = record.after.expect("a calibrated model was given");
+/// assert!(after.report.errors.rms < 1e-6);
+/// assert!(record.before.report.errors.rms > 1e-3);
+/// # Ok(())
+/// # }
+/// ```
 pub fn performance(
     cell: &Cell,
     data: &Dataset,

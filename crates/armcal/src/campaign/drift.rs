@@ -148,6 +148,30 @@ pub fn group_of(name: &str) -> &str {
 
 /// Tests the check measurements `data` against `estimate` of `cell` (module docs): the χ²
 /// of the whitened residual under `S = J C_p Jᵀ + I` and a score test per parameter group.
+///
+/// ```
+/// use armcal::model::random_configurations;
+/// use armcal::{check, identify, perturbed_truth, simulate, CheckSettings, DriftVerdict};
+/// use armcal::{IdentifySettings, Perturbation, Silent};
+///
+/// # fn main() -> armcal::Result<()> {
+/// let cell = armcal::cell::builtin::paper_cell()?;
+/// let model = &cell.model;
+/// let truth = perturbed_truth(model, &Perturbation::default(), 5);
+/// let poses = random_configurations(model, 30, 2);
+/// let data = simulate(model, &truth, &poses, Some(&cell.noise()), 3)?;
+/// let estimate = identify(&cell, &data, &IdentifySettings::default(), &mut Silent)?;
+/// // Ten check poses after the tracker moved 5 mm along x: drifted, the tracker first.
+/// let mut moved = truth.clone();
+/// moved[model.registry.index_of("tracker.x").expect("the tracker's x")] += 5.0;
+/// let again = random_configurations(model, 10, 9);
+/// let after = simulate(model, &moved, &again, Some(&cell.noise()), 4)?;
+/// let c = check(&cell, &estimate, &after, &CheckSettings::default())?;
+/// assert_eq!(c.verdict, DriftVerdict::Drifted);
+/// assert_eq!(c.groups[0].group, "tracker");
+/// # Ok(())
+/// # }
+/// ```
 pub fn check(
     cell: &Cell,
     estimate: &Estimate,

@@ -289,6 +289,22 @@ pub struct Exported {
 /// suspicious values are judged against the cell's nominal model in the same form. The
 /// formats that write corrections against the nominal model need it:
 /// [`export_against_nominal`].
+///
+/// ```
+/// use armcal::{export_model, perturbed_truth, ExportFormat, Perturbation};
+///
+/// # fn main() -> armcal::Result<()> {
+/// let cell = armcal::cell::builtin::paper_cell()?;
+/// let model = &cell.model;
+/// // An identified robot (here a perturbed one) as a URDF file.
+/// let identified = model.spec_at(&perturbed_truth(model, &Perturbation::default(), 1));
+/// let urdf = export_model(&identified, Some(&cell), ExportFormat::Urdf)?;
+/// assert!(urdf.content.contains("<robot"));
+/// // Corrections against the nominal model need the estimate, not a model alone.
+/// assert!(export_model(&identified, None, ExportFormat::JointCorrections).is_err());
+/// # Ok(())
+/// # }
+/// ```
 pub fn export_model(
     identified: &ModelSpec,
     cell: Option<&Cell>,

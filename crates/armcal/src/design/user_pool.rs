@@ -165,6 +165,24 @@ fn minimum_poses(n: usize, rows: usize, prior_rank: usize) -> usize {
 /// Plans `settings.poses` poses for `cell` from the user's pose pool given as values: its
 /// joint rows (internal units: rad, mm), named `1`, `2`, … in messages and in the record
 /// ([`plan_from_pool`] with the rows of a file).
+///
+/// ```
+/// use armcal::model::random_configurations;
+/// use armcal::{plan_pool, PoolSettings, Silent};
+///
+/// # fn main() -> armcal::Result<()> {
+/// let cell = armcal::cell::builtin::paper_cell()?;
+/// // The poses the user can reach (here random ones, of which the cell's constraints
+/// // exclude most: the reflector faces away): choose the best 10.
+/// let pool = random_configurations(&cell.model, 300, 4);
+/// let settings = PoolSettings { poses: 10, ..PoolSettings::default() };
+/// let chosen = plan_pool(&cell, &pool, &settings, &mut Silent)?;
+/// assert_eq!(chosen.plan.design.len(), 10);
+/// // Every chosen pose is one of the pool's rows.
+/// assert!(chosen.plan.design.iter().all(|q| pool.contains(q)));
+/// # Ok(())
+/// # }
+/// ```
 pub fn plan_pool(
     cell: &Cell,
     pool: &[Vec<f64>],

@@ -34,6 +34,31 @@ fn cell_of(source: &str, design_file: &Path) -> Result<Cell, Error> {
 
 /// The report of `files` titled `title`; an estimate whose fit did not converge is refused
 /// unless `accept_unconverged` (the report then says so).
+///
+/// ```
+/// use armcal::model::random_configurations;
+/// use armcal::{files_report, identify, perturbed_truth, simulate, Acceptance};
+/// use armcal::{IdentifySettings, Perturbation, Silent};
+///
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// let cell = armcal::cell::builtin::paper_cell()?;
+/// let model = &cell.model;
+/// let truth = perturbed_truth(model, &Perturbation::default(), 5);
+/// let poses = random_configurations(model, 30, 2);
+/// let data = simulate(model, &truth, &poses, Some(&cell.noise()), 3)?;
+/// let estimate = identify(&cell, &data, &IdentifySettings::default(), &mut Silent)?;
+/// // The estimate file, as `armcal identify --out` writes it, and its report page.
+/// let dir = std::env::temp_dir().join(format!("armcal-doc-report-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// let file = dir.join("estimate.json");
+/// std::fs::write(&file, serde_json::to_string_pretty(&estimate)?)?;
+/// let accept = Acceptance { accepted: false, accept: "", raise_iterations: "" };
+/// let report = files_report(&[file], "Calibration", &accept)?;
+/// assert!(report.page.render().contains("<html"));
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok(())
+/// # }
+/// ```
 pub fn files_report(
     files: &[PathBuf],
     title: &str,

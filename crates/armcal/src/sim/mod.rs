@@ -386,6 +386,29 @@ pub fn simulate_poses(
 /// parameters `params` with the robot carrying `payload` (an index into [`Model::payloads`];
 /// `None`: none), without noise; `measured` as in [`simulate_poses`]; the data's source is
 /// "prediction".
+///
+/// ```
+/// use armcal::model::identifiability::Measurement;
+/// use armcal::model::random_configurations;
+/// use armcal::{predict, simulate};
+///
+/// # fn main() -> armcal::Result<()> {
+/// let cell = armcal::cell::builtin::paper_cell()?;
+/// let model = &cell.model;
+/// let poses: Vec<(String, Vec<f64>)> = random_configurations(model, 3, 1)
+///     .into_iter()
+///     .enumerate()
+///     .map(|(i, q)| (format!("p{i}"), q))
+///     .collect();
+/// // What the tracker would see of the nominal robot: noise-free simulation.
+/// let seen = predict(model, &model.nominal(), &poses, None, Measurement::Position)?;
+/// let qs: Vec<Vec<f64>> = poses.iter().map(|(_, q)| q.clone()).collect();
+/// let simulated = simulate(model, &model.nominal(), &qs, None, 0)?;
+/// assert_eq!(seen.config_ids, ["p0", "p1", "p2"]);
+/// assert_eq!(seen.measurements[1].kind, simulated.measurements[1].kind);
+/// # Ok(())
+/// # }
+/// ```
 pub fn predict(
     model: &Model,
     params: &[f64],
