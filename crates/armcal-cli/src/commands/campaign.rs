@@ -209,7 +209,7 @@ impl Files {
 }
 
 /// `next.csv` of a state: the poses to measure, or (stopped) none, with a note saying why.
-fn next_csv(cell: &armcal::Cell, state: &CampaignState) -> String {
+fn next_csv(cell: &armcal::Cell, state: &CampaignState) -> anyhow::Result<String> {
     let poses: Vec<(String, Vec<f64>)> = state
         .next
         .iter()
@@ -219,14 +219,14 @@ fn next_csv(cell: &armcal::Cell, state: &CampaignState) -> String {
         .iter()
         .map(|(id, q)| (id.clone(), q.as_slice()))
         .collect();
-    let text = csv::write_poses(&cell.model, &refs);
+    let text = cell.with_controller_columns(csv::write_poses(&cell.model, &refs))?;
     let note = (state.decision != Decision::Measure).then(|| {
         format!(
             "armcal: the campaign has stopped ({}); nothing more to measure",
             state.decision.words()
         )
     });
-    with_note(text, note.as_deref(), NoteStyle::Hash)
+    Ok(with_note(text, note.as_deref(), NoteStyle::Hash))
 }
 
 fn run_start(a: &StartArgs) -> anyhow::Result<()> {
@@ -245,7 +245,7 @@ fn run_start(a: &StartArgs) -> anyhow::Result<()> {
     )?;
     outputs.commit(&[
         (&files.state, &state.to_json()?),
-        (&files.next, &next_csv(&cell, &state)),
+        (&files.next, &next_csv(&cell, &state)?),
     ])?;
     println!(
         "campaign on `{}`: target TCP σ ≤ {} mm at {}; {}",
@@ -329,7 +329,7 @@ pub(super) fn step_files(
 ) -> anyhow::Result<Vec<(PathBuf, String)>> {
     let mut written = vec![
         (files.state.clone(), r.state.to_json()?),
-        (files.next.clone(), next_csv(cell, &r.state)),
+        (files.next.clone(), next_csv(cell, &r.state)?),
     ];
     if let Some(e) = &r.estimate {
         written.push((files.estimate.clone(), serde_json::to_string_pretty(e)?));

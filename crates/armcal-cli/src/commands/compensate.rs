@@ -108,6 +108,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         read_capped(targets, DATA_CAP)?,
         &targets.display().to_string(),
         model,
+        &cell.data_format(),
     )?;
     // the rows' joints: the program, or the Cartesian targets' starting configurations
     warn_outside_fitted_ranges(&est, model, &program.rows);
@@ -146,11 +147,12 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         },
         correction.as_ref(),
     )?;
+    let csv = cell.with_controller_columns(comp.csv)?;
     let with_payload = if model.payloads.is_empty() {
-        comp.csv
+        csv
     } else {
         with_note(
-            comp.csv,
+            csv,
             Some(&format!("compensated for {payload_how}")),
             NoteStyle::Hash,
         )

@@ -24,7 +24,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let outputs = Outputs::plan(a.force, &[Path::new(&a.cell), &a.data], &[&a.out])?;
     let cell = load_cell(&a.cell)?;
     let import = armcal::measure::csv::import(&a.data, &cell.model, &cell.data_format())?;
-    outputs.commit(&[(&a.out, &import.csv)])?;
+    outputs.commit(&[(&a.out, &cell.with_controller_columns(import.csv.clone())?)])?;
     super::output::print_read_report(&import.report);
     println!(
         "read {} measurements at {} configurations from {} → {}",

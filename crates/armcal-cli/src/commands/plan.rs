@@ -150,7 +150,10 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
         .zip(rep.design.iter().map(Vec::as_slice))
         .collect();
     outputs.commit(&[
-        (&a.out, &csv::write_poses(&cell.model, &poses)),
+        (
+            &a.out,
+            &cell.with_controller_columns(csv::write_poses(&cell.model, &poses))?,
+        ),
         (&report_path, &serde_json::to_string_pretty(&record)?),
     ])?;
     let with_measured = match record.measured {

@@ -48,10 +48,10 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         Some(est) => prediction_sigmas(model, &params, est, &data)?,
         None => None,
     };
-    let text = match &sigmas {
+    let text = cell.with_controller_columns(match &sigmas {
         Some(s) => csv_with_sigmas(&data, model, s)?,
         None => csv::write_string(&data, model)?,
-    };
+    })?;
     outputs.commit(&[(&a.out, &with_note(text, note.as_deref(), NoteStyle::Hash))])?;
     println!(
         "predicted {} measurements at {} configurations with the {} model → {}",

@@ -93,7 +93,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let payload = model
         .payload_index(a.payload.as_deref().unwrap_or("none"))
         .map_err(|e| anyhow::anyhow!("--payload: {e}"))?;
-    let poses = csv::read_reachable_configurations(&a.poses, model)?;
+    let poses = csv::read_reachable_configurations(&a.poses, model, &cell.controller)?;
     let unmeasurable = unmeasurable_poses(&cell, &poses)?;
     if !unmeasurable.is_empty() {
         let (n, total) = (unmeasurable.len(), poses.len());
@@ -133,7 +133,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         (!a.noise_free).then_some(&noise),
         a.seed,
     )?;
-    let data = csv::write_string(&sim.data, model)?;
+    let data = cell.with_controller_columns(csv::write_string(&sim.data, model)?)?;
     let truth = sim.truth.to_json()?;
     let mut files = vec![(a.out.as_path(), data.as_str())];
     files.extend(a.truth_out.as_deref().map(|t| (t, truth.as_str())));

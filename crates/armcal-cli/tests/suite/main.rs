@@ -11,6 +11,7 @@ mod check_cli;
 mod cli;
 mod collision_model_cli;
 mod compensate_cli;
+mod controller_columns_cli;
 mod degenerate_target_cli;
 mod deploy_cli;
 mod error_causes;

@@ -276,11 +276,29 @@ pub struct Cell {
 impl Cell {
     /// How this cell's data files are laid out: its `[data]` section, or armcal's own CSV.
     pub fn data_format(&self) -> crate::measure::format::DataFormat {
-        self.data_columns
+        use crate::measure::format::DataFormat;
+        let mut format = self
+            .data_columns
             .as_ref()
-            .map_or_else(crate::measure::format::DataFormat::armcal, |d| {
-                d.format.clone()
-            })
+            .map_or_else(DataFormat::armcal, |d| d.format.clone());
+        format.controller_columns = DataFormat::armcal_for(&self.controller).controller_columns;
+        format
+    }
+
+    /// armcal's joint CSV `text` (a pose list, design, data file or compensated program) as
+    /// this cell writes it: with the controller's axis columns (`q2_controller_deg`) after
+    /// the model's when the cell's `[robot.controller]` is not the identity
+    /// ([`crate::measure::csv::with_controller_columns`]); else `text` itself.
+    pub fn with_controller_columns(&self, text: String) -> Result<String, Error> {
+        if self.controller.is_identity() {
+            return Ok(text);
+        }
+        crate::measure::csv::with_controller_columns(
+            &text,
+            "armcal's output",
+            &self.model,
+            &self.controller,
+        )
     }
 
     /// The instrument's noise model; [`NoiseModel::default`] for a cell without an

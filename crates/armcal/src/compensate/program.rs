@@ -16,6 +16,7 @@
 use crate::compensate::ik::{CalibratedIk, IkResult, IkSettings, IkStatus, IkTarget};
 use crate::compensate::joint_change::{self, within_joint_change_limit};
 use crate::compensate::nonparametric::ResidualCorrection;
+use crate::measure::format::DataFormat;
 use crate::measure::{csv, MeasurementKind};
 use crate::model::{forward_kinematics, Data, Model, Pose};
 use crate::table::Table;
@@ -458,20 +459,30 @@ pub struct ProgramFile {
     pub cartesian: bool,
     /// `(pose_id, q)` per row: the program, or the Cartesian targets' starting guesses.
     pub rows: Vec<(String, Vec<f64>)>,
+    /// How its joint columns are laid out.
+    pub format: DataFormat,
 }
 
 impl ProgramFile {
-    /// Reads a program file's text for `model`.
-    pub fn read(text: String, file: &str, model: &Model) -> Result<ProgramFile, Error> {
+    /// Reads a program file's text for `model`, its joint columns laid out as `format` says
+    /// (a cell's [`crate::cell::Cell::data_format`]: armcal's own `q1_deg` … model columns,
+    /// `q1_controller_deg` … controller columns, or the cell's `[data]` mapping).
+    pub fn read(
+        text: String,
+        file: &str,
+        model: &Model,
+        format: &DataFormat,
+    ) -> Result<ProgramFile, Error> {
         let cartesian = csv::header_str(&text, file)?
             .iter()
             .any(|h| h.starts_with("roll"));
-        let rows = csv::read_configurations_str(&text, file, model, None)?;
+        let rows = csv::read_configurations_format_str(&text, file, model, format)?;
         Ok(ProgramFile {
             file: file.into(),
             cartesian,
             rows,
             text,
+            format: format.clone(),
         })
     }
 }
@@ -542,7 +553,12 @@ pub fn compensate_program(
         robot_only.instrument = None;
         robot_only.targets.clear();
         let robot = Model::from_spec(&robot_only)?;
-        let data = csv::read_targets_str(text, file, &robot)?;
+        let data = csv::read_targets_str(
+            text,
+            file,
+            &robot,
+            program.format.controller_columns.as_ref(),
+        )?;
         let rows = data
             .measurements
             .iter()

@@ -218,13 +218,15 @@ pub(super) fn choose(
             (train.subset(&fit_idx), train.subset(&held_idx))
         })
         .collect();
-    // Every candidate's fold errors; the candidates and their folds run in parallel.
-    let fold_errors: Vec<Vec<Vec<f64>>> = offered
+    // Every candidate's term count and fold errors; the candidates and their folds run in
+    // parallel.
+    let fitted: Vec<(usize, Vec<Vec<f64>>)> = offered
         .par_iter()
         .map(|&candidate| {
             let left_out = candidate.left_out(&cell.model)?;
             let whole = fit_free_set(cell, train, noise, &inner, &left_out, &mut Silent)?;
-            folds_of
+            let terms = cell.model.joint_corrections().count() - left_out.len();
+            let errors = folds_of
                 .par_iter()
                 .map(|(fit_data, held)| {
                     let mut problem = Problem::new(&whole.model, fit_data, noise)?;
@@ -233,12 +235,12 @@ pub(super) fn choose(
                     let eval = Problem::new(&whole.model, held, noise)?;
                     Ok(eval.errors(&mut eval.workspace(), &fit.params))
                 })
-                .collect()
+                .collect::<Result<_, Error>>()?;
+            Ok((terms, errors))
         })
         .collect::<Result<_, Error>>()?;
     let mut candidates = Vec::new();
-    for (&candidate, fold_errors) in offered.iter().zip(fold_errors) {
-        let left_out = candidate.left_out(&cell.model)?;
+    for (&candidate, (terms, fold_errors)) in offered.iter().zip(fitted) {
         let mut errors = Vec::new();
         let mut fold_rms = Vec::new();
         for e in fold_errors {
@@ -246,7 +248,6 @@ pub(super) fn choose(
             errors.extend(e);
             observer.step();
         }
-        let terms = cell.model.joint_corrections().count() - left_out.len();
         let mean = fold_rms.iter().sum::<f64>() / folds as f64;
         let var = fold_rms.iter().map(|r| (r - mean).powi(2)).sum::<f64>() / (folds - 1) as f64;
         candidates.push(CandidateScore {

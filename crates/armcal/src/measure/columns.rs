@@ -5,13 +5,30 @@
 
 use crate::measure::angles::Orientation;
 use crate::measure::format::{angle_factor, length_factor, ColumnUnit, Columns, DataFormat};
-use crate::model::{JointKind, Model};
+use crate::model::controller::ControllerConvention;
+use crate::model::{Joint, JointKind, Model};
 use crate::Error;
 
 /// A resolved column: its index in the header and the factor to internal units.
 pub(crate) struct Column {
     pub index: usize,
     pub factor: f64,
+}
+
+/// The joint columns of a file: the model's joint variables, the controller's axis values
+/// with the convention that maps them, or both ([`DataFormat::joint_layout`]).
+pub(crate) struct JointColumns {
+    /// One column per model joint (`q2_deg`); `None`: the joints are read from `controller`.
+    pub model: Option<Vec<Column>>,
+    /// One column per joint in the controller's angles (`q2_controller_deg`) and the
+    /// convention that maps them to the model's.
+    pub controller: Option<(Vec<Column>, ControllerConvention)>,
+}
+
+/// The name, without its unit suffix, of joint `joint`'s controller column in armcal's own
+/// files: `q2` → `q2_controller` (written `q2_controller_deg`).
+pub(crate) fn controller_base(joint: &str) -> String {
+    format!("{joint}_controller")
 }
 
 /// What the σ columns of an orientation are σ of.
@@ -25,7 +42,7 @@ pub(crate) enum SigmaOf {
 
 /// A format resolved against a file's header.
 pub(crate) struct Layout {
-    pub joints: Vec<Column>,
+    pub joints: JointColumns,
     pub position: [Column; 3],
     pub orientation: Option<(Vec<Column>, Orientation)>,
     pub sigma_position: Option<[Column; 3]>,
@@ -119,63 +136,128 @@ fn split_unit(name: &str) -> (&str, &str) {
 
 impl DataFormat {
     /// The column of every joint, with its unit factor; marks the columns used.
+    ///
+    /// In armcal's own naming (no `[data] joints`), `q2_deg` is the model's joint variable
+    /// and `q2_controller_deg` the controller's axis value (the cell's `[robot.controller]`,
+    /// [`crate::model::controller`]). A file may carry either set or both; with both, each
+    /// row's controller values are checked against its model values.
     pub(crate) fn joint_layout(
         &self,
         header: &[String],
         model: &Model,
         file: &str,
         used: &mut [bool],
-    ) -> Result<Vec<Column>, Error> {
-        let find = |name: &str| header.iter().position(|h| h == name);
-        let mut joints = Vec::new();
-        for (j, joint) in model.joints.iter().enumerate() {
-            let col = match &self.joints {
-                Some(names) => {
-                    let name = &names[j];
-                    let i = find(name).ok_or_else(|| err(file, format!("header: no column `{name}` for joint `{}` (named in the cell's [data] joints)", joint.name)))?;
-                    (i, split_unit(name).1.to_string())
-                }
-                None => {
-                    let candidates: Vec<usize> = header
-                        .iter()
-                        .enumerate()
-                        .filter(|(_, h)| split_unit(h).0 == joint.name || h.as_str() == joint.name)
-                        .map(|(i, _)| i)
-                        .collect();
-                    match candidates.as_slice() {
-                        [i] => (*i, split_unit(&header[*i]).1.to_string()),
-                        [] => {
-                            return Err(err(
-                                file,
-                                format!(
-                                    "header: no column for joint `{}` (expected e.g. `{}`)",
-                                    joint.name,
-                                    super::csv::joint_column(joint)
-                                ),
-                            ))
-                        }
-                        _ => {
-                            return Err(err(
-                                file,
-                                format!("header: joint `{}` has several columns", joint.name),
-                            ))
-                        }
-                    }
-                }
-            };
-            let factor = match (self.joint_unit, joint.kind) {
-                (Some(u), _) => Some(u.factor()),
-                (None, JointKind::Revolute) => angle_factor(&col.1),
-                (None, JointKind::Prismatic) => length_factor(&col.1),
-            }
-            .ok_or_else(|| err(file, format!("column `{}`: unknown unit suffix `{}` for joint `{}` (use deg or rad for revolute, mm, m or in for prismatic joints)", header[col.0], col.1, joint.name)))?;
-            used[col.0] = true;
-            joints.push(Column {
-                index: col.0,
-                factor,
+    ) -> Result<JointColumns, Error> {
+        if let Some(names) = &self.joints {
+            let columns = model
+                .joints
+                .iter()
+                .zip(names)
+                .map(|(joint, name)| {
+                    let i = header.iter().position(|h| h == name).ok_or_else(|| err(file, format!("header: no column `{name}` for joint `{}` (named in the cell's [data] joints)", joint.name)))?;
+                    self.joint_column(header, i, joint, file, used)
+                })
+                .collect::<Result<_, Error>>()?;
+            return Ok(JointColumns {
+                model: Some(columns),
+                controller: None,
             });
         }
-        Ok(joints)
+        // the one column whose name without its unit suffix is `base` (or `base` itself)
+        let unique = |base: &str, joint: &str| -> Result<Option<usize>, Error> {
+            let mut found = header
+                .iter()
+                .enumerate()
+                .filter(|(_, h)| split_unit(h).0 == base || h.as_str() == base)
+                .map(|(i, _)| i);
+            match (found.next(), found.next()) {
+                (Some(_), Some(_)) => Err(err(
+                    file,
+                    format!("header: joint `{joint}` has several columns"),
+                )),
+                (i, _) => Ok(i),
+            }
+        };
+        let mut own = Vec::new();
+        let mut controller = Vec::new();
+        for joint in &model.joints {
+            own.push(unique(&joint.name, &joint.name)?);
+            controller.push(unique(&controller_base(&joint.name), &joint.name)?);
+        }
+        let all = |c: &[Option<usize>]| c.iter().all(Option::is_some);
+        let resolve = |c: &[Option<usize>], used: &mut [bool]| -> Result<Vec<Column>, Error> {
+            c.iter()
+                .zip(&model.joints)
+                .map(|(i, joint)| self.joint_column(header, i.expect("all"), joint, file, used))
+                .collect()
+        };
+        let controller = match (all(&controller), &self.controller_columns) {
+            (true, Some(c)) => Some((resolve(&controller, used)?, c.clone())),
+            (true, None) if all(&own) => {
+                // a file written for a cell with a controller convention, read without it:
+                // the model's columns hold the same configuration
+                controller.iter().flatten().for_each(|&i| used[i] = true);
+                None
+            }
+            (true, None) => {
+                return Err(err(
+                    file,
+                    format!(
+                        "header: the joints have controller columns (`{}`) but no model \
+                         columns, and the cell has no [robot.controller] that maps them: \
+                         add the section to the cell, or give the model's columns (`{}`)",
+                        header[controller[0].expect("all")],
+                        super::csv::joint_column(&model.joints[0])
+                    ),
+                ))
+            }
+            (false, _) => None,
+        };
+        let own = if all(&own) {
+            Some(resolve(&own, used)?)
+        } else if controller.is_some() && own.iter().all(Option::is_none) {
+            None
+        } else {
+            let (joint, _) = model
+                .joints
+                .iter()
+                .zip(&own)
+                .find(|(_, i)| i.is_none())
+                .expect("a joint without a column");
+            return Err(err(
+                file,
+                format!(
+                    "header: no column for joint `{}` (expected e.g. `{}`)",
+                    joint.name,
+                    super::csv::joint_column(joint)
+                ),
+            ));
+        };
+        Ok(JointColumns {
+            model: own,
+            controller,
+        })
+    }
+
+    /// Joint `joint`'s column `i` with the factor of its unit (the format's `joint_unit`, or
+    /// the name's suffix); marks it used.
+    fn joint_column(
+        &self,
+        header: &[String],
+        i: usize,
+        joint: &Joint,
+        file: &str,
+        used: &mut [bool],
+    ) -> Result<Column, Error> {
+        let suffix = split_unit(&header[i]).1;
+        let factor = match (self.joint_unit, joint.kind) {
+            (Some(u), _) => Some(u.factor()),
+            (None, JointKind::Revolute) => angle_factor(suffix),
+            (None, JointKind::Prismatic) => length_factor(suffix),
+        }
+        .ok_or_else(|| err(file, format!("column `{}`: unknown unit suffix `{suffix}` for joint `{}` (use deg or rad for revolute, mm, m or in for prismatic joints)", header[i], joint.name)))?;
+        used[i] = true;
+        Ok(Column { index: i, factor })
     }
 
     /// Resolves the format against a file's header (`file` names it in errors).

@@ -27,9 +27,10 @@
 //! Other columns are ignored and listed in [`ReadReport::ignored`]; a known column with an
 //! unknown unit suffix is an error.
 
-use crate::measure::columns::{explain_header, Column, SigmaOf};
+use crate::measure::columns::{controller_base, explain_header, Column, JointColumns, SigmaOf};
 use crate::measure::format::{clean, number, DataFormat, Decimal};
 use crate::measure::{Covariates, Dataset, Measurement, MeasurementKind};
+use crate::model::controller::ControllerConvention;
 use crate::model::{Joint, JointKind, Model, Observed, Pose};
 use crate::table;
 use crate::Error;
@@ -243,6 +244,55 @@ impl Row<'_> {
             .map(|(c, j)| self.value(c, &j.name))
             .collect()
     }
+
+    /// The row's configuration as the model's joint variables: from the model's columns
+    /// (through the format's convention if they hold controller angles), or from armcal's
+    /// controller columns through the cell's convention. With both, every controller value
+    /// must give the model's to [`CONTROLLER_COLUMN_TOLERANCE`]: a user who edited one set
+    /// and not the other gets an error naming the line and column, not either set silently.
+    fn model_joints(
+        &self,
+        columns: &JointColumns,
+        format: &DataFormat,
+        model: &Model,
+    ) -> Result<Vec<f64>, Error> {
+        let controller = match &columns.controller {
+            Some((cols, convention)) => {
+                Some((cols, convention.to_model(&self.joints(cols, model)?)))
+            }
+            None => None,
+        };
+        let Some(own) = &columns.model else {
+            return Ok(controller
+                .expect("a joint layout has model or controller columns")
+                .1);
+        };
+        let q = format.model_joints(self.joints(own, model)?);
+        if let Some((cols, from_controller)) = controller {
+            for (k, joint) in model.joints.iter().enumerate() {
+                let tolerance = CONTROLLER_COLUMN_TOLERANCE.of(joint.kind);
+                if (from_controller[k] - q[k]).abs() > tolerance {
+                    let f = joint.kind.unit().display_factor();
+                    return Err(err(
+                        self.file,
+                        format!(
+                            "line {}: `{}` gives joint `{}` = {:.6} {u} through the cell's \
+                             [robot.controller], but `{}` says {:.6} {u}: the two sets of \
+                             joint columns disagree; correct one, or delete one set",
+                            self.line,
+                            self.header[cols[k].index],
+                            joint.name,
+                            from_controller[k] * f,
+                            self.header[own[k].index],
+                            q[k] * f,
+                            u = joint.kind.unit().display_name(),
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(q)
+    }
 }
 
 /// The column names of an armcal CSV file's text (its first line that is not a comment),
@@ -311,12 +361,15 @@ pub fn read_configurations_format_str(
 /// As [`read_configurations`] (armcal's joint columns), for poses the robot must take (a
 /// pose list to measure): a row with a joint outside its limits is an error naming the
 /// file, line, pose and joint.
+/// `controller`: the cell's convention, for controller joint columns (`q1_controller_deg`).
 pub fn read_reachable_configurations(
     path: &Path,
     model: &Model,
+    controller: &ControllerConvention,
 ) -> Result<Vec<(String, Vec<f64>)>, Error> {
     let (file, text) = read_data_file(path)?;
-    configurations(&text, &file, model, &DataFormat::armcal(), Limits::Checked)
+    let format = DataFormat::armcal_for(controller);
+    configurations(&text, &file, model, &format, Limits::Checked)
 }
 
 /// The rows of a joint-configuration file; with [`Limits::Checked`] every row within the
@@ -345,7 +398,7 @@ fn configurations(
             line,
             decimal: format.decimal,
         };
-        let q = format.model_joints(row.joints(&joints, model)?);
+        let q = row.model_joints(&joints, format, model)?;
         let id = id_col
             .map(|c| row.text(c).to_string())
             .unwrap_or_else(|| format!("{}", r + 1));
@@ -422,8 +475,12 @@ fn mapped_or_own<T>(
     format: &DataFormat,
     read: impl Fn(&DataFormat) -> Result<T, Error>,
 ) -> Result<(T, bool), Error> {
-    // armcal's own columns: a file armcal wrote (`import`), in model angles.
-    let own = DataFormat::armcal();
+    // armcal's own columns: a file armcal wrote (`import`), in model angles (and the
+    // controller's in their own columns).
+    let own = DataFormat {
+        controller_columns: format.controller_columns.clone(),
+        ..DataFormat::armcal()
+    };
     match read(format) {
         Err(Error::File { file, message }) if message.starts_with("header:") && *format != own => {
             match read(&own) {
@@ -437,8 +494,18 @@ fn mapped_or_own<T>(
 
 /// Cartesian targets in armcal's data format (a program of tool poses): the joint columns
 /// are IK seeds, not measured joint values, so they are not checked against the limits.
-pub fn read_targets_str(text: &str, file: &str, model: &Model) -> Result<Dataset, Error> {
-    read_rows(text, file, model, &DataFormat::armcal(), Limits::Unchecked).map(|(d, _)| d)
+/// `controller`: the cell's convention, for controller joint columns (`q1_controller_deg`).
+pub fn read_targets_str(
+    text: &str,
+    file: &str,
+    model: &Model,
+    controller: Option<&ControllerConvention>,
+) -> Result<Dataset, Error> {
+    let format = DataFormat {
+        controller_columns: controller.cloned(),
+        ..DataFormat::armcal()
+    };
+    read_rows(text, file, model, &format, Limits::Unchecked).map(|(d, _)| d)
 }
 
 /// Whether the joint values of a file are checked against the model's limits (measured joints
@@ -477,7 +544,7 @@ fn read_rows(
             line,
             decimal: format.decimal,
         };
-        let q = format.model_joints(row.joints(&layout.joints, model)?);
+        let q = row.model_joints(&layout.joints, format, model)?;
         if limits == Limits::Checked {
             warnings.extend(row.limit_check(&q, model)?);
         }
@@ -756,6 +823,113 @@ pub fn write_string_with(
         w.row(&row);
     }
     Ok(w.into_string())
+}
+
+/// How far a row's controller columns may be from its model columns (1e-5° / 1e-5 mm: above
+/// the rounding of the six decimals armcal writes, far below any real error).
+pub(crate) const CONTROLLER_COLUMN_TOLERANCE: crate::model::LimitTolerance =
+    crate::model::LimitTolerance {
+        revolute: 1e-5 * std::f64::consts::PI / 180.0,
+        prismatic: 1e-5,
+    };
+
+/// armcal's joint CSV `text` (a pose list, design, data file or compensated program, with
+/// the model's joint columns `q1_deg` …) with each joint's controller column
+/// (`q1_controller_deg` …: the controller's axis value under `convention`, the cell's
+/// `[robot.controller]`) inserted after the last model joint column, each value to as many
+/// decimals as its model value. The text is returned unchanged when `convention` is the
+/// identity. Leading comment lines (`#`) are kept; every other field is kept as read.
+/// `file` names the text in errors (a file armcal wrote itself has none).
+pub fn with_controller_columns(
+    text: &str,
+    file: &str,
+    model: &Model,
+    convention: &ControllerConvention,
+) -> Result<String, Error> {
+    if convention.is_identity() {
+        return Ok(text.to_string());
+    }
+    let body_start = text
+        .split_inclusive('\n')
+        .take_while(|l| l.starts_with('#'))
+        .map(str::len)
+        .sum::<usize>();
+    let (comments, body) = text.split_at(body_start);
+    let mut rdr = ::csv::ReaderBuilder::new().from_reader(body.as_bytes());
+    let header: Vec<String> = rdr
+        .headers()
+        .map_err(|e| err(file, format!("header: {e}")))?
+        .iter()
+        .map(str::to_string)
+        .collect();
+    let columns = model
+        .joints
+        .iter()
+        .map(|j| {
+            let name = joint_column(j);
+            header.iter().position(|h| *h == name).ok_or_else(|| {
+                err(
+                    file,
+                    format!("header: no column `{name}` to map to the controller's axes"),
+                )
+            })
+        })
+        .collect::<Result<Vec<usize>, Error>>()?;
+    let at = columns.iter().max().map_or(header.len(), |&i| i + 1);
+    let insert = |fields: &mut Vec<String>, new: Vec<String>| {
+        let tail = fields.split_off(at);
+        fields.extend(new);
+        fields.extend(tail);
+    };
+    let mut h = header.clone();
+    insert(
+        &mut h,
+        model
+            .joints
+            .iter()
+            .map(|j| {
+                let unit = j.kind.unit().display_name();
+                format!("{}_{unit}", controller_base(&j.name))
+            })
+            .collect(),
+    );
+    let mut t = table::Table::new(&h);
+    for (r, record) in rdr.records().enumerate() {
+        let line = r + 2 + comments.lines().count();
+        let record = record.map_err(|e| err(file, format!("line {line}: {e}")))?;
+        let mut fields: Vec<String> = record.iter().map(str::to_string).collect();
+        let shown: Vec<&str> = columns
+            .iter()
+            .map(|&c| record.get(c).unwrap_or(""))
+            .collect();
+        let q = shown
+            .iter()
+            .zip(&model.joints)
+            .map(|(v, j)| {
+                v.parse::<f64>()
+                    .map(|v| v / joint_display(j, 1.0))
+                    .map_err(|_| {
+                        err(
+                            file,
+                            format!("line {line}: `{}` = `{v}` is not a number", joint_column(j)),
+                        )
+                    })
+            })
+            .collect::<Result<Vec<f64>, Error>>()?;
+        let controller = convention.to_controller(&q);
+        let values = controller
+            .iter()
+            .zip(&model.joints)
+            .zip(&shown)
+            .map(|((c, j), v)| {
+                let decimals = v.split_once('.').map_or(0, |(_, d)| d.len());
+                format!("{:.decimals$}", joint_display(j, *c))
+            })
+            .collect();
+        insert(&mut fields, values);
+        t.row(&fields);
+    }
+    Ok(format!("{comments}{}", t.into_string()))
 }
 
 /// The column name of a joint in the data files armcal writes: its name with the unit of

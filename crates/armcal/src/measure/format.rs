@@ -172,6 +172,11 @@ pub struct DataFormat {
     /// mapped to the model's joints by this convention on reading (`None`: model angles).
     #[serde(default)]
     pub controller: Option<ControllerConvention>,
+    /// The cell's controller convention, for the `<joint>_controller_<unit>` columns of
+    /// armcal's own files (`None`: the cell's convention is the identity, or unknown; such
+    /// columns are then ignored beside the model's and an error alone).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub controller_columns: Option<ControllerConvention>,
 }
 
 impl Default for DataFormat {
@@ -194,6 +199,7 @@ impl DataFormat {
             sigma_orientation: None,
             temperature: None,
             controller: None,
+            controller_columns: None,
         }
     }
 
@@ -204,6 +210,15 @@ impl DataFormat {
         match &self.controller {
             Some(c) => c.to_model(&q),
             None => q,
+        }
+    }
+
+    /// armcal's own CSV for a cell whose controller convention is `convention`: its
+    /// `<joint>_controller_<unit>` columns are read through it.
+    pub fn armcal_for(convention: &ControllerConvention) -> DataFormat {
+        DataFormat {
+            controller_columns: (!convention.is_identity()).then(|| convention.clone()),
+            ..DataFormat::armcal()
         }
     }
 
@@ -274,6 +289,15 @@ impl DataFormat {
     pub fn check(&self, model: &Model) -> Result<(), String> {
         if self.decimal == Decimal::Comma && self.delimiter == ',' {
             return Err("`decimal = \",\"` needs another `delimiter` (e.g. \";\")".into());
+        }
+        if self.controller.is_some() && self.joints.is_none() {
+            return Err(
+                "`angles = \"controller\"` says which angles the columns named in \
+                        `joints` hold: add `joints = [...]`. (armcal's own columns need no \
+                        setting: `q2_deg` is the model's joint, `q2_controller_deg` the \
+                        controller's axis, read through [robot.controller].)"
+                    .into(),
+            );
         }
         if let Some(j) = &self.joints {
             if j.len() != model.dof() {

@@ -161,23 +161,23 @@ mod tests {
         assert_eq!(back.controller.joints, c.controller.joints, "{text}");
     }
 
-    /// A data file in controller angles reads as the model's joints, with armcal's column
-    /// names and with the cell's; a file in armcal's own columns read through a `[data]
-    /// joints` mapping is one armcal wrote (`import`): model angles.
+    /// A data file in controller angles reads as the model's joints, in armcal's controller
+    /// columns (`q2_controller_deg`, no setting needed) and in the cell's mapped columns
+    /// (`angles = "controller"`); armcal's model columns (`q2_deg`) are model angles always,
+    /// also when read through a mapping (a file armcal wrote, e.g. by `import`).
     #[test]
     fn data_in_controller_angles_read_as_model_angles() {
-        let csv = "pose_id,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg\np1,10,20,30,40,50,60\n";
+        let own = "pose_id,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg\np1,10,20,30,40,50,60\n";
+        let controller = own.replace("_deg", "_controller_deg");
         let named = "pose_id,a1,a2,a3,a4,a5,a6\np1,10,20,30,40,50,60\n";
         let mapping =
             "joints = [\"a1\", \"a2\", \"a3\", \"a4\", \"a5\", \"a6\"]\njoint_unit = \"deg\"\n";
+        let convention = "[robot.controller]\nq2 = { sign = -1, offset_deg = -90 }\n";
         for (data, csv) in [
-            ("[data]\nangles = \"controller\"\n".to_string(), csv),
+            (String::new(), controller.as_str()),
             (format!("[data]\nangles = \"controller\"\n{mapping}"), named),
         ] {
-            let c = cell(&format!(
-                "[robot.controller]\nq2 = {{ sign = -1, offset_deg = -90 }}\n{data}"
-            ))
-            .unwrap();
+            let c = cell(&format!("{convention}{data}")).unwrap();
             let rows =
                 read_configurations_format_str(csv, "d.csv", &c.model, &c.data_format()).unwrap();
             let deg: Vec<f64> = rows[0].1.iter().map(|q| q.to_degrees()).collect();
@@ -185,25 +185,124 @@ mod tests {
                 (deg[1] + 110.0).abs() < 1e-9 && (deg[2] - 30.0).abs() < 1e-9,
                 "{deg:?}"
             );
-            assert!(c
-                .data_format()
-                .to_toml()
-                .contains("angles = \"controller\""));
         }
         let c = cell(&format!(
-            "[robot.controller]\nq2 = {{ sign = -1 }}\n[data]\nangles = \"controller\"\n{mapping}"
+            "{convention}[data]\nangles = \"controller\"\n{mapping}"
         ))
         .unwrap();
-        let own = read_configurations_format_str(csv, "d.csv", &c.model, &c.data_format()).unwrap();
-        assert!((own[0].1[1].to_degrees() - 20.0).abs() < 1e-9);
-        let model_angles = cell("[data]\nangles = \"model\"\n").unwrap();
-        let rows = read_configurations_format_str(
-            csv,
+        assert!(c
+            .data_format()
+            .to_toml()
+            .contains("angles = \"controller\""));
+        let rows =
+            read_configurations_format_str(own, "d.csv", &c.model, &c.data_format()).unwrap();
+        assert!((rows[0].1[1].to_degrees() - 20.0).abs() < 1e-9);
+        // without a convention, controller columns alone cannot be read
+        let plain = cell("").unwrap();
+        let e = read_configurations_format_str(
+            &controller,
             "d.csv",
-            &model_angles.model,
-            &model_angles.data_format(),
+            &plain.model,
+            &plain.data_format(),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("no [robot.controller]") && e.contains("q1_controller_deg"),
+            "{e}"
+        );
+    }
+
+    /// `angles = "controller"` names which columns hold controller angles: without
+    /// `joints` it would make armcal's own `q2_deg` (model angles) ambiguous.
+    #[test]
+    fn controller_angles_need_named_columns() {
+        let e = cell("[robot.controller]\nq2 = { sign = -1 }\n[data]\nangles = \"controller\"\n")
+            .unwrap_err();
+        assert!(
+            e.contains("add `joints = [...]`") && e.contains("q2_controller_deg"),
+            "{e}"
+        );
+    }
+
+    /// What armcal writes for a cell with a convention carries the controller's columns
+    /// beside the model's; either set reads back as the same configurations, and a row whose
+    /// two sets disagree is an error naming the line and both columns.
+    #[test]
+    fn written_controller_columns_read_back() {
+        use crate::measure::csv::{read_configurations_format_str as read, write_poses};
+        let c = cell(
+            "[robot.controller]\nq2 = { sign = -1, offset_deg = -90 }\nq3 = { offset_deg = 90 }\n\
+             q5 = { sign = -1 }\n",
         )
         .unwrap();
-        assert!((rows[0].1[1].to_degrees() - 20.0).abs() < 1e-9);
+        let qs: Vec<Vec<f64>> = (0..5)
+            .map(|k| {
+                (0..6)
+                    .map(|j| 0.1 * (k + 1) as f64 - 0.07 * j as f64)
+                    .collect()
+            })
+            .collect();
+        let poses: Vec<(String, &[f64])> = qs
+            .iter()
+            .enumerate()
+            .map(|(k, q)| (format!("p{k}"), q.as_slice()))
+            .collect();
+        let written = c
+            .with_controller_columns(write_poses(&c.model, &poses))
+            .unwrap();
+        let header = written.lines().next().unwrap();
+        assert!(
+            header.starts_with(
+                "pose_id,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg,q1_controller_deg,"
+            ),
+            "{header}"
+        );
+        // the controller's q2 of the first row: −(q2 − (−90°))
+        let row: Vec<f64> = written
+            .lines()
+            .nth(1)
+            .unwrap()
+            .split(',')
+            .skip(1)
+            .map(|v| v.parse().unwrap())
+            .collect();
+        assert!((row[7] + (row[1] + 90.0)).abs() < 2e-6, "{row:?}");
+        let format = c.data_format();
+        let both = read(&written, "w.csv", &c.model, &format).unwrap();
+        // the controller's set alone: drop the model columns
+        let controller_only: String = written
+            .lines()
+            .map(|l| {
+                l.split(',')
+                    .enumerate()
+                    .filter(|(i, _)| !(1..=6).contains(i))
+                    .map(|(_, f)| f)
+                    .collect::<Vec<_>>()
+                    .join(",")
+                    + "\n"
+            })
+            .collect();
+        let alone = read(&controller_only, "c.csv", &c.model, &format).unwrap();
+        for ((a, b), q) in both.iter().zip(&alone).zip(&qs) {
+            for k in 0..6 {
+                assert!((a.1[k] - q[k]).abs() < 1e-7 && (b.1[k] - q[k]).abs() < 1e-7);
+            }
+        }
+        // a user edits q5 in the controller's columns only
+        let mut lines: Vec<String> = written.lines().map(str::to_string).collect();
+        let mut fields: Vec<String> = lines[2].split(',').map(str::to_string).collect();
+        fields[11] = format!("{:.6}", fields[11].parse::<f64>().unwrap() + 0.5);
+        lines[2] = fields.join(",");
+        let e = read(&(lines.join("\n") + "\n"), "e.csv", &c.model, &format)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("e.csv")
+                && e.contains("line 3")
+                && e.contains("`q5_controller_deg`")
+                && e.contains("`q5_deg`"),
+            "{e}"
+        );
     }
 }

@@ -198,6 +198,7 @@ pub(super) fn data_columns(
         sigma_orientation: three(ctx, d.sigma_orientation.as_ref(), "data.sigma_orientation")?,
         temperature,
         controller,
+        controller_columns: DataFormat::armcal_for(convention).controller_columns,
     };
     format.check(model).map_err(|m| ctx.err(span, "data", m))?;
     Ok(Some(DataColumns {

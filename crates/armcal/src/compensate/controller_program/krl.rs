@@ -206,7 +206,16 @@ impl Dialect for Krl {
                 .map_or(len, |p| start + p);
             let at = code.skip_space(start).min(end);
             let (first, after) = word(code, at);
-            let next_line = end + 1;
+            // The line after the statement: after its last aggregate's `}` (which a
+            // malformed aggregate puts on a later line), so no text is read twice.
+            let mut next_line = end + 1;
+            let mut past = |close: usize| {
+                let line_end = code.code[close..]
+                    .iter()
+                    .position(|&b| b == b'\n')
+                    .map_or(len, |p| close + p);
+                next_line = next_line.max(line_end + 1);
+            };
             let (declared, rest) = if first == "DECL" {
                 word(code, code.skip_space(after))
             } else {
@@ -225,6 +234,7 @@ impl Dialect for Krl {
                             let open = code.skip_space(eq + 1);
                             if open < len && code.code[open] == b'{' {
                                 let (agg, close) = aggregate(code, open)?;
+                                past(close);
                                 let place = Place::Declaration {
                                     joints: ty.ends_with("AXIS"),
                                 };
@@ -249,6 +259,7 @@ impl Dialect for Krl {
                             break;
                         }
                         let (agg, close) = aggregate(code, open)?;
+                        past(close);
                         let name = if count == 2 && k == 0 {
                             format!("{declared} (auxiliary point)")
                         } else {
@@ -269,6 +280,7 @@ impl Dialect for Krl {
                     let open = code.skip_space(rest);
                     if open < len && code.code[open] == b'{' {
                         let close = code.closing(open, "{")?;
+                        past(close);
                         out.push(Target {
                             at: open,
                             name: w.to_string(),

@@ -381,6 +381,17 @@ pub fn filter_controller_program(
         edits.extend(t.numbers.iter().cloned().zip(numbers));
     }
     edits.sort_by_key(|(span, _)| span.start);
+    // A reader returns disjoint spans; overlapping ones would corrupt the program, so they
+    // are refused rather than written.
+    if let Some(w) = edits.windows(2).find(|w| w[1].0.start < w[0].0.end) {
+        let line = |at: usize| text[..at].matches('\n').count() + 1;
+        return Err(Error::Input(format!(
+            "{file}: line {}: two motion targets share the text at line {}; armcal cannot \
+             filter this program (is an aggregate or statement left open?)",
+            line(w[0].0.start),
+            line(w[1].0.start)
+        )));
+    }
     let mut out = String::with_capacity(text.len() + 64 * edits.len());
     let mut at = 0;
     for (span, new) in edits {

@@ -349,3 +349,33 @@ fn configuration_bits_are_refused_for_a_robot_they_do_not_fit() {
     .to_string();
     assert!(e.contains("configuration bits cannot be mapped"), "{e}");
 }
+
+/// A fuzzer's find: an `E6POS` aggregate left open closes lines later, over other
+/// declarations. Those were read a second time, two targets shared text, and applying the
+/// edits panicked. Now the reader resumes after the aggregate and the program filters (or
+/// is refused with its line), without a panic.
+#[test]
+fn an_aggregate_left_open_is_read_once() {
+    let text = include_str!("../../../tests/fixtures/programs/fuzz-krl-open-aggregate.dat");
+    let c = cell("kr15");
+    let targets = read(text, Language::Krl, 6);
+    for w in targets.windows(2) {
+        assert!(
+            w[0].literal.end <= w[1].literal.start,
+            "{:?} {:?}",
+            w[0].literal,
+            w[1].literal
+        );
+    }
+    let filtered = filter_controller_program(
+        &c.model,
+        &calibrated(&c.model),
+        &c.controller,
+        text,
+        "fuzz.dat",
+        &settings(Language::Krl, false),
+    );
+    if let Err(e) = filtered {
+        assert!(e.to_string().contains("fuzz.dat: line"), "{e}");
+    }
+}

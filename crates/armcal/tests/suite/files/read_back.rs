@@ -9,6 +9,7 @@ use crate::common::{every_convention_model, measure, random_q, rng};
 use armcal::cell::Cell;
 use armcal::compensate::program::{compensate_program, ProgramFile};
 use armcal::compensate::IkSettings;
+use armcal::measure::format::DataFormat;
 use armcal::measure::{csv, Covariates, Dataset, Measurement, MeasurementKind};
 use armcal::model::{export, Model, Observed};
 use armcal::sim::{perturbed_truth, Perturbation};
@@ -182,7 +183,7 @@ fn compensated_programs_read_back_in_the_program_reader() {
             program.row(row);
         }
         let text = program.into_string();
-        let file = ProgramFile::read(text, "program.csv", &model).unwrap();
+        let file = ProgramFile::read(text, "program.csv", &model, &DataFormat::armcal()).unwrap();
         assert_eq!(file.cartesian, cartesian);
         let ids: Vec<String> = file.rows.iter().map(|(id, _)| id.clone()).collect();
         let out =
@@ -216,7 +217,13 @@ fn compensated_programs_read_back_in_the_program_reader() {
         assert_eq!(failed, out.not_converged);
 
         // The consumer: the compensated program is a program again, of the same kind.
-        let again = ProgramFile::read(out.csv.clone(), "compensated.csv", &model).unwrap();
+        let again = ProgramFile::read(
+            out.csv.clone(),
+            "compensated.csv",
+            &model,
+            &DataFormat::armcal(),
+        )
+        .unwrap();
         assert_eq!(again.cartesian, cartesian, "{}", out.csv);
         let back: Vec<String> = again.rows.iter().map(|(id, _)| id.clone()).collect();
         assert_eq!(back, ids);

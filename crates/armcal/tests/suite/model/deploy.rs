@@ -189,6 +189,94 @@ fn ros_joint_corrections_reload_to_the_same_kinematics() {
     }
 }
 
+/// Every capsule end of `cell`'s robot in the world at `q` (mm).
+fn capsule_ends(cell: &Cell, q: &[f64]) -> Vec<[f64; 3]> {
+    use armcal::model::{forward_kinematics, Data};
+    let m = &cell.model;
+    let mut data = Data::new(m);
+    forward_kinematics(m, &mut data, &m.nominal(), q);
+    cell.robot
+        .capsules
+        .iter()
+        .flat_map(|c| {
+            let frame = &data.frames[m.link_index(&c.frame).unwrap()];
+            [c.a, c.b].map(|p| {
+                let v = frame.transform_point(&nalgebra::Vector3::from(p));
+                [v.x, v.y, v.z]
+            })
+        })
+        .collect()
+}
+
+/// `[robot] joint_corrections`: a built-in robot corrected by a parameter file has the
+/// calibrated forward kinematics, and its hand-made capsules stay on their bodies (with no
+/// correction they are where the uncorrected robot has them, to 1e-9 mm).
+#[test]
+fn joint_corrections_read_as_a_cell_robot_reproduce_the_calibration() {
+    let dir = std::env::temp_dir().join(format!("armcal-cell-corrections-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cell_file = dir.join("cell.toml");
+    for name in ["kr15", "paper", "ur10", "irb120"] {
+        let (nominal, calibrated) = nominal_and_calibrated(name, 7);
+        std::fs::write(
+            &cell_file,
+            format!("[robot]\nbuiltin = \"{name}\"\njoint_corrections = \"c.yaml\"\n"),
+        )
+        .unwrap();
+        let file = dir.join("c.yaml");
+        std::fs::write(
+            &file,
+            export(&calibrated, &nominal, ExportFormat::JointCorrections),
+        )
+        .unwrap();
+        let corrected = Cell::from_file(&cell_file).unwrap();
+        let (p, r) = fk_gap(&calibrated, &without_targets(&corrected.model.spec()));
+        assert!(p < 1e-9 && r < 1e-12, "{name}: {p} mm, {r} rad");
+        assert!(
+            corrected.robot.summary.contains("c.yaml"),
+            "{}",
+            corrected.robot.summary
+        );
+
+        std::fs::write(
+            &file,
+            export(&nominal, &nominal, ExportFormat::JointCorrections),
+        )
+        .unwrap();
+        let same = Cell::from_file(&cell_file).unwrap();
+        let builtin = Cell::from_robot(name).unwrap();
+        assert!(!builtin.robot.capsules.is_empty(), "{name} has capsules");
+        for q in random_configurations(&builtin.model, 20, 3) {
+            for (a, b) in capsule_ends(&same, &q)
+                .iter()
+                .zip(capsule_ends(&builtin, &q))
+            {
+                let d = (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt();
+                assert!(d < 1e-9, "{name}: a capsule end moved by {d} mm");
+            }
+        }
+    }
+    // a file that does not fit the robot names the cell's field and the file's line
+    std::fs::write(
+        dir.join("c.yaml"),
+        "armcal_joint_corrections:\n  ros__parameters:\n    corrections:\n      q9: {dx: 0, dy: 0, dz: 0, droll: 0, dpitch: 0, dyaw: 0}\n",
+    )
+    .unwrap();
+    let e = Cell::from_file(&cell_file).unwrap_err().to_string();
+    assert!(
+        e.contains("robot.joint_corrections") && e.contains("line 4") && e.contains("q9"),
+        "{e}"
+    );
+}
+
+/// `spec` without instrument and targets (a cell adds its own).
+fn without_targets(spec: &ModelSpec) -> ModelSpec {
+    let mut s = spec.clone();
+    s.instrument = None;
+    s.targets.clear();
+    s
+}
+
 #[test]
 fn ros_joint_corrections_errors_name_line_and_field() {
     let nominal = armcal::robots::robot("ur10").unwrap().spec;
