@@ -96,8 +96,10 @@ pub use error::{Error, Result};
 // A cell and its model.
 pub use cell::Cell;
 pub use model::Model;
-// Kinematic trees and coupled joints (analysis only, for now).
+// Kinematic trees and coupled joints: analysis, simulation and identification.
 pub use cell::tree::{analyze_tree_file, describes_tree, TreeAnalysis, TreeCell};
+pub use identify::tree::{identify_tree, TreeEstimate, TreeTargetFit};
+pub use sim::tree::simulate_tree;
 // Kinematics over many configurations.
 pub use model::kinematics::fk;
 // Measurements: from arrays, from several stations, simulated, predicted.

@@ -27,6 +27,7 @@ pub(crate) mod robust;
 pub(crate) mod sign_diagnosis;
 pub(crate) mod solver;
 mod split;
+pub(crate) mod tree;
 pub mod uncertainty;
 pub(crate) mod unit_check;
 pub(crate) mod verdicts;

@@ -349,6 +349,29 @@ impl Tree {
         &self.spec
     }
 
+    /// The spec of this tree with every geometric value taken from the tree parameter
+    /// vector `params` (an estimate): each link, the instrument and each target at its
+    /// branch's values (a shared link is one parameter set, so every branch gives it alike).
+    pub fn spec_at(&self, params: &[f64]) -> TreeSpec {
+        let mut spec = self.spec.clone();
+        for b in &self.branches {
+            let local: Vec<f64> = b.params.iter().map(|&t| params[t]).collect();
+            let at = b.model.spec_at(&local);
+            if let (Some(i), Some(given)) = (at.instrument, spec.instrument.as_mut()) {
+                *given = i;
+            }
+            for l in at.links {
+                if let Some(t) = spec.links.iter_mut().find(|t| t.link.name == l.name) {
+                    t.link = l;
+                }
+            }
+            for (k, t) in at.targets.into_iter().enumerate() {
+                spec.targets[b.targets[k]].target = t;
+            }
+        }
+        spec
+    }
+
     /// The same tree with every coupled joint moving on its own (a data row then carries
     /// it): what the coupling costs is the difference between their identifiable sets.
     pub fn uncoupled(&self) -> Result<Tree, Error> {
