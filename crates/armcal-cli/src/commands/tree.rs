@@ -12,13 +12,8 @@ use std::path::Path;
 
 /// `armcal identify --cell <tree cell>`: one fit of the whole tree over every data file.
 pub fn identify(a: &identify::Args, cell_path: &Path) -> anyhow::Result<()> {
+    // `--data TARGET=FILE`: every row of FILE saw TARGET (a serial cell's STATION=FILE)
     let files = station_files(&a.data);
-    if let Some((Some(station), _)) = files.iter().find(|(s, _)| s.is_some()) {
-        bail!(
-            "--data {station}=…: a tree is fitted from one instrument station for now; give \
-             each branch's file as --data FILE"
-        );
-    }
     if a.refit.is_some() {
         bail!("--refit: a tree fit does not refit frames yet (issue 32)");
     }
@@ -29,12 +24,16 @@ pub fn identify(a: &identify::Args, cell_path: &Path) -> anyhow::Result<()> {
     let cell = TreeCell::from_file(cell_path)?;
     let mut data = armcal::Dataset::default();
     let mut sources = Vec::new();
-    for (_, file) in &files {
-        data.append(&cell.read_data(file)?);
+    for (target, file) in &files {
+        data.append(&cell.read_data(file, target.as_deref())?);
         sources.push(file.display().to_string());
     }
     data.source = sources.join(" + ");
-    let test = a.test.as_deref().map(|t| cell.read_data(t)).transpose()?;
+    let test = a
+        .test
+        .as_deref()
+        .map(|t| cell.read_data(t, None))
+        .transpose()?;
     let opts = identify::settings(a, test, None);
     let est = armcal::identify_tree(&cell, &data, &opts, &mut Progress::new(a.quiet))?;
     outputs.commit(&[(&a.out, &est.to_json()?)])?;

@@ -83,10 +83,34 @@ impl TreeCell {
     /// Reads a data file of this tree in armcal's CSV: a column per tree joint that is not
     /// coupled (`<joint>_deg`, `_rad`, `_mm`, … by joint name; a coupled joint follows its
     /// coupling and has no column), and a `target` column naming the target each row saw
-    /// (needed with more than one target; one file may mix the targets of several
-    /// branches). Errors name the file, line and field.
-    pub fn read_data(&self, path: &Path) -> Result<Dataset, Error> {
-        Ok(csv::read(path, &self.data_model, None)?.0)
+    /// (one file may mix the targets of several branches). With `target`, every row saw that
+    /// target (a file of one arm's poses; a `target` column then names it on every row).
+    /// Errors name the file, line and field.
+    pub fn read_data(&self, path: &Path, target: Option<&str>) -> Result<Dataset, Error> {
+        let Some(name) = target else {
+            return Ok(csv::read(path, &self.data_model, None)?.0);
+        };
+        let t = self
+            .tree
+            .targets
+            .iter()
+            .position(|t| t.0 == name)
+            .ok_or_else(|| {
+                let names: Vec<&str> = self.tree.targets.iter().map(|t| t.0.as_str()).collect();
+                Error::Input(format!(
+                    "{}: no target `{name}` in tree cell `{}` (it has: {})",
+                    path.display(),
+                    self.name,
+                    names.join(", ")
+                ))
+            })?;
+        let mut spec = self.data_model.spec_at(&self.data_model.nominal());
+        spec.targets = vec![spec.targets[t].clone()];
+        let mut data = csv::read(path, &Model::from_spec(&spec)?, None)?.0;
+        for m in &mut data.measurements {
+            m.observed = crate::model::Observed::Target(t);
+        }
+        Ok(data)
     }
 
     /// Reads joint configurations of this tree (`pose_id` and a column per tree joint that

@@ -502,7 +502,7 @@ fn data_measurement(data: &Dataset) -> Measurement {
 }
 
 /// Identifies the tree of `cell` from `data` (every row naming its target): a frames-first
-/// fit (instrument and target frames, the robot nominal), then the tree's identifiable set
+/// fit (the instrument frame, the robot nominal), then the tree's identifiable set
 /// at the data's rows decided there and fitted by the settings' solver (Levenberg–Marquardt,
 /// Gauss–Newton, or robust IRLS); its covariance `C_p = σ̂₀² (JᵀJ)⁻¹` (book eq. 5.23), and
 /// the position errors per target, fitted and held out (`opts.holdout` of the configurations
@@ -544,11 +544,13 @@ pub fn identify_tree(
     let measurement = data_measurement(&train);
     let nominal = tree.nominal();
     let lm = &opts.lm;
-    // 1. the frames: instrument and targets, the robot nominal
+    // 1. the instrument frame, the robot and its targets nominal (a target's offset the
+    // data see only together with the placement would wander off here: the serial
+    // frames-first start holds such offsets too, `frames_first`)
     observer.start("frames-first fit", None);
     let is_frame = |i: usize| {
         let p = tree.registry.get(i);
-        p.status.is_free() && matches!(p.segment, Segment::Instrument | Segment::Target(_))
+        p.status.is_free() && p.segment == Segment::Instrument
     };
     let (frames, _) = identifiable_at(tree, &nominal, &train, measurement, is_frame)?;
     let frames_fit = {

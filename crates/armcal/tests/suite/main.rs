@@ -33,6 +33,7 @@ mod identify {
     mod pivot;
     mod priors_and_noise;
     mod stations;
+    mod tree;
 }
 mod campaign {
     mod adaptive;

@@ -171,8 +171,9 @@ pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
         return Err(ctx.err(
             span,
             &field,
-            "this cell describes a kinematic tree (or a coupled joint): `armcal model` \
-             analyses it; the other commands take a serial chain for now (issue 32)",
+            "this cell describes a kinematic tree (or a coupled joint): `armcal model`, \
+             `simulate` and `identify` take it; the other commands take a serial chain for \
+             now (issue 32)",
         ));
     }
 
