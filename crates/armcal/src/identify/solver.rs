@@ -145,10 +145,18 @@ pub(crate) trait LeastSquares {
     fn free_values(&self, params: &[f64]) -> DVector<f64>;
     /// Writes free values into a full parameter vector.
     fn set_free(&self, params: &mut [f64], x: &DVector<f64>);
-    /// The measurements: each one's first row and number of rows, in measurement order.
-    fn blocks(&self) -> Vec<(usize, usize)>;
+    /// The first row of each measurement.
+    fn row_of(&self) -> &[usize];
     /// The data fitted (for the outliers a robust fit names).
     fn dataset(&self) -> &crate::measure::Dataset;
+    /// The measurements: each one's first row and number of rows, in measurement order.
+    fn blocks(&self) -> Vec<(usize, usize)> {
+        self.row_of()
+            .iter()
+            .zip(&self.dataset().measurements)
+            .map(|(&row, m)| (row, m.kind.rows()))
+            .collect()
+    }
     /// Per-row weight multipliers (robust estimation).
     fn row_weights_mut(&mut self) -> &mut Vec<f64>;
     /// Whitened residual and Jacobian at `params` (allocating; for one-off evaluations).
@@ -190,12 +198,8 @@ impl LeastSquares for super::Problem<'_> {
     fn set_free(&self, params: &mut [f64], x: &DVector<f64>) {
         super::Problem::set_free(self, params, x)
     }
-    fn blocks(&self) -> Vec<(usize, usize)> {
-        self.row_of
-            .iter()
-            .zip(&self.data.measurements)
-            .map(|(&row, m)| (row, m.kind.rows()))
-            .collect()
+    fn row_of(&self) -> &[usize] {
+        &self.row_of
     }
     fn dataset(&self) -> &crate::measure::Dataset {
         self.data
