@@ -6,8 +6,7 @@ use super::output::{station_files, Outputs};
 use super::progress::Progress;
 use super::{identify, simulate};
 use anyhow::bail;
-use armcal::sim::Perturbation;
-use armcal::{TreeCell, TreeEstimate};
+use armcal::{Perturbation, TreeCell, TreeEstimate};
 use std::path::Path;
 
 /// `armcal identify --cell <tree cell>`: one fit of the whole tree over every data file.
