@@ -80,7 +80,7 @@ fn a_dual_arm_tree_measured_arm_by_arm_is_fitted_as_one_tree() {
     for t in ["smr_r", "smr_l"] {
         let line = stdout
             .lines()
-            .find(|l| l.trim_start().starts_with(t))
+            .find(|l| l.trim_start().starts_with(&format!("{t} ")))
             .unwrap();
         // held-out RMS of the calibrated tree at the noise level (σ 0.05 mm), far below the
         // frames-only model's
