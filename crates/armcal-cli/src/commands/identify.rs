@@ -88,6 +88,10 @@ pub struct Args {
 const ACCEPT_MISFIT: &str = "--accept-misfit";
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
+    let cell_path = Path::new(&a.cell);
+    if cell_path.is_file() && armcal::describes_tree(cell_path)? {
+        return super::tree::identify(a, cell_path);
+    }
     let files = station_files(&a.data);
     let mut inputs = vec![Path::new(&a.cell)];
     inputs.extend(files.iter().map(|(_, f)| f.as_path()));
@@ -105,7 +109,37 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         }),
         None => None,
     };
-    let opts = IdentifySettings {
+    let opts = settings(a, test, refit);
+    let est = identify(&cell, &data, &opts, &mut Progress::new(a.quiet))?;
+    if let Some(fit) = est.verdicts.as_ref().map(|v| &v.fit) {
+        if fit.refuses() && !a.accept_misfit {
+            print_summary(&est);
+            bail!(
+                "{}\nno estimate written: correct the data or the cell, or pass {ACCEPT_MISFIT} to write it anyway (marked as not fitting its data)",
+                fit.reasons().join("\n")
+            );
+        }
+    }
+    outputs.commit(&[(&a.out, &serde_json::to_string_pretty(&est)?)])?;
+    print_summary(&est);
+    println!("\nestimate → {}", a.out.display());
+    if !est.solver.status.is_converged() {
+        bail!(
+            "the fit did not converge ({}); check the cell's nominal model and the data (units, joint columns), or fix weakly identifiable parameters",
+            est.solver.status
+        );
+    }
+    Ok(())
+}
+
+/// The library's settings of a fit from the flags, with the test data and the frames
+/// refit read.
+pub fn settings(
+    a: &Args,
+    test: Option<armcal::Dataset>,
+    refit: Option<FramesRefit>,
+) -> IdentifySettings {
+    IdentifySettings {
         method: Method::from_name(&a.method).expect("clap checked"),
         robust: a.robust.as_deref().and_then(Loss::from_name),
         holdout: a.holdout,
@@ -127,27 +161,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         },
         diagnose_signs: a.diagnose_signs,
         accept_misfit: a.accept_misfit.then(|| ACCEPT_MISFIT.to_string()),
-    };
-    let est = identify(&cell, &data, &opts, &mut Progress::new(a.quiet))?;
-    if let Some(fit) = est.verdicts.as_ref().map(|v| &v.fit) {
-        if fit.refuses() && !a.accept_misfit {
-            print_summary(&est);
-            bail!(
-                "{}\nno estimate written: correct the data or the cell, or pass {ACCEPT_MISFIT} to write it anyway (marked as not fitting its data)",
-                fit.reasons().join("\n")
-            );
-        }
     }
-    outputs.commit(&[(&a.out, &serde_json::to_string_pretty(&est)?)])?;
-    print_summary(&est);
-    println!("\nestimate → {}", a.out.display());
-    if !est.solver.status.is_converged() {
-        bail!(
-            "the fit did not converge ({}); check the cell's nominal model and the data (units, joint columns), or fix weakly identifiable parameters",
-            est.solver.status
-        );
-    }
-    Ok(())
 }
 
 /// `--holdout`: a fraction in [0, 1).

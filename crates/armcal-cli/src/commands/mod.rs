@@ -21,3 +21,4 @@ pub mod report;
 pub mod robots;
 pub mod simulate;
 pub mod study;
+pub mod tree;

@@ -69,12 +69,23 @@ pub struct Args {
     /// too, instead of refusing them; stderr says how many there were.
     #[arg(long)]
     pub allow_unmeasurable: bool,
+    /// A tree cell: the target each pose measures (repeat it for several; default: every
+    /// target at every pose, an instrument that sees every branch's reflector).
+    #[arg(long)]
+    pub target: Vec<String>,
     /// Overwrite existing output files.
     #[arg(long)]
     pub force: bool,
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
+    let cell_path = Path::new(&a.cell);
+    if cell_path.is_file() && armcal::describes_tree(cell_path)? {
+        return super::tree::simulate(a, cell_path);
+    }
+    if !a.target.is_empty() {
+        bail!("--target chooses the targets of a tree cell's poses; `{}` is a serial cell (its data measure every target)", a.cell);
+    }
     let mut outs = vec![a.out.as_path()];
     outs.extend(a.truth_out.as_deref());
     let outputs = Outputs::plan(a.force, &[Path::new(&a.cell), &a.poses], &outs)?;

@@ -37,5 +37,6 @@ mod readme;
 mod real_poses_measurable_cli;
 mod refit_cli;
 mod scale;
+mod tree_cli;
 mod units_signs_cli;
 mod workflow;

@@ -3,9 +3,11 @@
 //! target's `link` (the cell reference, "Trees and coupled joints"); [`crate::Cell`] refuses
 //! such a file and [`TreeCell`] reads it.
 
+use crate::measure::{csv, Dataset, NoiseModel};
 use crate::model::identifiability::{Identifiability, IdentifiabilitySettings, Measurement};
 use crate::model::tree::identifiability::analyze_tree;
 use crate::model::tree::{Tree, TreeSpec};
+use crate::model::{LinkSpec, Model, ModelSpec};
 use crate::Error;
 use std::path::Path;
 
@@ -22,6 +24,13 @@ pub struct TreeCell {
     pub tree: Tree,
     /// `[parameters] measurement`; default pose if every target is a frame, else position.
     pub measurement: Measurement,
+    /// The instrument's noise (`[instrument] noise`; default [`NoiseModel::default`]).
+    pub noise: NoiseModel,
+    /// The tree's joints (the non-coupled ones, in link order) and targets as a serial
+    /// model, for reading and writing data files only: its joints name a data file's joint
+    /// columns (with their units and limits) and its targets the `target` column's values;
+    /// its kinematics is not the tree's and is never evaluated.
+    data_model: Model,
 }
 
 impl TreeCell {
@@ -33,6 +42,86 @@ impl TreeCell {
                 message: e.to_string(),
             })?;
         TreeCell::from_toml(&text, &path.display().to_string())
+    }
+
+    /// The cell of `tree` (built from `spec`), with its data model (the tree's joints and
+    /// targets, [`TreeCell::read_data`]).
+    pub(crate) fn new(
+        name: String,
+        origin: String,
+        spec: TreeSpec,
+        tree: Tree,
+        measurement: Measurement,
+        noise: NoiseModel,
+    ) -> Result<TreeCell, Error> {
+        let joint_links: Vec<LinkSpec> = spec
+            .links
+            .iter()
+            .filter(|l| l.link.joint.is_some() && l.coupling.is_none())
+            .map(|l| l.link.clone())
+            .collect();
+        let data_model = Model::from_spec(&ModelSpec {
+            name: spec.name.clone(),
+            instrument: spec.instrument.clone(),
+            links: joint_links,
+            targets: spec.targets.iter().map(|t| t.target.clone()).collect(),
+            compliance: None,
+            periodic: None,
+            payloads: Vec::new(),
+        })?;
+        Ok(TreeCell {
+            name,
+            origin,
+            spec,
+            tree,
+            measurement,
+            noise,
+            data_model,
+        })
+    }
+
+    /// Reads a data file of this tree in armcal's CSV: a column per tree joint that is not
+    /// coupled (`<joint>_deg`, `_rad`, `_mm`, … by joint name; a coupled joint follows its
+    /// coupling and has no column), and a `target` column naming the target each row saw
+    /// (one file may mix the targets of several branches). With `target`, every row saw that
+    /// target (a file of one arm's poses; a `target` column then names it on every row).
+    /// Errors name the file, line and field.
+    pub fn read_data(&self, path: &Path, target: Option<&str>) -> Result<Dataset, Error> {
+        let Some(name) = target else {
+            return Ok(csv::read(path, &self.data_model, None)?.0);
+        };
+        let t = self
+            .tree
+            .targets
+            .iter()
+            .position(|t| t.0 == name)
+            .ok_or_else(|| {
+                let names: Vec<&str> = self.tree.targets.iter().map(|t| t.0.as_str()).collect();
+                Error::Input(format!(
+                    "{}: no target `{name}` in tree cell `{}` (it has: {})",
+                    path.display(),
+                    self.name,
+                    names.join(", ")
+                ))
+            })?;
+        let mut spec = self.data_model.spec_at(&self.data_model.nominal());
+        spec.targets = vec![spec.targets[t].clone()];
+        let mut data = csv::read(path, &Model::from_spec(&spec)?, None)?.0;
+        for m in &mut data.measurements {
+            m.observed = crate::model::Observed::Target(t);
+        }
+        Ok(data)
+    }
+
+    /// Reads joint configurations of this tree (`pose_id` and a column per tree joint that
+    /// is not coupled, as [`TreeCell::read_data`]), each within the joint limits.
+    pub fn read_poses(&self, path: &Path) -> Result<Vec<(String, Vec<f64>)>, Error> {
+        csv::read_reachable_configurations(path, &self.data_model)
+    }
+
+    /// `data` in armcal's CSV for this tree ([`TreeCell::read_data`] reads it back).
+    pub fn write_data(&self, data: &Dataset) -> Result<String, Error> {
+        csv::write_string(data, &self.data_model)
     }
 
     /// Parses a tree cell from TOML text; `file` names it in errors.

@@ -304,7 +304,8 @@ impl Estimate {
             })?;
         serde_json::from_str(&text).map_err(|e| Error::File {
             file: path.display().to_string(),
-            message: format!("not an armcal estimate: {e}"),
+            message: super::tree::tree_estimate_refusal(&text)
+                .unwrap_or_else(|| format!("not an armcal estimate: {e}")),
         })
     }
 

@@ -13,7 +13,8 @@
 
 use super::problem::Problem;
 use super::solver::{
-    gradient_cosine, no_decrease_status, Iterate, SolverResult, ToleranceSettings,
+    gradient_cosine, no_decrease_status, Iterate, LeastSquares, SolverResult,
+    ToleranceSettings,
 };
 use crate::progress::Observer;
 use crate::solve::Status;
@@ -30,6 +31,16 @@ const HALVINGS: usize = 40;
 /// `start` (full parameter vector), stopping by `tol`.
 pub fn gauss_newton(
     problem: &Problem,
+    start: &[f64],
+    tol: &ToleranceSettings,
+    observer: &mut dyn Observer,
+) -> Result<SolverResult, Error> {
+    minimise(problem, start, tol, observer)
+}
+
+/// [`gauss_newton`] of any least-squares problem (a serial chain's or a tree's).
+pub(crate) fn minimise<P: LeastSquares>(
+    problem: &P,
     start: &[f64],
     tol: &ToleranceSettings,
     observer: &mut dyn Observer,

@@ -40,7 +40,8 @@
 
 use super::problem::Problem;
 use super::solver::{
-    gradient_cosine, no_decrease_status, Iterate, SolverResult, ToleranceSettings,
+    gradient_cosine, no_decrease_status, Iterate, LeastSquares, SolverResult,
+    ToleranceSettings,
 };
 use crate::progress::Observer;
 use crate::solve::Status;
@@ -184,6 +185,16 @@ fn noise_factor(cost: f64, m: usize, n: usize) -> f64 {
 /// documentation.
 pub fn levenberg_marquardt(
     problem: &Problem,
+    start: &[f64],
+    settings: &LmSettings,
+    observer: &mut dyn Observer,
+) -> Result<SolverResult, Error> {
+    minimise(problem, start, settings, observer)
+}
+
+/// [`levenberg_marquardt`] of any least-squares problem (a serial chain's or a tree's).
+pub(crate) fn minimise<P: LeastSquares>(
+    problem: &P,
     start: &[f64],
     settings: &LmSettings,
     observer: &mut dyn Observer,

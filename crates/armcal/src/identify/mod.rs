@@ -27,6 +27,7 @@ pub(crate) mod robust;
 pub(crate) mod sign_diagnosis;
 pub(crate) mod solver;
 mod split;
+pub(crate) mod tree;
 pub mod uncertainty;
 pub(crate) mod unit_check;
 pub(crate) mod verdicts;
@@ -499,22 +500,7 @@ fn estimate_of_fit(
     let validation = phase(observer, "held-out validation", || {
         split.validate(model, &sol.params, opts, noise)
     })?;
-    let free_set: std::collections::HashSet<usize> = problem.free.iter().copied().collect();
-    let parameters = (0..model.param_count())
-        .map(|i| {
-            let p = model.registry.get(i);
-            let f = p.unit.display_factor();
-            let col = problem.free.iter().position(|&c| c == i);
-            ParameterEstimate {
-                name: p.name.clone(),
-                unit: p.unit.display_name().into(),
-                nominal: p.nominal * f,
-                estimate: sol.params[i] * f,
-                sigma: col.map(|c| unc.sigma[c] * f),
-                free: free_set.contains(&i),
-            }
-        })
-        .collect();
+    let parameters = parameter_table(&model.registry, &sol.params, &problem.free, &unc.sigma);
     let strong = unc
         .strong_correlations
         .iter()
@@ -568,6 +554,32 @@ fn estimate_of_fit(
         fitted_ranges: fitted_ranges::FittedRange::of(model, &train.configurations),
         refit: opts.refit.as_ref().map(|r| refit::record(r, kept)),
     })
+}
+
+/// Every parameter of `registry` in display units: nominal, the value in `params`, and for
+/// the free ones (`free`, in covariance order) the σ of `sigma`.
+pub(crate) fn parameter_table(
+    registry: &crate::model::Registry,
+    params: &[f64],
+    free: &[usize],
+    sigma: &[f64],
+) -> Vec<ParameterEstimate> {
+    let free_set: std::collections::HashSet<usize> = free.iter().copied().collect();
+    (0..registry.len())
+        .map(|i| {
+            let p = registry.get(i);
+            let f = p.unit.display_factor();
+            let col = free.iter().position(|&c| c == i);
+            ParameterEstimate {
+                name: p.name.clone(),
+                unit: p.unit.display_name().into(),
+                nominal: p.nominal * f,
+                estimate: params[i] * f,
+                sigma: col.map(|c| sigma[c] * f),
+                free: free_set.contains(&i),
+            }
+        })
+        .collect()
 }
 
 /// Runs `f` as the task `task` of `observer` (a phase that reports no steps of its own).

@@ -307,13 +307,15 @@ impl<'a> Problem<'a> {
             let row = self.row_of[i];
             let jrow = if with_j { row } else { 0 };
             residual_rows(&m.kind, a, b, block_r, jac, jrow);
-            for k in 0..m.kind.rows() {
-                let w = self.row_weights[row + k].sqrt() / self.sigmas[row + k];
-                r[row + k] = block_r[k] * w;
-                if with_j {
-                    jac.row_mut(row + k).scale_mut(w);
-                }
-            }
+            whiten(
+                m.kind.rows(),
+                block_r,
+                row,
+                (&self.row_weights, &self.sigmas),
+                r,
+                jac,
+                with_j,
+            );
         });
         let n = self.sigmas.len();
         for k in 0..self.prior_rows.nrows() {
@@ -363,6 +365,27 @@ impl<'a> Problem<'a> {
             }
         });
         errors
+    }
+}
+
+/// Writes the `rows` residual rows of one measurement (`block_r`, unwhitened) into `r` at
+/// `row`, each times `√weight / σ` (`weights_sigmas`: every data row's), and scales the same
+/// rows of `jac` (already written there by [`residual_rows`]) if `with_j`.
+pub(crate) fn whiten(
+    rows: usize,
+    block_r: &[f64; 6],
+    row: usize,
+    (weights, sigmas): (&[f64], &[f64]),
+    r: &mut DVector<f64>,
+    jac: &mut DMatrix<f64>,
+    with_j: bool,
+) {
+    for k in 0..rows {
+        let w = weights[row + k].sqrt() / sigmas[row + k];
+        r[row + k] = block_r[k] * w;
+        if with_j {
+            jac.row_mut(row + k).scale_mut(w);
+        }
     }
 }
 

@@ -7,9 +7,9 @@
 //! measurements, unweighted (outlier rows removed): the variance factor and χ² test of a
 //! robust fit are computed on the data it kept, with m − n = kept rows − free parameters.
 
-use super::lm::{levenberg_marquardt, LmSettings};
+use super::lm::{minimise, LmSettings};
 use super::problem::Problem;
-use super::solver::SolverResult;
+use super::solver::{LeastSquares, SolverResult};
 use crate::progress::Observer;
 use crate::Error;
 use nalgebra::{DMatrix, DVector};
@@ -98,25 +98,31 @@ pub fn robust_fit(
     settings: &LmSettings,
     observer: &mut dyn Observer,
 ) -> Result<RobustResult, Error> {
-    let blocks: Vec<(usize, usize)> = problem
-        .row_of
-        .iter()
-        .zip(&problem.data.measurements)
-        .map(|(&row, m)| (row, m.kind.rows()))
-        .collect();
-    problem.row_weights.fill(1.0);
+    robust_minimise(problem, start, loss, settings, observer)
+}
+
+/// [`robust_fit`] of any least-squares problem (a serial chain's or a tree's).
+pub(crate) fn robust_minimise<P: LeastSquares>(
+    problem: &mut P,
+    start: &[f64],
+    loss: Loss,
+    settings: &LmSettings,
+    observer: &mut dyn Observer,
+) -> Result<RobustResult, Error> {
+    let blocks = problem.blocks();
+    problem.row_weights_mut().fill(1.0);
     observer.start("robust reweighting", None);
-    let mut sol = levenberg_marquardt(problem, start, settings, observer)?;
+    let mut sol = minimise(problem, start, settings, observer)?;
     let mut scale = 1.0;
     let mut reweightings = 0;
-    let norms = |sol: &SolverResult, problem: &Problem| -> Vec<f64> {
+    let norms = |sol: &SolverResult, problem: &mut P| -> Vec<f64> {
         // Undo the weights to get the plain whitened residual of each block.
         blocks
             .iter()
             .map(|&(row, k)| {
                 (0..k)
                     .map(|i| {
-                        let w = problem.row_weights[row + i];
+                        let w = problem.row_weights_mut()[row + i];
                         if w > 0.0 {
                             (sol.residual[row + i] / w.sqrt()).powi(2)
                         } else {
@@ -141,12 +147,13 @@ pub fn robust_fit(
         for (b, &(row, k)) in blocks.iter().enumerate() {
             let w = loss.weight(e[b] / (k as f64).sqrt() / scale);
             for i in 0..k {
-                change = change.max((problem.row_weights[row + i] - w).abs());
-                problem.row_weights[row + i] = w;
+                let weights = problem.row_weights_mut();
+                change = change.max((weights[row + i] - w).abs());
+                weights[row + i] = w;
             }
         }
         reweightings += 1;
-        sol = levenberg_marquardt(problem, &sol.params, settings, observer)?;
+        sol = minimise(problem, &sol.params, settings, observer)?;
         if change < 1e-4 {
             break;
         }
@@ -159,13 +166,15 @@ pub fn robust_fit(
             .unwrap_or(f64::INFINITY);
         let z = e[b] / scale;
         if z * z > limit {
-            let m = &problem.data.measurements[b];
+            let weight = problem.row_weights_mut()[row];
+            let data = problem.dataset();
+            let m = &data.measurements[b];
             outliers.push(Outlier {
                 measurement: b,
                 line: m.line,
-                configuration: problem.data.config_ids[m.config].clone(),
+                configuration: data.config_ids[m.config].clone(),
                 standardized: z,
-                weight: problem.row_weights[row],
+                weight,
             });
         }
     }
@@ -180,19 +189,19 @@ pub fn robust_fit(
 }
 
 /// Unweighted whitened residual and Jacobian at `params` without the rows of `outliers`.
-pub(crate) fn kept_rows(
-    problem: &mut Problem,
+pub(crate) fn kept_rows<P: LeastSquares>(
+    problem: &mut P,
     params: &[f64],
     outliers: &[Outlier],
 ) -> (DVector<f64>, DMatrix<f64>) {
     let ones = vec![1.0; problem.data_rows()];
-    let weights = std::mem::replace(&mut problem.row_weights, ones);
-    let (r, j) = problem.residual_and_jacobian(params);
-    problem.row_weights = weights;
+    let weights = std::mem::replace(problem.row_weights_mut(), ones);
+    let (r, j) = problem.residual_and_jacobian_at(params);
+    *problem.row_weights_mut() = weights;
+    let blocks = problem.blocks();
     let mut dropped = vec![false; problem.rows()];
     for o in outliers {
-        let row = problem.row_of[o.measurement];
-        let k = problem.data.measurements[o.measurement].kind.rows();
+        let (row, k) = blocks[o.measurement];
         dropped[row..row + k].fill(true);
     }
     let keep: Vec<usize> = (0..problem.rows()).filter(|&i| !dropped[i]).collect();

@@ -108,7 +108,7 @@ pub(crate) fn gradient_cosine(j: &DMatrix<f64>, r: &DVector<f64>) -> f64 {
 /// precision if the residual is orthogonal to every Jacobian column to six digits (gradient
 /// cosine < 10⁻⁶), else `Diverged` with `reason` — a step that lowers nothing is never
 /// convergence by itself.
-pub(crate) fn no_decrease_status(it: &Iterate, reason: String) -> Status {
+pub(crate) fn no_decrease_status<W>(it: &Iterate<W>, reason: String) -> Status {
     if gradient_cosine(&it.j, &it.r) < 1e-6 {
         Status::Converged {
             criterion: "no further decrease possible (at machine precision)".into(),
@@ -118,18 +118,112 @@ pub(crate) fn no_decrease_status(it: &Iterate, reason: String) -> Status {
     }
 }
 
+/// A whitened least-squares problem as the solvers see it: a serial chain's
+/// [`super::Problem`] or a kinematic tree's ([`super::tree`]). The solvers are generic over
+/// it, so a tree is fitted by the same Levenberg–Marquardt, Gauss–Newton and IRLS code as a
+/// serial chain (monomorphised: the serial path is unchanged).
+pub(crate) trait LeastSquares {
+    /// Buffers of one evaluation.
+    type Workspace;
+    /// Buffers for evaluating this problem.
+    fn workspace(&self) -> Self::Workspace;
+    /// Rows of the whitened residual (data rows, then prior rows).
+    fn rows(&self) -> usize;
+    /// Data rows (without priors).
+    fn data_rows(&self) -> usize;
+    /// Columns of the Jacobian: the free parameters.
+    fn columns(&self) -> usize;
+    /// Whitened residual and, if asked, its Jacobian at the full parameter vector `params`.
+    fn evaluate(
+        &self,
+        ws: &mut Self::Workspace,
+        params: &[f64],
+        r: &mut DVector<f64>,
+        jac: Option<&mut DMatrix<f64>>,
+    );
+    /// Values of the free parameters in a full parameter vector.
+    fn free_values(&self, params: &[f64]) -> DVector<f64>;
+    /// Writes free values into a full parameter vector.
+    fn set_free(&self, params: &mut [f64], x: &DVector<f64>);
+    /// The first row of each measurement.
+    fn row_of(&self) -> &[usize];
+    /// The data fitted (for the outliers a robust fit names).
+    fn dataset(&self) -> &crate::measure::Dataset;
+    /// The measurements: each one's first row and number of rows, in measurement order.
+    fn blocks(&self) -> Vec<(usize, usize)> {
+        self.row_of()
+            .iter()
+            .zip(&self.dataset().measurements)
+            .map(|(&row, m)| (row, m.kind.rows()))
+            .collect()
+    }
+    /// Per-row weight multipliers (robust estimation).
+    fn row_weights_mut(&mut self) -> &mut Vec<f64>;
+    /// Whitened residual and Jacobian at `params` (allocating; for one-off evaluations).
+    fn residual_and_jacobian_at(&self, params: &[f64]) -> (DVector<f64>, DMatrix<f64>) {
+        let mut ws = self.workspace();
+        let mut r = DVector::zeros(self.rows());
+        let mut j = DMatrix::zeros(self.rows(), self.columns());
+        self.evaluate(&mut ws, params, &mut r, Some(&mut j));
+        (r, j)
+    }
+}
+
+impl LeastSquares for super::Problem<'_> {
+    type Workspace = super::problem::Workspace;
+    fn workspace(&self) -> Self::Workspace {
+        super::Problem::workspace(self)
+    }
+    fn rows(&self) -> usize {
+        super::Problem::rows(self)
+    }
+    fn data_rows(&self) -> usize {
+        super::Problem::data_rows(self)
+    }
+    fn columns(&self) -> usize {
+        super::Problem::columns(self)
+    }
+    fn evaluate(
+        &self,
+        ws: &mut Self::Workspace,
+        params: &[f64],
+        r: &mut DVector<f64>,
+        jac: Option<&mut DMatrix<f64>>,
+    ) {
+        super::Problem::evaluate(self, ws, params, r, jac)
+    }
+    fn free_values(&self, params: &[f64]) -> DVector<f64> {
+        super::Problem::free_values(self, params)
+    }
+    fn set_free(&self, params: &mut [f64], x: &DVector<f64>) {
+        super::Problem::set_free(self, params, x)
+    }
+    fn row_of(&self) -> &[usize] {
+        &self.row_of
+    }
+    fn dataset(&self) -> &crate::measure::Dataset {
+        self.data
+    }
+    fn row_weights_mut(&mut self) -> &mut Vec<f64> {
+        &mut self.row_weights
+    }
+}
+
 /// The state every iterative solver carries: workspace, full parameter vector, whitened
 /// residual and Jacobian at those parameters.
-pub(crate) struct Iterate {
-    pub ws: super::problem::Workspace,
+pub(crate) struct Iterate<W> {
+    pub ws: W,
     pub params: Vec<f64>,
     pub r: DVector<f64>,
     pub j: DMatrix<f64>,
 }
 
-impl Iterate {
+impl<W> Iterate<W> {
     /// Evaluates the problem at `start`; a non-finite residual is an error.
-    pub fn start(problem: &super::Problem, start: &[f64]) -> Result<Iterate, crate::Error> {
+    pub fn start<P: LeastSquares<Workspace = W>>(
+        problem: &P,
+        start: &[f64],
+    ) -> Result<Iterate<W>, crate::Error> {
         let mut it = Iterate {
             ws: problem.workspace(),
             params: start.to_vec(),
@@ -146,7 +240,7 @@ impl Iterate {
     }
 
     /// Re-evaluates residual and Jacobian at `self.params`.
-    pub fn update(&mut self, problem: &super::Problem) {
+    pub fn update<P: LeastSquares<Workspace = W>>(&mut self, problem: &P) {
         problem.evaluate(&mut self.ws, &self.params, &mut self.r, Some(&mut self.j));
     }
 

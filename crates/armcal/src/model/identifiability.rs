@@ -441,33 +441,20 @@ pub fn analyze_at(
     let name = |i: usize| model.registry.get(i).name.clone();
     let names: Vec<String> = candidates.iter().map(|&i| name(i)).collect();
     let s = select(factor, m, &names, opts.measurement, opts.tolerance);
-    let mut identifiable: Vec<(usize, f64)> =
-        s.kept.iter().map(|&(k, v)| (candidates[k], v)).collect();
-    identifiable.sort_by_key(|&(i, _)| i);
     let (rv, pr) = joint_counts(model);
-    Ok(Identifiability {
-        measurement: opts.measurement,
-        poses: qs.len(),
-        completeness: Completeness {
+    Ok(s.into_report(
+        &candidates,
+        &name,
+        fixed,
+        opts.measurement,
+        qs.len(),
+        Completeness {
             revolute: rv,
             prismatic: pr,
             complete_pose_model: 4 * rv + 2 * pr + 6,
             expected_for_measurement: expected_count(model, opts.measurement),
         },
-        candidates: {
-            let mut c = candidates.clone();
-            c.sort();
-            c.into_iter().map(name).collect()
-        },
-        fixed,
-        rank_svd: s.rank_svd,
-        rank_qr: s.rank_qr,
-        singular_values: s.singular_values,
-        variance_inflation: identifiable.iter().map(|&(_, v)| v).collect(),
-        identifiable: identifiable.into_iter().map(|(i, _)| name(i)).collect(),
-        condition_number: s.condition_number,
-        excluded: s.excluded,
-    })
+    ))
 }
 
 /// What the analysis of a stacked factor finds, by position in the candidate list (shared by
@@ -485,6 +472,42 @@ pub(crate) struct Selection {
     pub condition_number: f64,
     /// The candidates left out, with the reason.
     pub excluded: Vec<Exclusion>,
+}
+
+impl Selection {
+    /// The analysis record of this selection over `candidates` (parameter indices in
+    /// preference order, as given to [`select`], named by `name`), with the parameters the
+    /// user fixed, the measurement and number of configurations analysed and the
+    /// completeness count.
+    pub(crate) fn into_report(
+        self,
+        candidates: &[usize],
+        name: &dyn Fn(usize) -> String,
+        fixed: Vec<String>,
+        measurement: Measurement,
+        poses: usize,
+        completeness: Completeness,
+    ) -> Identifiability {
+        let mut identifiable: Vec<(usize, f64)> =
+            self.kept.iter().map(|&(k, v)| (candidates[k], v)).collect();
+        identifiable.sort_by_key(|&(i, _)| i);
+        let mut sorted = candidates.to_vec();
+        sorted.sort();
+        Identifiability {
+            measurement,
+            poses,
+            completeness,
+            candidates: sorted.into_iter().map(name).collect(),
+            fixed,
+            rank_svd: self.rank_svd,
+            rank_qr: self.rank_qr,
+            singular_values: self.singular_values,
+            variance_inflation: identifiable.iter().map(|&(_, v)| v).collect(),
+            identifiable: identifiable.into_iter().map(|(i, _)| name(i)).collect(),
+            condition_number: self.condition_number,
+            excluded: self.excluded,
+        }
+    }
 }
 
 /// The rank, the greedy minimal set (candidates in preference order, `names`), the

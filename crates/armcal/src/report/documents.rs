@@ -55,6 +55,9 @@ impl Document {
             let what = what.to_string();
             move |e: serde_json::Error| fail(format!("looks like an armcal {what}, but: {e}"))
         };
+        if let Some(refusal) = crate::identify::tree::tree_estimate_refusal(text) {
+            return Err(fail(refusal));
+        }
         if let Some(study) = obj.get("study") {
             return match study.as_str() {
                 Some("paper") => Ok(Document::Study(

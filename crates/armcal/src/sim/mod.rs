@@ -16,6 +16,8 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use serde::{Deserialize, Serialize};
 
+pub(crate) mod tree;
+
 /// Standard deviations of the truth perturbation per parameter kind (internal units).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Perturbation {
@@ -90,10 +92,18 @@ fn default_periodic() -> f64 {
 /// one nominal + N(0, σ²) of its stated prior if `p.fixed` is given (the same draw z per
 /// parameter whatever the statuses, so a seed's free parameters do not change).
 pub fn perturbed_truth(model: &Model, p: &Perturbation, seed: u64) -> Vec<f64> {
+    perturbed_registry(&model.registry, p, seed)
+}
+
+/// [`perturbed_truth`] of the parameters of `registry` (a serial model's or a tree's).
+pub(crate) fn perturbed_registry(
+    registry: &crate::model::Registry,
+    p: &Perturbation,
+    seed: u64,
+) -> Vec<f64> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let unit_normal = Normal::new(0.0, 1.0).expect("valid normal");
-    model
-        .registry
+    registry
         .iter()
         .map(|par| {
             // Draw for every parameter so the sequence does not depend on the statuses.
@@ -214,33 +224,44 @@ pub fn simulate_measuring(
         for &obs in &observed {
             let mut m = measurement_at(model, &fk, config, obs, measured);
             if let Some(noise) = noise {
-                let s = noise.row_sigmas(&m)?;
-                let mut z = || unit_normal.sample(&mut rng);
-                match &mut m.kind {
-                    MeasurementKind::Position { value, .. } => {
-                        *value += Vector3::new(s[0] * z(), s[1] * z(), s[2] * z());
-                    }
-                    MeasurementKind::Pose { value, .. } => {
-                        let dp = Vector3::new(s[0] * z(), s[1] * z(), s[2] * z());
-                        let dr = Vector3::new(s[3] * z(), s[4] * z(), s[5] * z());
-                        let angle = dr.norm();
-                        let rot = if angle > 0.0 {
-                            rot_axis(&(dr / angle), angle)
-                        } else {
-                            nalgebra::Matrix3::identity()
-                        };
-                        *value = Pose {
-                            rot: rot * value.rot,
-                            trans: value.trans + dp,
-                        };
-                    }
-                    _ => unreachable!("simulation makes position and pose measurements"),
-                }
+                add_noise(&mut m, noise, &mut || unit_normal.sample(&mut rng))?;
             }
             data.measurements.push(m);
         }
     }
     Ok(data)
+}
+
+/// Adds the instrument's noise to a simulated position or pose measurement, drawing each
+/// standard normal from `z`: `σ z` per position row, and a rotation by the vector `σ z` of
+/// the rotation rows on the left (the residual's `log(R_model R_measᵀ)` convention).
+pub(crate) fn add_noise(
+    m: &mut Measurement,
+    noise: &NoiseModel,
+    z: &mut dyn FnMut() -> f64,
+) -> Result<(), Error> {
+    let s = noise.row_sigmas(m)?;
+    match &mut m.kind {
+        MeasurementKind::Position { value, .. } => {
+            *value += Vector3::new(s[0] * z(), s[1] * z(), s[2] * z());
+        }
+        MeasurementKind::Pose { value, .. } => {
+            let dp = Vector3::new(s[0] * z(), s[1] * z(), s[2] * z());
+            let dr = Vector3::new(s[3] * z(), s[4] * z(), s[5] * z());
+            let angle = dr.norm();
+            let rot = if angle > 0.0 {
+                rot_axis(&(dr / angle), angle)
+            } else {
+                nalgebra::Matrix3::identity()
+            };
+            *value = Pose {
+                rot: rot * value.rot,
+                trans: value.trans + dp,
+            };
+        }
+        _ => unreachable!("simulation makes position and pose measurements"),
+    }
+    Ok(())
 }
 
 /// The frames a configuration's measurements observe: every target of `model`, or the tool
@@ -318,11 +339,20 @@ pub struct TruthRecord {
 impl TruthRecord {
     /// The record of `truth` (internal units) for `model` of the cell `cell`.
     pub fn new(cell: &str, model: &Model, truth: &[f64], seed: u64) -> TruthRecord {
+        TruthRecord::of_registry(cell, &model.registry, truth, seed)
+    }
+
+    /// [`TruthRecord::new`] of the parameters of `registry` (a serial model's or a tree's).
+    pub(crate) fn of_registry(
+        cell: &str,
+        registry: &crate::model::Registry,
+        truth: &[f64],
+        seed: u64,
+    ) -> TruthRecord {
         TruthRecord {
             cell: cell.to_string(),
             seed,
-            parameters: model
-                .registry
+            parameters: registry
                 .iter()
                 .zip(truth)
                 .map(|(p, v)| TrueParameter {

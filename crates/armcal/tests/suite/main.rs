@@ -33,6 +33,7 @@ mod identify {
     mod pivot;
     mod priors_and_noise;
     mod stations;
+    mod tree;
 }
 mod campaign {
     mod adaptive;
@@ -75,6 +76,7 @@ mod real_data {
     mod motoman_calibration;
     mod motoman_nominal;
     mod motoman_nongeometric;
+    mod motoman_tree;
     mod solver_convergence;
     mod ur10_cubes;
     mod ur10_import;

@@ -155,21 +155,28 @@ impl Ctx<'_> {
 
 pub(super) use tree::parse_tree;
 
-/// Parses a cell file section by section (in the order errors are reported).
-pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
-    let ctx = Ctx { file, text };
+/// The TOML of a cell file (serial or tree) read into its raw sections, with the context
+/// its errors name (file, line, field).
+fn parse_raw<'a>(text: &'a str, file: &'a str) -> Result<(Ctx<'a>, RawCell), Error> {
     let raw: RawCell = toml::from_str(text).map_err(|e| Error::File {
         file: file.to_string(),
         message: e.to_string(),
     })?;
+    Ok((Ctx { file, text }, raw))
+}
+
+/// Parses a cell file section by section (in the order errors are reported).
+pub(super) fn parse(text: &str, file: &str, dir: &Path) -> Result<Cell, Error> {
+    let (ctx, raw) = parse_raw(text, file)?;
     let rspan = raw.robot.span();
     let rr = raw.robot.into_inner();
     if let Some((span, field)) = tree::tree_field(&rr.links, &raw.targets) {
         return Err(ctx.err(
             span,
             &field,
-            "this cell describes a kinematic tree (or a coupled joint): `armcal model` \
-             analyses it; the other commands take a serial chain for now (issue 32)",
+            "this cell describes a kinematic tree (or a coupled joint): `armcal model`, \
+             `simulate` and `identify` take it; the other commands take a serial chain for \
+             now (issue 32)",
         ));
     }
 

@@ -32,11 +32,7 @@ pub(super) fn tree_field(
 
 /// Parses a tree cell.
 pub(in crate::cell) fn parse_tree(text: &str, file: &str) -> Result<TreeCell, Error> {
-    let ctx = Ctx { file, text };
-    let raw: RawCell = toml::from_str(text).map_err(|e| Error::File {
-        file: file.to_string(),
-        message: e.to_string(),
-    })?;
+    let (ctx, raw) = parse_raw(text, file)?;
     let rspan = raw.robot.span();
     let rr = raw.robot.into_inner();
     let unsupported = [
@@ -124,7 +120,8 @@ pub(in crate::cell) fn parse_tree(text: &str, file: &str) -> Result<TreeCell, Er
             "a tree cell lists its links in `[[robot.links]]`",
         ));
     }
-    let (_, instrument_geometry, instrument_name) = instrument::instrument(&ctx, raw.instrument)?;
+    let (instrument, instrument_geometry, instrument_name) =
+        instrument::instrument(&ctx, raw.instrument)?;
     let last = links
         .last()
         .map(|l| l.link.name.clone())
@@ -218,13 +215,15 @@ pub(in crate::cell) fn parse_tree(text: &str, file: &str) -> Result<TreeCell, Er
     } else {
         Measurement::Position
     });
-    Ok(TreeCell {
-        name: raw.name.unwrap_or_else(|| spec.name.clone()),
-        origin: file.to_string(),
+    TreeCell::new(
+        raw.name.unwrap_or_else(|| spec.name.clone()),
+        file.to_string(),
         spec,
         tree,
         measurement,
-    })
+        instrument.map(|i| i.noise).unwrap_or_default(),
+    )
+    .map_err(|e| ctx.err(rspan, "robot.links", e))
 }
 
 /// The name an unnamed `[[robot.links]]` entry `k` gets (as [`robot::inline_link`] names it).

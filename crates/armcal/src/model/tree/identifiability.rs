@@ -149,6 +149,20 @@ pub fn analyze_tree(
             &random
         }
     };
+    analyze_tree_measured(tree, params, qs, None, opts)
+}
+
+/// As [`analyze_tree`] at the configurations `qs`, configuration `c` measuring only the tree
+/// targets `measured[c]` (`None`: every target at every configuration): the analysis of a
+/// data set that measures one arm at a time, where the other arm's joints stand still and
+/// its parameters have no effect on those rows.
+pub(crate) fn analyze_tree_measured(
+    tree: &Tree,
+    params: &[f64],
+    qs: &[Vec<f64>],
+    measured: Option<&[Vec<usize>]>,
+    opts: &IdentifiabilitySettings,
+) -> Result<Identifiability, Error> {
     for q in qs {
         if q.len() != tree.dof() || q.iter().any(|x| !x.is_finite()) {
             return Err(Error::Input(format!(
@@ -162,16 +176,21 @@ pub fn analyze_tree(
     let obs = observations(tree, opts.measurement)?;
     let mut candidates = tree.registry.free();
     candidates.sort_by_key(|&i| preference(tree, i));
-    let per_pose: usize = obs.iter().map(|(_, r)| r.count()).sum();
     let mut data = TreeData::new(tree);
     let mut factor = RowCompressor::new(candidates.len());
-    let mut block = DMatrix::zeros(per_pose, candidates.len());
-    for q in qs {
+    for (c, q) in qs.iter().enumerate() {
+        let seen: Vec<(usize, Rows)> = obs
+            .iter()
+            .filter(|(t, _)| measured.is_none_or(|m| m[c].contains(t)))
+            .copied()
+            .collect();
+        let per_pose: usize = seen.iter().map(|(_, r)| r.count()).sum();
+        let mut block = DMatrix::zeros(per_pose, candidates.len());
         for b in 0..tree.branches.len() {
             branch_kinematics(tree, &mut data, b, params, q);
         }
         let mut row = 0;
-        for &(t, rows) in &obs {
+        for &(t, rows) in &seen {
             tree_identification_jacobian(tree, &mut data, t, rows, &candidates, &mut block, row);
             row += rows.count();
         }
@@ -180,8 +199,7 @@ pub fn analyze_tree(
     let m = factor.rows();
     let name = |i: usize| tree.registry.get(i).name.clone();
     let names: Vec<String> = candidates.iter().map(|&i| name(i)).collect();
-    let s = select(factor.finish(), m, &names, opts.measurement, opts.tolerance);
-    let mut excluded = s.excluded;
+    let mut s = select(factor.finish(), m, &names, opts.measurement, opts.tolerance);
     if !tree.coupled.is_empty() {
         // what the same tree identifies with its coupled joints moving on their own: a
         // parameter left out only under the coupling is left out because of it
@@ -196,7 +214,7 @@ pub fn analyze_tree(
             .iter()
             .filter_map(|c| tree.coupling_of(&c.link))
             .collect();
-        for e in &mut excluded {
+        for e in &mut s.excluded {
             if without.identifiable.contains(&e.name) {
                 e.reason += &format!(
                     "; it is identifiable when the coupled joints move on their own, so the \
@@ -206,37 +224,27 @@ pub fn analyze_tree(
             }
         }
     }
-    let mut identifiable: Vec<(usize, f64)> =
-        s.kept.iter().map(|&(k, v)| (candidates[k], v)).collect();
-    identifiable.sort_by_key(|&(i, _)| i);
     let r = tree
         .joints
         .iter()
         .filter(|j| j.kind == JointKind::Revolute)
         .count();
     let p = tree.dof() - r;
-    let mut sorted = candidates.clone();
-    sorted.sort();
-    Ok(Identifiability {
-        measurement: opts.measurement,
-        poses: qs.len(),
-        completeness: Completeness {
+    let fixed = (0..tree.param_count())
+        .filter(|&i| tree.registry.get(i).status == ParameterStatus::Fixed)
+        .map(name)
+        .collect();
+    Ok(s.into_report(
+        &candidates,
+        &name,
+        fixed,
+        opts.measurement,
+        qs.len(),
+        Completeness {
             revolute: r,
             prismatic: p,
             complete_pose_model: 4 * r + 2 * p + 6 * tree.targets.len(),
             expected_for_measurement: expected_tree_count(tree, opts.measurement),
         },
-        candidates: sorted.into_iter().map(name).collect(),
-        fixed: (0..tree.param_count())
-            .filter(|&i| tree.registry.get(i).status == ParameterStatus::Fixed)
-            .map(name)
-            .collect(),
-        rank_svd: s.rank_svd,
-        rank_qr: s.rank_qr,
-        singular_values: s.singular_values,
-        variance_inflation: identifiable.iter().map(|&(_, v)| v).collect(),
-        identifiable: identifiable.into_iter().map(|(i, _)| name(i)).collect(),
-        condition_number: s.condition_number,
-        excluded,
-    })
+    ))
 }

@@ -1,6 +1,10 @@
 //! Kinematic trees (a torso with several arms, a humanoid) and coupled joints (a joint that
 //! is a linear function of others: a parallelogram, a URDF `<mimic>`), issue 32.
 //!
+//! (Over 600 lines: the tree, its construction with every structural check, and the maps
+//! between the tree and its branches — registry, joints, the spec at an estimate — read the
+//! same index tables; split, they would be passed between files.)
+//!
 //! # Design: a tree is a set of serial branches with index maps
 //!
 //! A [`Tree`] holds one ordinary serial [`Model`] per *branch*: the path from the root link
@@ -347,6 +351,29 @@ impl Tree {
     /// The spec the tree was built from (nominal values).
     pub fn spec(&self) -> &TreeSpec {
         &self.spec
+    }
+
+    /// The spec of this tree with every geometric value taken from the tree parameter
+    /// vector `params` (an estimate): each link, the instrument and each target at its
+    /// branch's values (a shared link is one parameter set, so every branch gives it alike).
+    pub fn spec_at(&self, params: &[f64]) -> TreeSpec {
+        let mut spec = self.spec.clone();
+        for b in &self.branches {
+            let local: Vec<f64> = b.params.iter().map(|&t| params[t]).collect();
+            let at = b.model.spec_at(&local);
+            if let (Some(i), Some(given)) = (at.instrument, spec.instrument.as_mut()) {
+                *given = i;
+            }
+            for l in at.links {
+                if let Some(t) = spec.links.iter_mut().find(|t| t.link.name == l.name) {
+                    t.link = l;
+                }
+            }
+            for (k, t) in at.targets.into_iter().enumerate() {
+                spec.targets[b.targets[k]].target = t;
+            }
+        }
+        spec
     }
 
     /// The same tree with every coupled joint moving on its own (a data row then carries

@@ -1,0 +1,181 @@
+//! `armcal identify` and `armcal simulate` of a tree cell (links that name a `parent`,
+//! coupled joints, targets that name a `link`): parse, one library call, print.
+
+use super::digits::fixed;
+use super::output::{station_files, Outputs};
+use super::progress::Progress;
+use super::{identify, simulate};
+use anyhow::bail;
+use armcal::{Perturbation, TreeCell, TreeEstimate};
+use std::path::Path;
+
+/// `armcal identify --cell <tree cell>`: one fit of the whole tree over every data file.
+pub fn identify(a: &identify::Args, cell_path: &Path) -> anyhow::Result<()> {
+    // `--data TARGET=FILE`: every row of FILE saw TARGET (a serial cell's STATION=FILE)
+    let files = station_files(&a.data);
+    if a.refit.is_some() {
+        bail!("--refit: a tree fit does not refit frames yet (issue 32)");
+    }
+    let mut inputs = vec![cell_path];
+    inputs.extend(files.iter().map(|(_, f)| f.as_path()));
+    inputs.extend(a.test.as_deref());
+    let outputs = Outputs::plan(a.force, &inputs, &[&a.out])?;
+    let cell = TreeCell::from_file(cell_path)?;
+    let mut data = armcal::Dataset::default();
+    let mut sources = Vec::new();
+    for (target, file) in &files {
+        data.append(&cell.read_data(file, target.as_deref())?);
+        sources.push(file.display().to_string());
+    }
+    data.source = sources.join(" + ");
+    let test = a
+        .test
+        .as_deref()
+        .map(|t| cell.read_data(t, None))
+        .transpose()?;
+    let opts = identify::settings(a, test, None);
+    let est = armcal::identify_tree(&cell, &data, &opts, &mut Progress::new(a.quiet))?;
+    outputs.commit(&[(&a.out, &est.to_json()?)])?;
+    print_tree_summary(&est);
+    println!("\nestimate → {}", a.out.display());
+    if !est.solver.status.is_converged() {
+        bail!(
+            "the fit did not converge ({}); check the cell's nominal model and the data (units, joint columns, targets)",
+            est.solver.status
+        );
+    }
+    Ok(())
+}
+
+/// The summary of a tree estimate: solver, parameters, what is fixed and why, σ̂₀², the
+/// fit per target.
+fn print_tree_summary(e: &TreeEstimate) {
+    println!(
+        "{} (a tree): {} measurements at {} configurations from {}",
+        e.cell, e.measurements, e.configurations, e.data
+    );
+    println!(
+        "solver {}{}: {} after {} iterations, {:.1} ms",
+        e.solver.method.words(),
+        e.solver
+            .robust
+            .map(|l| format!(" + robust {}", l.words()))
+            .unwrap_or_default(),
+        e.solver.status,
+        e.solver.iterations,
+        e.solver.time_ms
+    );
+    println!(
+        "\n{:<16} {:>14} {:>14} {:>12} {:>5}",
+        "parameter", "nominal", "estimate", "± σ", "unit"
+    );
+    for p in e.parameters.iter().filter(|p| p.free) {
+        println!(
+            "{:<16} {:>14} {:>14} {:>12.5} {:>5}",
+            p.name,
+            fixed(p.nominal, 5),
+            fixed(p.estimate, 5),
+            p.sigma.unwrap_or(f64::NAN),
+            p.unit
+        );
+    }
+    if !e.fixed_reasons.is_empty() {
+        println!(
+            "\n{} parameters fixed at nominal (not identifiable from these data)",
+            e.fixed_reasons.len()
+        );
+    }
+    let u = &e.uncertainty;
+    println!(
+        "\nvariance factor σ̂₀² = {:.3} (χ² = {:.1}, {} dof, p = {:.3}): {}",
+        u.variance_factor, u.chi2, u.dof, u.p_value, u.verdict
+    );
+    if !e.outliers.is_empty() {
+        println!(
+            "  on the {} measurements kept; the {} outliers are left out of χ² and C_p",
+            e.measurements - e.outliers.len(),
+            e.outliers.len()
+        );
+    }
+    println!("\nposition error (mm) per target   fitted RMS / max   held-out RMS / max   frames only RMS");
+    for t in &e.targets {
+        let held = if t.held_out.count == 0 {
+            "         —".to_string()
+        } else {
+            format!(
+                "{:>8.4} / {:<8.4}   {:>8.4}",
+                t.held_out.rms, t.held_out.max, t.held_out_frames_only.rms
+            )
+        };
+        println!(
+            "  {:<30} {:>8.4} / {:<8.4}   {held}",
+            t.target, t.fitted.rms, t.fitted.max
+        );
+    }
+    if !e.validation.is_empty() {
+        println!("held out: {}", e.validation);
+    }
+}
+
+/// `armcal simulate --cell <tree cell>`: the tree measured at the poses, each pose at every
+/// target (or those of `--target`).
+pub fn simulate(a: &simulate::Args, cell_path: &Path) -> anyhow::Result<()> {
+    if a.payload.is_some() || a.perturb_fixed {
+        bail!("--payload and --perturb-fixed: a tree cell has no payloads or stated priors yet");
+    }
+    let mut outs = vec![a.out.as_path()];
+    outs.extend(a.truth_out.as_deref());
+    let outputs = Outputs::plan(a.force, &[cell_path, &a.poses], &outs)?;
+    let cell = TreeCell::from_file(cell_path)?;
+    let poses = cell.read_poses(&a.poses)?;
+    let targets = a
+        .target
+        .iter()
+        .map(|name| {
+            cell.tree
+                .targets
+                .iter()
+                .position(|t| t.0 == *name)
+                .ok_or_else(|| {
+                    let names: Vec<&str> = cell.tree.targets.iter().map(|t| t.0.as_str()).collect();
+                    anyhow::anyhow!(
+                        "--target {name}: no such target (the cell has: {})",
+                        names.join(", ")
+                    )
+                })
+        })
+        .collect::<anyhow::Result<Vec<usize>>>()?;
+    let pert = Perturbation {
+        length: a.perturb_mm,
+        angle: a.perturb_deg.to_radians(),
+        all: a.perturb_all,
+        instrument_length: Some(a.instrument_offset_mm),
+        ..Perturbation::default()
+    };
+    let sim = armcal::simulate_tree(
+        &cell.tree,
+        cell.measurement,
+        (!a.noise_free).then_some(&cell.noise),
+        &poses,
+        &targets,
+        &pert,
+        a.seed,
+    )?;
+    let data = cell.write_data(&sim.data)?;
+    let truth = sim.truth.to_json()?;
+    let mut files = vec![(a.out.as_path(), data.as_str())];
+    files.extend(a.truth_out.as_deref().map(|t| (t, truth.as_str())));
+    outputs.commit(&files)?;
+    println!(
+        "simulated {} measurements at {} configurations of tree `{}` (seed {}) → {}",
+        sim.data.measurements.len(),
+        poses.len(),
+        cell.name,
+        a.seed,
+        a.out.display()
+    );
+    if let Some(t) = &a.truth_out {
+        println!("true parameters → {}", t.display());
+    }
+    Ok(())
+}
