@@ -23,9 +23,8 @@ pub(crate) fn rows(
             "{name}: expected an array of shape (n, {cols}) ({what}), got {got}"
         ))
     };
-    let array: PyArrayLikeDyn<'_, f64, AllowTypeChange> = value
-        .extract()
-        .map_err(|_| shape_error(type_name(value)))?;
+    let array: PyArrayLikeDyn<'_, f64, AllowTypeChange> =
+        value.extract().map_err(|_| shape_error(type_name(value)))?;
     let view = array.as_array();
     if view.ndim() != 2 || width.is_some_and(|w| view.shape()[1] != w) {
         return Err(shape_error(format!("shape {:?}", view.shape())));
@@ -49,9 +48,8 @@ pub(crate) fn vector(
             "{name}: expected an array of shape ({n},) ({what}), got {got}"
         ))
     };
-    let array: PyArrayLikeDyn<'_, f64, AllowTypeChange> = value
-        .extract()
-        .map_err(|_| shape_error(type_name(value)))?;
+    let array: PyArrayLikeDyn<'_, f64, AllowTypeChange> =
+        value.extract().map_err(|_| shape_error(type_name(value)))?;
     let view = array.as_array();
     if view.ndim() != 1 || len.is_some_and(|l| view.len() != l) {
         return Err(shape_error(format!("shape {:?}", view.shape())));
@@ -60,7 +58,11 @@ pub(crate) fn vector(
 }
 
 /// Equal-length rows as an (n, k) array; `k` is used for an empty list.
-pub(crate) fn matrix<'py>(py: Python<'py>, rows: &[Vec<f64>], k: usize) -> Bound<'py, PyArray2<f64>> {
+pub(crate) fn matrix<'py>(
+    py: Python<'py>,
+    rows: &[Vec<f64>],
+    k: usize,
+) -> Bound<'py, PyArray2<f64>> {
     let k = rows.first().map_or(k, Vec::len);
     let flat: Vec<f64> = rows.iter().flatten().copied().collect();
     Array2::from_shape_vec((rows.len(), k), flat)

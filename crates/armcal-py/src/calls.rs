@@ -51,6 +51,7 @@ fn data_from_arrays(
     q: &Bound<'_, PyAny>,
     measured: &Bound<'_, PyAny>,
     sigma: Option<&Bound<'_, PyAny>>,
+    ids: Vec<String>,
 ) -> PyResult<armcal::Dataset> {
     let joints = joint_rows(cell, q)?;
     let measured = rows(
@@ -67,12 +68,13 @@ fn data_from_arrays(
         joints,
         measured,
         kind: armcal::RowKind::Position,
+        ids,
         ..Default::default()
     };
     let data = armcal::Dataset::from_arrays(&cell.cell.model, &arrays).map_err(armcal_error)?;
     match sigma {
         None => Ok(data),
-        Some(sigma) => with_sigma(data, &sigma),
+        Some(sigma) => with_sigma(cell, data, &sigma),
     }
 }
 
@@ -108,10 +110,12 @@ fn sigma_rows(s: &Bound<'_, PyAny>, m: usize) -> PyResult<Vec<[f64; 3]>> {
         .collect()
 }
 
-/// `data` with the σ of its i-th (position) measurement `sigma[i]`. The measurement kind's
-/// serde form (`{"kind": "position", "value": …, "sigma": …}`) is edited, so that the
-/// binding names only root items of the library.
-fn with_sigma(data: armcal::Dataset, sigma: &[[f64; 3]]) -> PyResult<armcal::Dataset> {
+/// `data` with the σ of its i-th (position) measurement `sigma[i]`, for a cell whose noise
+/// model weights each row by its own σ (`per-measurement`); for another cell an error
+/// (its noise model would not use them). The measurement kind's serde form (`{"kind":
+/// "position", "value": …, "sigma": …}`) is edited, so that the binding names only root
+/// items of the library.
+fn with_sigma(cell: &Cell, data: armcal::Dataset, sigma: &[[f64; 3]]) -> PyResult<armcal::Dataset> {
     let json = |e: serde_json::Error| ArmcalError::new_err(e.to_string());
     let mut value = serde_json::to_value(&data).map_err(json)?;
     if let Some(ms) = value["measurements"].as_array_mut() {
@@ -119,7 +123,11 @@ fn with_sigma(data: armcal::Dataset, sigma: &[[f64; 3]]) -> PyResult<armcal::Dat
             m["kind"]["sigma"] = serde_json::json!(s);
         }
     }
-    serde_json::from_value(value).map_err(json)
+    let data: armcal::Dataset = serde_json::from_value(value).map_err(json)?;
+    match cell.cell.noise().unused_sigmas(&data) {
+        Some(why) => Err(ArmcalError::new_err(format!("sigma: {why}"))),
+        None => Ok(data),
+    }
 }
 
 /// The data of `identify`, `check` and `campaign_step`: a `Dataset`, or joint rows with
@@ -133,12 +141,16 @@ fn data_argument(
     match (q.cast::<Dataset>(), measured) {
         (Ok(d), None) => match sigma {
             None => Ok(d.get().inner.clone()),
-            Some(s) => with_sigma(d.get().inner.clone(), &sigma_rows(s, d.get().inner.measurements.len())?),
+            Some(s) => {
+                let data = d.get().inner.clone();
+                let sigma = sigma_rows(s, data.measurements.len())?;
+                with_sigma(cell, data, &sigma)
+            }
         },
         (Ok(_), Some(_)) => Err(ArmcalError::new_err(
             "measured: give either a Dataset or q and measured, not both",
         )),
-        (Err(_), Some(m)) => data_from_arrays(cell, q, m, sigma),
+        (Err(_), Some(m)) => data_from_arrays(cell, q, m, sigma, Vec::new()),
         (Err(_), None) => Err(ArmcalError::new_err(
             "measured: missing (give q and measured, or a Dataset)",
         )),
@@ -170,7 +182,11 @@ fn fk<'py>(
 /// default perturbation: the scale of a real robot's errors), seeded; shape (p,), mm, rad.
 #[pyfunction]
 #[pyo3(signature = (cell, seed = 1))]
-fn perturbed_truth<'py>(py: Python<'py>, cell: &Cell, seed: u64) -> Bound<'py, numpy::PyArray1<f64>> {
+fn perturbed_truth<'py>(
+    py: Python<'py>,
+    cell: &Cell,
+    seed: u64,
+) -> Bound<'py, numpy::PyArray1<f64>> {
     let model = &cell.cell.model;
     array1(
         py,
@@ -180,9 +196,10 @@ fn perturbed_truth<'py>(py: Python<'py>, cell: &Cell, seed: u64) -> Bound<'py, n
 
 /// What the cell's instrument measures at `q` (shape (n, dof), rad) on a robot with the
 /// parameters `truth` (`None`: the nominal; an array, registry order, mm and rad), with the
-/// cell's instrument noise if `noise` (seeded: same seed, same data). Returns a `Dataset`.
+/// cell's instrument noise if `noise` (seeded: same seed, same data); `ids` name the rows
+/// (default `1`, `2`, …). Returns a `Dataset`.
 #[pyfunction]
-#[pyo3(signature = (cell, q, truth = None, noise = true, seed = 1))]
+#[pyo3(signature = (cell, q, truth = None, noise = true, seed = 1, ids = None))]
 fn simulate(
     py: Python<'_>,
     cell: &Cell,
@@ -190,8 +207,12 @@ fn simulate(
     truth: Option<&Bound<'_, PyAny>>,
     noise: bool,
     seed: u64,
+    ids: Option<Vec<String>>,
 ) -> PyResult<Dataset> {
     let configurations = joint_rows(cell, q)?;
+    let ids = ids
+        .map(|ids| checked_ids(ids, configurations.len()))
+        .transpose()?;
     let truth = parameters(cell, truth)?;
     let cell = &cell.cell;
     let data = py
@@ -200,7 +221,25 @@ fn simulate(
             armcal::simulate(&cell.model, &truth, &configurations, noise.as_ref(), seed)
         })
         .map_err(armcal_error)?;
-    Ok(Dataset::wrap(data))
+    Ok(Dataset::wrap(match ids {
+        Some(ids) => armcal::Dataset {
+            config_ids: ids,
+            ..data
+        },
+        None => data,
+    }))
+}
+
+/// `ids`, one per row of `q`.
+fn checked_ids(ids: Vec<String>, n: usize) -> PyResult<Vec<String>> {
+    if ids.len() == n {
+        Ok(ids)
+    } else {
+        Err(ArmcalError::new_err(format!(
+            "ids: {} ids for {n} rows of q",
+            ids.len()
+        )))
+    }
 }
 
 /// What the instrument measures at `q` (shape (n, dof), rad), noise-free, on the robot with
@@ -229,21 +268,27 @@ fn predict(
 /// A data set from arrays: joint rows `q` (shape (n, dof), rad) and the measured positions
 /// (shape (n, 3), mm, instrument frame), checked row by row (shape, non-finite values,
 /// joints past their limits: the message names the row and field); `sigma` (mm; a number,
-/// (3,) or (n, 3)) overrides the cell's instrument σ.
+/// (3,) or (n, 3)) is each row's σ, for a cell with the `per-measurement` noise model; `ids` name the rows (default `1`,
+/// `2`, …; a campaign step's batch has the ids of `state.next_ids`).
 #[pyfunction]
-#[pyo3(signature = (cell, q, measured, sigma = None))]
+#[pyo3(signature = (cell, q, measured, sigma = None, ids = None))]
 fn dataset(
     cell: &Cell,
     q: &Bound<'_, PyAny>,
     measured: &Bound<'_, PyAny>,
     sigma: Option<&Bound<'_, PyAny>>,
+    ids: Option<Vec<String>>,
 ) -> PyResult<Dataset> {
-    Ok(Dataset::wrap(data_from_arrays(cell, q, measured, sigma)?))
+    let ids = ids.unwrap_or_default();
+    Ok(Dataset::wrap(data_from_arrays(
+        cell, q, measured, sigma, ids,
+    )?))
 }
 
 /// Identifies the cell's free parameters from measured positions (`armcal identify`): `q`
 /// shape (n, dof) rad and `measured` shape (n, 3) mm, or a `Dataset` as `q`. `sigma`: the
-/// measurements' σ (mm; default the cell's instrument); `method`: `lm`, `gauss-newton` or
+/// measurements' σ (mm), for a cell whose instrument noise model is `per-measurement` (an
+/// error for another: its noise model weights every row by its own σ); `method`: `lm`, `gauss-newton` or
 /// `kalman`; `robust`: `None`, `huber` or `cauchy`; `holdout`: the fraction of
 /// configurations held out for validation (seeded by `seed`); `progress(event, info)`:
 /// see the package's docs. Returns an `Estimate`; a fit that did not converge is returned
@@ -333,8 +378,14 @@ fn plan(
             };
             let chosen = armcal::plan_pool(cell, &pool, &settings, &mut observer)?;
             let design = chosen.plan.design.clone();
-            let mut record =
-                armcal::DesignRecord::new(cell, None, "pool", &design, Some(chosen.plan), collisions)?;
+            let mut record = armcal::DesignRecord::new(
+                cell,
+                None,
+                "pool",
+                &design,
+                Some(chosen.plan),
+                collisions,
+            )?;
             record.pool = Some(chosen.pool);
             Ok(record)
         }
@@ -348,7 +399,9 @@ fn plan(
 fn assess<'py>(py: Python<'py>, cell: &Cell, q: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
     let design = joint_rows(cell, q)?;
     let cell = &cell.cell;
-    let a = py.detach(|| armcal::assess(cell, &design)).map_err(armcal_error)?;
+    let a = py
+        .detach(|| armcal::assess(cell, &design))
+        .map_err(armcal_error)?;
     py.import("json")?.call_method1("loads", (to_json(&a)?,))
 }
 
@@ -386,10 +439,17 @@ fn compensate<'py>(
         }
     };
     let model = &cell.cell.model;
-    estimate.inner.check_model(model).map_err(armcal_error)?;
-    let calibrated = estimate.params_vec()?;
+    // As the command line: the estimate's parameters for the cell's model, checked to be
+    // identified on it.
+    let calibrated = estimate.inner.params_for(model).map_err(armcal_error)?;
     let rows = py.detach(|| {
-        armcal::compensate(model, &calibrated, &program, &armcal::IkSettings::default(), None)
+        armcal::compensate(
+            model,
+            &calibrated,
+            &program,
+            &armcal::IkSettings::default(),
+            None,
+        )
     });
     let out = PyDict::new(py);
     let q_out: Vec<Vec<f64>> = rows.iter().map(|r| r.result.q.clone()).collect();
@@ -400,15 +460,24 @@ fn compensate<'py>(
     out.set_item("position_error", array1(py, errors))?;
     out.set_item(
         "rows",
-        py.import("json")?.call_method1("loads", (to_json(&rows)?,))?,
+        py.import("json")?
+            .call_method1("loads", (to_json(&rows)?,))?,
     )?;
     Ok(out)
 }
 
 /// `targets` (shape (n, 4, 4), homogeneous, mm) as the library's poses, through their serde
 /// form `{"rot": [column-major 3 × 3], "trans": [x, y, z]}` (a root item names no pose type).
-fn target_poses<T: serde::de::DeserializeOwned>(t: &Bound<'_, PyAny>, n: usize) -> PyResult<Vec<T>> {
-    let flat = rows(t.call_method1("reshape", (-1, 16))?.as_any(), "targets", Some(16), "4 × 4 world poses, mm")?;
+fn target_poses<T: serde::de::DeserializeOwned>(
+    t: &Bound<'_, PyAny>,
+    n: usize,
+) -> PyResult<Vec<T>> {
+    let flat = rows(
+        t.call_method1("reshape", (-1, 16))?.as_any(),
+        "targets",
+        Some(16),
+        "4 × 4 world poses, mm",
+    )?;
     if flat.len() != n {
         return Err(ArmcalError::new_err(format!(
             "targets: {} poses for {n} rows of q",
@@ -417,7 +486,9 @@ fn target_poses<T: serde::de::DeserializeOwned>(t: &Bound<'_, PyAny>, n: usize) 
     }
     flat.iter()
         .map(|m| {
-            let rot: Vec<f64> = (0..3).flat_map(|c| (0..3).map(move |r| m[4 * r + c])).collect();
+            let rot: Vec<f64> = (0..3)
+                .flat_map(|c| (0..3).map(move |r| m[4 * r + c]))
+                .collect();
             let value = serde_json::json!({ "rot": rot, "trans": [m[3], m[7], m[11]] });
             serde_json::from_value(value).map_err(|e| ArmcalError::new_err(format!("targets: {e}")))
         })
@@ -569,7 +640,8 @@ impl Scratch {
             .duration_since(std::time::UNIX_EPOCH)
             .map_or(0, |d| d.as_nanos());
         let dir = std::env::temp_dir().join(format!("armcal-py-{}-{nanos}", std::process::id()));
-        std::fs::create_dir_all(&dir).map_err(|e| ArmcalError::new_err(format!("{}: {e}", dir.display())))?;
+        std::fs::create_dir_all(&dir)
+            .map_err(|e| ArmcalError::new_err(format!("{}: {e}", dir.display())))?;
         Ok(Scratch(dir))
     }
 }

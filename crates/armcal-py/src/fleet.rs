@@ -1,13 +1,15 @@
 //! A fleet: many robots, each calibrated the same way (issue 34 item 4). One robot's task
 //! ([`robot`]): a virtual robot (the cell's nominal model perturbed, seeded), its KPI design
 //! of `poses` poses, its campaign simulated with the cell's instrument noise, the
-//! identification, and the check on held-out poses (the cell's working poses, measured
-//! again with fresh noise, never fitted): the calibrated model's error there and the drift
-//! check. `fleet_task` runs one robot (what a Ray task runs); `fleet` runs many in this
+//! identification, and the check on held-out poses (random configurations within the joint
+//! limits, seeded, measured with fresh noise, never fitted): the calibrated model's error
+//! there and the drift check. `fleet_task` runs one robot (what a Ray task runs); `fleet` runs many in this
 //! process over rayon's pool (`RAYON_NUM_THREADS`).
 
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -25,6 +27,8 @@ struct Task {
     poses: usize,
     /// Whether the design keeps the cell's collision constraints.
     collisions: bool,
+    /// Held-out poses of the check.
+    check_poses: usize,
     /// Where to write the robot's design, estimate and report (`None`: nowhere).
     out: Option<PathBuf>,
 }
@@ -48,10 +52,13 @@ struct Row {
     fit_rms_mm: f64,
     /// The largest predicted TCP σ over the working poses, √(max (1/3) tr C_s) (mm).
     tcp_sigma_mm: f64,
-    /// RMS and largest error of the calibrated model at the held-out poses (mm).
+    /// RMS error of the calibrated model at the held-out poses (mm; the instrument noise
+    /// included).
     check_rms_mm: f64,
     /// Largest error there (mm).
     check_max_mm: f64,
+    /// RMS error of the nominal model at the same poses (mm), for comparison.
+    nominal_rms_mm: f64,
     /// The parameter groups the drift check finds moved (`;`-separated; empty: none).
     check_moved: String,
     /// Wall time of the plan, the identification and the whole task (s).
@@ -77,26 +84,35 @@ fn robot(cell: &armcal::Cell, seed: u64, task: &Task) -> Result<Row, String> {
         ..Default::default()
     };
     let mut silent = armcal::Silent;
-    let design =
-        armcal::DesignRecord::planned(cell, None, "fleet", &settings, &[], &mut silent).map_err(err)?;
+    let design = armcal::DesignRecord::planned(cell, None, "fleet", &settings, &[], &mut silent)
+        .map_err(err)?;
     let plan_s = start.elapsed().as_secs_f64();
     let plan = design.plan.as_ref().ok_or("the plan made no design")?;
     let noise = cell.noise();
     let data = armcal::simulate(model, &truth, &plan.design, Some(&noise), seed).map_err(err)?;
     let t = Instant::now();
-    let estimate = armcal::identify(cell, &data, &armcal::IdentifySettings::default(), &mut silent)
-        .map_err(err)?;
+    let estimate = armcal::identify(
+        cell,
+        &data,
+        &armcal::IdentifySettings::default(),
+        &mut silent,
+    )
+    .map_err(err)?;
     let identify_s = t.elapsed().as_secs_f64();
-    // Held out: the working poses, measured again with fresh noise (seed offset so the
-    // noise differs from the fitted data's), never fitted.
-    let held: Vec<Vec<f64>> = cell.working.iter().map(|w| w.q.clone()).collect();
-    if held.is_empty() {
-        return Err(format!("cell `{}` has no working poses to check on", cell.name));
-    }
-    let measured = armcal::simulate(model, &truth, &held, Some(&noise), seed ^ 0x5eed).map_err(err)?;
-    let (check_rms_mm, check_max_mm) = held_out_error(cell, &estimate, &measured)?;
-    let drift = armcal::check(cell, &estimate, &measured, &armcal::CheckSettings::default())
-        .map_err(err)?;
+    // Held out: random configurations, measured with noise of another seed, never fitted.
+    let held = held_out_poses(model, task.check_poses, seed);
+    let measured =
+        armcal::simulate(model, &truth, &held, Some(&noise), seed ^ 0x5eed).map_err(err)?;
+    let calibrated = estimate.params_for(model).map_err(err)?;
+    let (check_rms_mm, check_max_mm) = held_out_error(cell, &calibrated, &measured)?;
+    let (nominal_rms_mm, _) = held_out_error(cell, &model.nominal(), &measured)?;
+    let drift = armcal::check(
+        cell,
+        &estimate,
+        &measured,
+        &armcal::CheckSettings::default(),
+    )
+    .map_err(err)?;
     let robot = format!("{}-{seed}", cell.name);
     let report = match &task.out {
         Some(dir) => write_robot(dir, &robot, &design, &estimate)?,
@@ -114,6 +130,7 @@ fn robot(cell: &armcal::Cell, seed: u64, task: &Task) -> Result<Row, String> {
         tcp_sigma_mm: max_kpi.sqrt(),
         check_rms_mm,
         check_max_mm,
+        nominal_rms_mm,
         check_moved: drift.moved_groups().join(";"),
         plan_s,
         identify_s,
@@ -122,28 +139,52 @@ fn robot(cell: &armcal::Cell, seed: u64, task: &Task) -> Result<Row, String> {
     })
 }
 
-/// RMS and largest distance between what the calibrated model predicts at the held-out
+/// `n` configurations uniform within the joint limits, seeded. (The library's own
+/// `random_configurations` is not a root item of its front door; this is the same uniform
+/// draw, with its own seed stream.)
+fn held_out_poses(model: &armcal::Model, n: usize, seed: u64) -> Vec<Vec<f64>> {
+    let (lower, upper) = model.joint_limits();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(0xc4ec));
+    (0..n)
+        .map(|_| {
+            lower
+                .iter()
+                .zip(&upper)
+                .map(|(l, u)| rng.random_range(*l..=*u))
+                .collect()
+        })
+        .collect()
+}
+
+/// RMS and largest distance between what the model with `params` predicts at the held-out
 /// poses and what was measured there (mm).
 fn held_out_error(
     cell: &armcal::Cell,
-    estimate: &armcal::Estimate,
+    params: &[f64],
     measured: &armcal::Dataset,
 ) -> Result<(f64, f64), String> {
-    let params = estimate.params_for(&cell.model).map_err(|e| e.to_string())?;
     let poses: Vec<(String, Vec<f64>)> = measured
         .config_ids
         .iter()
         .cloned()
         .zip(measured.configurations.iter().cloned())
         .collect();
-    let predicted = armcal::predict(&cell.model, &params, &poses, None, cell.measurement)
+    let predicted = armcal::predict(&cell.model, params, &poses, None, cell.measurement)
         .map_err(|e| e.to_string())?;
-    let json = |d: &armcal::Dataset| serde_json::to_value(&d.measurements).map_err(|e| e.to_string());
+    let json =
+        |d: &armcal::Dataset| serde_json::to_value(&d.measurements).map_err(|e| e.to_string());
     let (p, m) = (json(&predicted)?, json(measured)?);
-    let (p, m) = (p.as_array().cloned().unwrap_or_default(), m.as_array().cloned().unwrap_or_default());
+    let (p, m) = (
+        p.as_array().cloned().unwrap_or_default(),
+        m.as_array().cloned().unwrap_or_default(),
+    );
     let point = |v: &serde_json::Value| -> Option<[f64; 3]> {
         let a = v["kind"]["value"].as_array()?;
-        Some([a.first()?.as_f64()?, a.get(1)?.as_f64()?, a.get(2)?.as_f64()?])
+        Some([
+            a.first()?.as_f64()?,
+            a.get(1)?.as_f64()?,
+            a.get(2)?.as_f64()?,
+        ])
     };
     let errors: Vec<f64> = p
         .iter()
@@ -194,7 +235,9 @@ fn row_dict<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     match row {
         Ok(row) => {
-            let d = py.import("json")?.call_method1("loads", (to_json(&row)?,))?;
+            let d = py
+                .import("json")?
+                .call_method1("loads", (to_json(&row)?,))?;
             d.set_item("error", py.None())?;
             Ok(d)
         }
@@ -211,23 +254,26 @@ fn row_dict<'py>(
 /// One robot's calibration (what each Ray task of `examples/fleet_ray.py` runs): the
 /// virtual robot `cell` perturbed with `seed`, its KPI design of `poses` poses (with the
 /// cell's collision constraints if `collisions`), the simulated campaign, identification
-/// and the check on the held-out working poses. Returns the robot's row (a dict: plan value,
-/// status, χ² verdict, fit RMS, TCP σ, held-out RMS and largest error in mm, times in s);
+/// and the check on `check_poses` held-out random poses. Returns the robot's row (a dict: plan value,
+/// status, χ² verdict, fit RMS, TCP σ, held-out RMS and largest error of the calibrated
+/// and RMS of the nominal model in mm, the drift check's moved groups, times in s);
 /// a robot that fails has its message in `error`. With `out`, writes `out/<robot>/`
 /// (design, estimate, report).
 #[pyfunction]
-#[pyo3(signature = (cell, seed, *, poses = 30, collisions = false, out = None))]
+#[pyo3(signature = (cell, seed, *, poses = 60, check_poses = 20, collisions = false, out = None))]
 fn fleet_task<'py>(
     py: Python<'py>,
     cell: &Cell,
     seed: u64,
     poses: usize,
+    check_poses: usize,
     collisions: bool,
     out: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let task = Task {
         poses,
         collisions,
+        check_poses,
         out,
     };
     let c = &cell.cell;
@@ -240,12 +286,15 @@ fn fleet_task<'py>(
 /// threads; each robot's own planning runs inside it). Returns the rows in robot order;
 /// `progress("step", {})` after each robot.
 #[pyfunction]
-#[pyo3(signature = (cells, *, seed = 1, poses = 30, collisions = false, out = None, progress = None))]
+#[pyo3(signature = (cells, *, seed = 1, poses = 60, check_poses = 20, collisions = false, out = None,
+    progress = None))]
+#[allow(clippy::too_many_arguments)]
 fn fleet<'py>(
     py: Python<'py>,
     cells: &Bound<'py, PyList>,
     seed: u64,
     poses: usize,
+    check_poses: usize,
     collisions: bool,
     out: Option<PathBuf>,
     progress: Option<Py<PyAny>>,
@@ -262,6 +311,7 @@ fn fleet<'py>(
     let task = Task {
         poses,
         collisions,
+        check_poses,
         out,
     };
     let observer = std::sync::Mutex::new(Progress::new(progress));
@@ -279,7 +329,9 @@ fn fleet<'py>(
         armcal::Observer::finish(&mut *lock(&observer));
         rows
     });
-    let observer = observer.into_inner().map_err(|_| ArmcalError::new_err("progress poisoned"))?;
+    let observer = observer
+        .into_inner()
+        .map_err(|_| ArmcalError::new_err("progress poisoned"))?;
     let list = PyList::empty(py);
     for (i, (row, c)) in rows.into_iter().zip(&robots).enumerate() {
         list.append(row_dict(py, c, seed + i as u64, row)?)?;

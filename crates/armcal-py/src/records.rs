@@ -97,7 +97,11 @@ impl Cell {
         let cell = match kind {
             "load" => armcal::Cell::load(arg),
             "toml" => armcal::Cell::from_toml(arg, "<text>", std::path::Path::new(".")),
-            _ => return Err(ArmcalError::new_err(format!("unknown cell origin `{kind}`"))),
+            _ => {
+                return Err(ArmcalError::new_err(format!(
+                    "unknown cell origin `{kind}`"
+                )))
+            }
         }
         .map_err(armcal_error)?;
         Ok(Cell {
@@ -137,7 +141,12 @@ impl Cell {
     /// The joints' names.
     #[getter]
     fn joints(&self) -> Vec<String> {
-        self.cell.model.joints.iter().map(|j| j.name.clone()).collect()
+        self.cell
+            .model
+            .joints
+            .iter()
+            .map(|j| j.name.clone())
+            .collect()
     }
 
     /// The joint limits `(lower, upper)`, each of shape (dof,) (rad; mm for a prismatic
@@ -180,8 +189,8 @@ impl Cell {
             d.set_item("nominal", p.nominal)?;
             d.set_item("nominal_display", p.nominal * p.unit.display_factor())?;
             // The status's serde form: {"status": "free" | "fixed" | "prior", "sigma": …}.
-            let status = serde_json::to_value(p.status)
-                .map_err(|e| ArmcalError::new_err(e.to_string()))?;
+            let status =
+                serde_json::to_value(p.status).map_err(|e| ArmcalError::new_err(e.to_string()))?;
             d.set_item("status", status["status"].as_str())?;
             d.set_item("prior_sigma", status.get("sigma").and_then(|s| s.as_f64()))?;
             let reason = analysis.excluded.iter().find(|e| e.name == p.name);
@@ -302,10 +311,11 @@ impl Estimate {
         Estimate { inner }
     }
 
-    /// The identified parameter vector for the cell's model, registry order (mm, rad).
+    /// The identified parameters, registry order (mm, rad): the nominal values of the
+    /// identified model the estimate holds (`Estimate::model`), in internal units as fitted.
     pub(crate) fn params_vec(&self) -> PyResult<Vec<f64>> {
         let model = armcal::Model::from_spec(&self.inner.model).map_err(armcal_error)?;
-        self.inner.params_for(&model).map_err(armcal_error)
+        Ok(model.nominal())
     }
 }
 
@@ -320,7 +330,11 @@ record_methods!(Estimate, "estimate", {
     /// The names of `params`, registry order.
     #[getter]
     fn names(&self) -> Vec<String> {
-        self.inner.parameters.iter().map(|p| p.name.clone()).collect()
+        self.inner
+            .parameters
+            .iter()
+            .map(|p| p.name.clone())
+            .collect()
     }
 
     /// The free (estimated) parameters' names: the order of `sigma` and `cov`.
@@ -454,7 +468,13 @@ record_methods!(Design, "design", {
     /// The predicted C_s at each working pose, shape (w, 3, 3) (mm²).
     #[getter]
     fn tcp_cov<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f64>> {
-        let mats: Vec<_> = self.inner.assessment.tcp.iter().map(|t| t.covariance).collect();
+        let mats: Vec<_> = self
+            .inner
+            .assessment
+            .tcp
+            .iter()
+            .map(|t| t.covariance)
+            .collect();
         stack(py, &mats)
     }
 

@@ -67,21 +67,22 @@ def read_data(path, dof):
     """A position data file the CLI wrote: q (rad, converted as armcal does), measured (mm)."""
     with open(path) as f:
         header = f.readline().strip().split(",")
-    table = np.loadtxt(path, delimiter=",", skiprows=1, usecols=range(1, len(header)))
-    cols = header[1:]
-    qcols = [cols.index(f"q{j + 1}_deg") for j in range(dof)]
-    xcols = [cols.index(c) for c in ("x_mm", "y_mm", "z_mm")]
+    qcols = [header.index(f"q{j + 1}_deg") for j in range(dof)]
+    xcols = [header.index(c) for c in ("x_mm", "y_mm", "z_mm")]
+    table = np.loadtxt(path, delimiter=",", skiprows=1, usecols=qcols + xcols, ndmin=2)
     # f64::to_radians is x * (π / 180), as numpy's radians: the same bits as the CLI's.
-    return np.radians(table[:, qcols]), table[:, xcols]
+    return np.radians(table[:, :dof]), table[:, dof:]
 
 
 @pytest.fixture(scope="session")
 def simulated(tmp_path_factory, cli, cell):
-    """40 random poses of the paper cell simulated by the CLI (seed 3): the folder, the
-    poses (deg), and the data file."""
+    """The 60 KPI poses planned for the paper cell simulated by the CLI (seed 3): the folder
+    (poses.csv, data.csv, truth.json) and the poses (deg)."""
     d = tmp_path_factory.mktemp("sim")
-    q_deg = random_poses_deg(cell, 40, 11)
+    q_deg = np.loadtxt(ROOT / "examples" / "paper-poses-planned-60.csv", delimiter=",",
+                       skiprows=1, usecols=range(1, 7))
     write_poses(d / "poses.csv", q_deg)
     cli("simulate", "--cell", PAPER_CELL, "--poses", d / "poses.csv", "--seed", 3,
+        "--allow-unmeasurable",
         "--out", d / "data.csv", "--truth-out", d / "truth.json")
     return d, q_deg

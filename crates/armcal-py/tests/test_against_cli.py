@@ -72,7 +72,7 @@ def test_predict_and_fk_match_cli(cli, cell, tmp_path):
     tool = armcal.fk(cell, np.radians(q_deg))
     assert tool.shape == (2, 4, 4)
     for row, pose in zip(q_deg, tool):
-        out = json.loads(cli("fk", "--cell", PAPER_CELL, "--joints",
+        out = json.loads(cli("fk", PAPER_CELL, "--joints",
                              ",".join(repr(float(v)) for v in row), "--json"))
         tcp = [f for f in out["frames_world"] if f["frame"] in ("tool", "tcp")][-1]
         np.testing.assert_allclose(pose[:3, 3], tcp["pose"]["xyz_mm"], **TIGHT)
@@ -118,7 +118,7 @@ def test_check_and_compensate_match_cli(cli, cell, simulated, tmp_path):
     # compensate a joint program.
     program = np.array([[10.0, -20.0, 30.0, 40.0, -50.0, 60.0], [5.0, 5.0, 10.0, -15.0, 20.0, 1.0]])
     write_poses(tmp_path / "program.csv", program)
-    cli("compensate", "--cell", PAPER_CELL, "--estimate", est_path, "--program",
+    cli("compensate", "--cell", PAPER_CELL, "--estimate", est_path, "--targets",
         tmp_path / "program.csv", "--out", tmp_path / "out.csv")
     out = armcal.compensate(cell, est, np.radians(program))
     assert out["status"] == ["converged", "converged"]

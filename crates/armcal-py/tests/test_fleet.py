@@ -14,28 +14,29 @@ import armcal
 from conftest import PAPER_CELL, ROOT
 
 DETERMINISTIC = ["robot", "seed", "plan_value", "status", "converged", "chi2", "fit_rms_mm",
-                 "tcp_sigma_mm", "check_rms_mm", "check_max_mm", "check_moved"]
+                 "tcp_sigma_mm", "check_rms_mm", "check_max_mm", "nominal_rms_mm",
+                 "check_moved"]
 
 
 @pytest.fixture(scope="module")
 def in_process(cell):
-    return armcal.fleet([cell] * 3, seed=5, poses=20)
+    return armcal.fleet([cell] * 3, seed=5, poses=40)
 
 
 def test_fleet_rows(cell, in_process):
     assert [r["robot"] for r in in_process] == [f"{cell.name}-{s}" for s in (5, 6, 7)]
     for r in in_process:
         assert r["error"] is None and r["converged"], r
-        # Calibrated: the held-out error is of the order of the instrument noise, far below
-        # the perturbed robot's error (mm).
-        assert r["check_rms_mm"] < 0.2 and r["check_max_mm"] >= r["check_rms_mm"]
-        assert r["check_moved"] == ""
+        # Calibrated: at the held-out poses the error is better than the nominal model's
+        # and near the instrument's noise (σ = 1 mm per axis in this cell: √3 mm RMS alone).
+        assert r["check_rms_mm"] < min(r["nominal_rms_mm"], 2 * 3**0.5), r
+        assert r["check_max_mm"] >= r["check_rms_mm"]
     # Different robots, different results.
     assert len({r["fit_rms_mm"] for r in in_process}) == 3
 
 
 def test_fleet_task_is_the_fleets_task(cell, in_process):
-    row = armcal.fleet_task(cell, 6, poses=20)
+    row = armcal.fleet_task(cell, 6, poses=40)
     assert {k: row[k] for k in DETERMINISTIC} == {k: in_process[1][k] for k in DETERMINISTIC}
 
 

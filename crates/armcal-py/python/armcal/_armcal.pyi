@@ -101,11 +101,20 @@ class DriftCheck(_Record):
 def fk(cell: Cell, q: ArrayLike, params: Params = None) -> F64: ...
 def perturbed_truth(cell: Cell, seed: int = 1) -> F64: ...
 def simulate(
-    cell: Cell, q: ArrayLike, truth: Optional[ArrayLike] = None, noise: bool = True, seed: int = 1
+    cell: Cell,
+    q: ArrayLike,
+    truth: Optional[ArrayLike] = None,
+    noise: bool = True,
+    seed: int = 1,
+    ids: Optional[Sequence[str]] = None,
 ) -> Dataset: ...
 def predict(cell: Cell, q: ArrayLike, params: Params = None) -> Dataset: ...
 def dataset(
-    cell: Cell, q: ArrayLike, measured: ArrayLike, sigma: Optional[ArrayLike] = None
+    cell: Cell,
+    q: ArrayLike,
+    measured: ArrayLike,
+    sigma: Optional[ArrayLike] = None,
+    ids: Optional[Sequence[str]] = None,
 ) -> Dataset: ...
 def identify(
     cell: Cell,
@@ -171,7 +180,8 @@ def fleet_task(
     cell: Cell,
     seed: int,
     *,
-    poses: int = 30,
+    poses: int = 60,
+    check_poses: int = 20,
     collisions: bool = False,
     out: Optional[Union[str, PathLike[str]]] = None,
 ) -> dict[str, Any]: ...
@@ -179,7 +189,8 @@ def fleet(
     cells: Sequence[Cell],
     *,
     seed: int = 1,
-    poses: int = 30,
+    poses: int = 60,
+    check_poses: int = 20,
     collisions: bool = False,
     out: Optional[Union[str, PathLike[str]]] = None,
     progress: Optional[Progress] = None,
