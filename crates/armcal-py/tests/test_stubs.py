@@ -34,9 +34,8 @@ def native_names():
         if name.startswith("__"):
             continue
         if inspect.isclass(obj):
-            names[name] = {
-                m for m in vars(obj) if not m.startswith("__") or m == "__len__"
-            } - ({"__len__"} if "__len__" not in vars(obj) else set())
+            own = set(vars(obj))
+            names[name] = {m for m in own if not m.startswith("__")} | ({"__len__"} & own)
         elif callable(obj):
             names[name] = None
     return names
