@@ -96,7 +96,7 @@ def test_identify_recovers_the_truth(cell, fitted):
 
 def test_gil_released_during_identify(cell):
     """A second Python thread keeps counting while identify runs."""
-    q = np.radians(random_poses_deg(cell, 400, 9))
+    q = np.radians(random_poses_deg(cell, 1000, 9))
     data = armcal.simulate(cell, q, truth=armcal.perturbed_truth(cell, seed=2), seed=3)
     ticks = []
     stop = threading.Event()
