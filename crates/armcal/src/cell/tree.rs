@@ -4,6 +4,7 @@
 //! such a file and [`TreeCell`] reads it.
 
 use crate::measure::{csv, Dataset, NoiseModel};
+use crate::model::controller::ControllerConvention;
 use crate::model::identifiability::{Identifiability, IdentifiabilitySettings, Measurement};
 use crate::model::tree::identifiability::analyze_tree;
 use crate::model::tree::{Tree, TreeSpec};
@@ -116,7 +117,9 @@ impl TreeCell {
     /// Reads joint configurations of this tree (`pose_id` and a column per tree joint that
     /// is not coupled, as [`TreeCell::read_data`]), each within the joint limits.
     pub fn read_poses(&self, path: &Path) -> Result<Vec<(String, Vec<f64>)>, Error> {
-        csv::read_reachable_configurations(path, &self.data_model)
+        // a tree cell has no controller convention (its joints are the model's)
+        let model_angles = ControllerConvention::model_angles(self.data_model.dof());
+        csv::read_reachable_configurations(path, &self.data_model, &model_angles)
     }
 
     /// `data` in armcal's CSV for this tree ([`TreeCell::read_data`] reads it back).

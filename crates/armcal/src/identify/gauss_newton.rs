@@ -13,8 +13,7 @@
 
 use super::problem::Problem;
 use super::solver::{
-    gradient_cosine, no_decrease_status, Iterate, LeastSquares, SolverResult,
-    ToleranceSettings,
+    gradient_cosine, no_decrease_status, Iterate, LeastSquares, SolverResult, ToleranceSettings,
 };
 use crate::progress::Observer;
 use crate::solve::Status;

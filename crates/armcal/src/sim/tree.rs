@@ -55,11 +55,14 @@ pub fn simulate_tree(
         )?;
         for i in 0..registry.len() {
             let free = generic.identifiable.contains(&registry.get(i).name);
-            registry.set_status(i, if free {
-                ParameterStatus::Free
-            } else {
-                ParameterStatus::Fixed
-            });
+            registry.set_status(
+                i,
+                if free {
+                    ParameterStatus::Free
+                } else {
+                    ParameterStatus::Fixed
+                },
+            );
         }
     }
     let truth = perturbed_registry(&registry, perturbation, seed);
