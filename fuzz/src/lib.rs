@@ -110,7 +110,7 @@ pub fn data_csv(bytes: &[u8]) {
     match (choice >> 1) & 3 {
         1 => configurations(cell, text),
         2 => {
-            let _ = csv::read_targets_str(text, "fuzz.csv", &cell.model);
+            let _ = csv::read_targets_str(text, "fuzz.csv", &cell.model, Some(&cell.controller));
         }
         _ => measurements(cell, text),
     }

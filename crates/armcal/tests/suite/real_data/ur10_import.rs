@@ -197,6 +197,7 @@ fn handeye_format(
         sigma_orientation: None,
         temperature: None,
         controller: None,
+        controller_columns: None,
     }
 }
 
