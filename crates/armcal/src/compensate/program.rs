@@ -12,6 +12,9 @@
 //! [`compensate_program`] does either for a program file (`armcal compensate`): Cartesian
 //! targets if its header has orientation columns, a joint program otherwise, and returns the
 //! compensated program as CSV with a status per row.
+//!
+//! (Over 600 lines: one filter — the rows as values, their CSV reader and writer, and the
+//! program record — whose parts share the row types; split, each would re-export the others.)
 
 use crate::compensate::ik::{CalibratedIk, IkResult, IkSettings, IkStatus, IkTarget};
 use crate::compensate::joint_change::{self, within_joint_change_limit};

@@ -58,9 +58,6 @@ struct RawRobot {
     /// A Universal Robots kinematics YAML ([`crate::model::ur_kinematics`]), relative to the
     /// cell file: the robot's factory calibration as its nominal model.
     ur_kinematics: Option<String>,
-    /// A ROS 2 per-joint corrections file ([`crate::model::urdf::joint_corrections`]),
-    /// relative to the cell file, applied to the robot (built-in, URDF, UR file or links).
-    joint_corrections: Option<String>,
     tip: Option<String>,
     name: Option<String>,
     #[serde(default)]

@@ -1,5 +1,5 @@
 //! `[robot]` (a built-in robot, a URDF file, a Universal Robots kinematics YAML or inline
-//! `[[robot.links]]`, a ROS 2 `joint_corrections` file applied to it, joint `limits`,
+//! `[[robot.links]]`, joint `limits`,
 //! `[[robot.capsules]]`, the skeleton's `link_radius_mm` and `link_radii_mm`, `convention`)
 //! and `[[tool_capsules]]`.
 
@@ -157,39 +157,7 @@ pub(super) fn robot(
     } else if !rr.capsules.is_empty() {
         robot.collision = format!("the cell's {} [[robot.capsules]]", rr.capsules.len());
     }
-    if let Some(c) = &rr.joint_corrections {
-        corrections(ctx, &mut robot, &dir.join(c), rspan)?;
-    }
     Ok((robot, shapes))
-}
-
-/// `[robot] joint_corrections`: the ROS 2 per-joint corrections file at `path` applied to
-/// the robot ([`crate::model::urdf::joint_corrections`]). The corrected chain is the robot
-/// as a URDF chain, whose frames are the URDF's links; the robot's capsules are re-expressed
-/// in them ([`crate::robots::transfer_capsules`], through the uncorrected URDF chain, which
-/// has the robot's forward kinematics), so they stay on the bodies they were drawn on.
-fn corrections(
-    ctx: &Ctx,
-    robot: &mut Robot,
-    path: &Path,
-    rspan: Range<usize>,
-) -> Result<(), Error> {
-    use crate::model::urdf::joint_corrections::{as_urdf_chain, read_joint_corrections};
-    let field = "robot.joint_corrections";
-    let fail = |e: Error| ctx.err(rspan.clone(), field, e);
-    let nominal = Model::from_spec(&robot.spec).map_err(fail)?;
-    let same = Model::from_spec(&as_urdf_chain(&robot.spec).map_err(fail)?).map_err(fail)?;
-    robot.capsules =
-        crate::robots::transfer_capsules(&nominal, &same, &robot.capsules).map_err(fail)?;
-    robot.spec = read_joint_corrections(path, &robot.spec).map_err(fail)?;
-    check_values(ctx, &robot.spec.links, rspan.clone(), field)?;
-    robot.summary = format!(
-        "{}, with the joint corrections of {}",
-        robot.summary,
-        path.display()
-    );
-    robot.source = format!("{}, corrected by {}", robot.source, path.display());
-    Ok(())
 }
 
 /// The arm's collision model when the cell does not draw it: a robot from `urdf` or

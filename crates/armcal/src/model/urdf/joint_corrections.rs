@@ -202,23 +202,12 @@ pub fn apply_joint_corrections(text: &str, nominal: &ModelSpec) -> Result<ModelS
             });
         }
     }
-    urdf_chain(&robot, nominal)
-}
-
-/// `nominal` as the URDF chain the corrections apply to, uncorrected: the same forward
-/// kinematics, with the URDF's link frames (a cell re-expresses capsules in them).
-pub(crate) fn as_urdf_chain(nominal: &ModelSpec) -> Result<ModelSpec, Error> {
-    urdf_chain(&urdf_robot(nominal, &[])?, nominal)
-}
-
-/// `robot` (the URDF of `nominal`, corrected or not) imported back as a chain.
-fn urdf_chain(robot: &urdf_rs::Robot, nominal: &ModelSpec) -> Result<ModelSpec, Error> {
     // The chain ends in the link before the targets' fixed joints (super::export).
     let tip = robot.joints[robot.joints.len() - nominal.targets.len() - 1]
         .child
         .link
         .clone();
-    let mut spec = super::import::from_urdf_robot(robot, Some(&tip))?;
+    let mut spec = super::import::from_urdf_robot(&robot, Some(&tip))?;
     spec.name = nominal.name.clone();
     Ok(spec)
 }
