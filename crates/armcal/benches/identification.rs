@@ -1,5 +1,8 @@
-//! Identification benchmark: 1000 simulated poses of the paper cell, 27 free parameters,
-//! Levenberg–Marquardt from the nominal model.
+//! Identification benchmark: 1000 simulated poses of the paper cell, 27 free parameters:
+//! Levenberg–Marquardt alone from the nominal model on a prepared problem, and the whole
+//! root call `armcal::identify` (frames-first start, free set, LM, uncertainty, residuals),
+//! the call the CLI and the Python package make (the Python figure is compared with this
+//! one, docs/src/reference/benchmarks.md).
 
 use armcal::cell::Cell;
 use armcal::identify::{levenberg_marquardt, LmSettings, Problem};
@@ -29,6 +32,15 @@ fn identification(c: &mut Criterion) {
                 .expect("solve");
             assert!(sol.status.is_converged());
             sol
+        })
+    });
+    group.bench_function("identify (the root call), 1000 poses, 27 parameters", |b| {
+        b.iter(|| {
+            let estimate =
+                armcal::identify(&cell, &data, &armcal::IdentifySettings::default(), &mut Silent)
+                    .expect("identify");
+            assert!(estimate.solver.status.is_converged());
+            estimate
         })
     });
     group.finish();
