@@ -394,9 +394,24 @@ pub fn filter_controller_program(
     }
     let mut out = String::with_capacity(text.len() + 64 * edits.len());
     let mut at = 0;
+    let bytes = text.as_bytes();
     for (span, new) in edits {
         out.push_str(&text[at..span.start]);
+        // A number written against a word (`C.4519` → `C0.401198`) would join it and be read
+        // back as another field (`C0`); a space keeps the two tokens apart, as they were.
+        let glued = |outside: Option<&u8>, inside: Option<u8>| {
+            outside.is_some_and(|&b| scan::ident_byte(b)) && inside.is_some_and(scan::ident_byte)
+        };
+        if glued(
+            span.start.checked_sub(1).and_then(|i| bytes.get(i)),
+            new.bytes().next(),
+        ) {
+            out.push(' ');
+        }
         out.push_str(&new);
+        if glued(bytes.get(span.end), new.bytes().last()) {
+            out.push(' ');
+        }
         at = span.end;
     }
     out.push_str(&text[at..]);

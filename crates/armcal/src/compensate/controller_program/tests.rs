@@ -379,3 +379,52 @@ fn an_aggregate_left_open_is_read_once() {
         assert!(e.to_string().contains("fuzz.dat: line"), "{e}");
     }
 }
+
+/// A number written right after its field's name (`C.4519`, `A6.5`: KRL reads the name up to
+/// the first byte that cannot continue it) is rewritten with a space before it, so the
+/// filtered program reads back with the same fields (`C0.4…` would be a field `C0`). The
+/// fuzz finding (`fuzz-krl-glued-number.dat`) and the same in the sample program.
+#[test]
+fn a_number_glued_to_its_field_name_stays_apart() {
+    let c = cell("kr15");
+    let sample = KRL_DAT
+        .replace("C 3.4519,S 2", "C.4519,S 2")
+        .replace("A6 60.0}", "A6.5}");
+    assert_ne!(sample, KRL_DAT);
+    let fuzz = include_str!("../../../tests/fixtures/programs/fuzz-krl-glued-number.dat");
+    for (text, to_joints) in [
+        (sample.as_str(), false),
+        (sample.as_str(), true),
+        (fuzz, false),
+    ] {
+        let s = settings(Language::Krl, to_joints);
+        let run = |t: &str| {
+            filter_controller_program(&c.model, &calibrated(&c.model), &c.controller, t, "f", &s)
+        };
+        let first = run(text).unwrap();
+        let again = run(&first.text).unwrap_or_else(|e| panic!("{e}\n{}", first.text));
+        assert_eq!(first.targets.len(), again.targets.len());
+        let compensated = |t: &str| {
+            let targets = read(t, Language::Krl, 6);
+            targets.iter().filter(|t| t.value.is_ok()).count()
+        };
+        assert_eq!(
+            compensated(text),
+            compensated(&first.text),
+            "{}",
+            first.text
+        );
+        if text == sample && !to_joints {
+            let line = |start: &str| {
+                let l = first.text.lines().find(|l| l.starts_with(start));
+                l.unwrap_or_else(|| panic!("no line {start}")).to_string()
+            };
+            assert!(line("DECL E6POS XP1=").contains(",C 0."), "{}", first.text);
+            assert!(
+                line("DECL GLOBAL AXIS XP3=").contains(",A6 0."),
+                "{}",
+                first.text
+            );
+        }
+    }
+}
