@@ -44,7 +44,7 @@ pub struct Args {
     #[arg(long, requires = "campaign")]
     pub target_sigma_mm: Option<f64>,
     /// Groups to release from the prior, comma-separated (`j2,tracker`); default: the
-    /// groups whose score test rejects at α (at least the first).
+    /// groups Holm's step-down procedure over the score tests rejects at α (at least the first).
     #[arg(long, value_delimiter = ',', requires = "campaign")]
     pub release: Vec<String>,
     /// The campaign's poses per batch.

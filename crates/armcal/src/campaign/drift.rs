@@ -118,16 +118,23 @@ pub struct DriftCheck {
 }
 
 impl DriftCheck {
-    /// The groups that most likely moved: every group whose score test rejects "did not
-    /// move" at the check's α, and at least the first when the check says "drifted" (the
-    /// groups a campaign after the check releases from the old estimate's prior,
-    /// [`crate::campaign::prior`]). Empty for a consistent check without such a group.
+    /// The groups that most likely moved: the groups whose score test rejects "did not
+    /// move" by Holm's step-down procedure at the check's α (Holm 1979, "A simple sequentially
+    /// rejective multiple test procedure": the k-th smallest of the G tested groups' p-values,
+    /// k = 0, 1, …, rejects at α/(G − k) while every smaller one has), and at least the first
+    /// when the check says "drifted" (the groups a campaign after the check releases from the
+    /// old estimate's prior, [`crate::campaign::prior`]). Empty for a consistent check without
+    /// such a group. Testing each of a robot's 8 or so groups at α on its own would name a
+    /// group on an unmoved robot far more often than α; Holm's procedure keeps the chance of
+    /// naming any group of an unmoved robot at most α.
     pub fn moved_groups(&self) -> Vec<String> {
+        let tested = self.groups.iter().filter(|g| g.rank > 0).count();
         let mut moved: Vec<String> = self
             .groups
             .iter()
-            .filter(|g| g.p_value < self.alpha)
-            .map(|g| g.group.clone())
+            .enumerate()
+            .take_while(|(k, g)| g.rank > 0 && g.p_value < self.alpha / (tested - k) as f64)
+            .map(|(_, g)| g.group.clone())
             .collect();
         if moved.is_empty() && self.verdict == DriftVerdict::Drifted {
             moved.extend(self.groups.first().map(|g| g.group.clone()));

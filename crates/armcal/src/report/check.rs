@@ -26,7 +26,7 @@ pub fn check_section(id: &str, label: &str, c: &DriftCheck) -> Section {
         }
     ));
     s.html(format!(
-        "<p class=\"note\">χ² = rᵀ S⁻¹ r of the check residuals r, S the instrument's covariance plus the calibration's prediction covariance ({}); without the prediction covariance χ² would be {}. The groups' score tests say which parameters most likely moved.</p>\n",
+        "<p class=\"note\">χ² = rᵀ S⁻¹ r of the check residuals r, S the instrument's covariance plus the calibration's prediction covariance ({}); without the prediction covariance χ² would be {}. The groups' score tests say which parameters most likely moved; a group marked ! rejects \"did not move\" by Holm's step-down procedure over the groups at α (so an unmoved robot has a group marked with probability at most α).</p>\n",
         escape(&c.covariance_rule),
         number(c.chi2_without_prediction)
     ));

@@ -38,6 +38,9 @@ fn without_drift_the_false_alarm_rate_is_alpha() {
     let cell = paper_cell();
     let runs = 1000u64;
     let (mut alarms, mut alarms_without_prediction) = (0, 0);
+    // Unmoved robots with a group named as moved: by Holm's procedure (`moved_groups`) and
+    // by each group's test at α on its own.
+    let (mut groups_named, mut groups_uncorrected) = (0, 0);
     for seed in 1..=runs {
         let truth = perturbed_truth(&cell.model, &Perturbation::default(), seed);
         let est = calibrate(&cell, &truth, 10_000 + seed);
@@ -51,6 +54,12 @@ fn without_drift_the_false_alarm_rate_is_alpha() {
             alarms_without_prediction += 1;
         }
         assert!(c.chi2 <= c.chi2_without_prediction + 1e-9);
+        if c.verdict == DriftVerdict::Consistent && !c.moved_groups().is_empty() {
+            groups_named += 1;
+        }
+        if c.groups.iter().any(|g| g.p_value < c.alpha) {
+            groups_uncorrected += 1;
+        }
     }
     let rate = alarms as f64 / runs as f64;
     eprintln!(
@@ -60,6 +69,12 @@ fn without_drift_the_false_alarm_rate_is_alpha() {
     // Binomial(1000, 0.05): σ 0.69 %; the band 3–7 % is ±2.9 σ.
     assert!((0.03..=0.07).contains(&rate), "false-alarm rate {rate}");
     assert!(alarms_without_prediction >= alarms);
+    // A consistent check names a group only through Holm's procedure, whose family-wise rate
+    // is at most α over all the robot's groups (so at most α here too).
+    eprintln!(
+        "consistent checks naming a moved group: {groups_named}/{runs}; any group's own test at α rejecting: {groups_uncorrected}/{runs}"
+    );
+    assert!(groups_named as f64 / runs as f64 <= 0.07, "{groups_named}");
 }
 
 #[test]
