@@ -111,6 +111,7 @@ pub use sim::{perturbed_truth, predict, simulate, Perturbation};
 // Identification, its checks, the prediction σ of any configuration, joint axes by circle
 // point analysis.
 pub use identify::circle_point::record::{axes_record, AxesRecord};
+pub use identify::estimate::{ParameterEstimate, SolverReport};
 pub use identify::fit_checks::FitChecks;
 pub use identify::prediction_sigma::{csv_with_sigmas, prediction_sigmas, RowSigma};
 pub use identify::{identify, Acceptance, Estimate, IdentifySettings};

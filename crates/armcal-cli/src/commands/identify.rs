@@ -11,6 +11,7 @@ use armcal::identify::{
     held_out, identify, Candidate, Estimate, FramesRefit, IdentifySettings, LmSettings, Loss,
     Method, NonGeometric, ToleranceSettings,
 };
+use armcal::{ParameterEstimate, SolverReport};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -181,31 +182,7 @@ pub fn print_summary(e: &Estimate) {
         "{}: {} measurements at {} configurations from {}",
         e.cell, e.measurements, e.configurations, e.data
     );
-    println!(
-        "solver {}{}: {} after {} iterations, {:.1} ms",
-        e.solver.method.words(),
-        e.solver
-            .robust
-            .map(|l| format!(" + robust {}", l.words()))
-            .unwrap_or_default(),
-        e.solver.status,
-        e.solver.iterations,
-        e.solver.time_ms
-    );
-    println!(
-        "\n{:<14} {:>14} {:>14} {:>12} {:>5}",
-        "parameter", "nominal", "estimate", "± σ", "unit"
-    );
-    for p in e.parameters.iter().filter(|p| p.free) {
-        println!(
-            "{:<14} {:>14} {:>14} {:>12.5} {:>5}",
-            p.name,
-            fixed(p.nominal, 5),
-            fixed(p.estimate, 5),
-            p.sigma.unwrap_or(f64::NAN),
-            p.unit
-        );
-    }
+    print_solver_and_parameters(&e.solver, &e.parameters, 14);
     if !e.fixed_reasons.is_empty() {
         println!("\nfixed (not identifiable):");
         for (_, r) in &e.fixed_reasons {
@@ -381,6 +358,40 @@ pub fn print_summary(e: &Estimate) {
                 );
             }
         }
+    }
+}
+
+/// The solver line and the table of the free parameters (nominal, estimate, σ, unit) of a
+/// serial or a tree estimate; `name_width` is the width of the name column.
+pub fn print_solver_and_parameters(
+    solver: &SolverReport,
+    parameters: &[ParameterEstimate],
+    name_width: usize,
+) {
+    println!(
+        "solver {}{}: {} after {} iterations, {:.1} ms",
+        solver.method.words(),
+        solver
+            .robust
+            .map(|l| format!(" + robust {}", l.words()))
+            .unwrap_or_default(),
+        solver.status,
+        solver.iterations,
+        solver.time_ms
+    );
+    println!(
+        "\n{:<name_width$} {:>14} {:>14} {:>12} {:>5}",
+        "parameter", "nominal", "estimate", "± σ", "unit"
+    );
+    for p in parameters.iter().filter(|p| p.free) {
+        println!(
+            "{:<name_width$} {:>14} {:>14} {:>12.5} {:>5}",
+            p.name,
+            fixed(p.nominal, 5),
+            fixed(p.estimate, 5),
+            p.sigma.unwrap_or(f64::NAN),
+            p.unit
+        );
     }
 }
 

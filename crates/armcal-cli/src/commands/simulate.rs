@@ -145,15 +145,33 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         a.seed,
     )?;
     let data = cell.with_controller_columns(csv::write_string(&sim.data, model)?)?;
-    let truth = sim.truth.to_json()?;
-    let mut files = vec![(a.out.as_path(), data.as_str())];
-    files.extend(a.truth_out.as_deref().map(|t| (t, truth.as_str())));
-    outputs.commit(&files)?;
-    println!(
-        "simulated {} measurements at {} configurations of `{}` (seed {}) → {}",
+    commit_and_print(
+        a,
+        &outputs,
+        &data,
+        &sim.truth.to_json()?,
         sim.data.measurements.len(),
         poses.len(),
-        cell.name,
+        &format!("`{}`", cell.name),
+    )
+}
+
+/// Writes the simulated data (and the true parameters, `--truth-out`) all or nothing and
+/// says what was simulated of `what` (a serial cell's or a tree's name) and where it went.
+pub fn commit_and_print(
+    a: &Args,
+    outputs: &Outputs,
+    data: &str,
+    truth: &str,
+    measurements: usize,
+    configurations: usize,
+    what: &str,
+) -> anyhow::Result<()> {
+    let mut files = vec![(a.out.as_path(), data)];
+    files.extend(a.truth_out.as_deref().map(|t| (t, truth)));
+    outputs.commit(&files)?;
+    println!(
+        "simulated {measurements} measurements at {configurations} configurations of {what} (seed {}) → {}",
         a.seed,
         a.out.display()
     );

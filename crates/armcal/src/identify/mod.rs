@@ -35,8 +35,9 @@ mod weak_gain;
 
 pub use estimate::{
     Acceptance, AxisErrors, Estimate, HeldOutAxes, HeldOutOrientation, MeasurementResidual,
-    ParameterEstimate, ResidualReport, SolverReport, Usability, Validation,
+    ResidualReport, Usability, Validation,
 };
+pub(crate) use estimate::{ParameterEstimate, SolverReport};
 pub use fingerprint::ModelFingerprint;
 pub(crate) use fit_checks::FitChecks;
 use frames_first::frames_model;
