@@ -7,11 +7,10 @@ use super::output::{
 };
 use super::progress::Progress;
 use anyhow::bail;
-use armcal::identify::{
-    held_out, identify, Candidate, Estimate, FramesRefit, IdentifySettings, LmSettings, Loss,
-    Method, NonGeometric, ToleranceSettings,
+use armcal::{
+    identify, Candidate, ErrorStats, Estimate, FramesRefit, IdentifySettings, LmSettings, Loss,
+    Method, NonGeometric, ParameterEstimate, SolverReport, ToleranceSettings,
 };
-use armcal::{ParameterEstimate, SolverReport};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -336,8 +335,8 @@ pub fn print_summary(e: &Estimate) {
             ]);
         }
         let groups = [
-            ("station", held_out::by_station(&v.errors)),
-            ("temperature", held_out::by_temperature(&v.errors, 0.5)),
+            ("station", v.errors_by_station()),
+            ("temperature", v.errors_by_temperature(0.5)),
         ];
         for (what, rows) in groups.iter().filter(|(_, g)| !g.is_empty()) {
             println!("  {calibrated}, per {what}: n, position mean / RMS / max / p95 (mm), orientation (deg), mean °C");
@@ -423,7 +422,7 @@ fn print_fit_checks(fit: &armcal::FitChecks) {
 }
 
 /// One line per model of the held-out table: mean, RMS, max and p95.
-fn print_stats_rows(rows: [(&str, &armcal::accuracy::ErrorStats); 3]) {
+fn print_stats_rows(rows: [(&str, &ErrorStats); 3]) {
     for (n, s) in rows {
         println!(
             "  {n:<24} {:>8.4} {:>9.4} {:>9.4} {:>9.4}",

@@ -2,10 +2,7 @@
 
 use super::output::{load_cell_to_measure, Outputs};
 use anyhow::bail;
-use armcal::design::cell_constraints::unmeasurable_poses;
-use armcal::measure::csv;
-use armcal::model::Unit;
-use armcal::sim::{simulate_poses, Perturbation};
+use armcal::{simulate_poses, unmeasurable_poses, Perturbation, Unit};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -104,7 +101,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let payload = model
         .payload_index(a.payload.as_deref().unwrap_or("none"))
         .map_err(|e| anyhow::anyhow!("--payload: {e}"))?;
-    let poses = csv::read_reachable_configurations(&a.poses, model, &cell.controller)?;
+    let poses = cell.read_reachable_poses(&a.poses)?;
     let unmeasurable = unmeasurable_poses(&cell, &poses)?;
     if !unmeasurable.is_empty() {
         let (n, total) = (unmeasurable.len(), poses.len());
@@ -144,7 +141,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         (!a.noise_free).then_some(&noise),
         a.seed,
     )?;
-    let data = cell.with_controller_columns(csv::write_string(&sim.data, model)?)?;
+    let data = cell.write_data(&sim.data)?;
     commit_and_print(
         a,
         &outputs,

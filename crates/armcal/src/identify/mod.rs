@@ -51,7 +51,8 @@ pub use problem::Problem;
 pub use refit::{FramesRefit, RefitRecord};
 pub use robust::{robust_fit, Loss, Outlier};
 pub use solver::{SolverResult, ToleranceSettings};
-pub use uncertainty::{Chi2Outcome, Observability, ParameterUncertainty, TcpCovariance};
+pub(crate) use uncertainty::Observability;
+pub use uncertainty::{Chi2Outcome, ParameterUncertainty, TcpCovariance};
 pub use verdicts::{Chi2Verdict, IdentifiabilityVerdict, Verdicts};
 
 use crate::cell::Cell;
