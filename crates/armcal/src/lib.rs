@@ -75,7 +75,7 @@ pub(crate) mod json;
 pub(crate) mod linalg;
 pub mod measure;
 pub mod model;
-pub mod performance;
+pub(crate) mod performance;
 pub mod progress;
 pub mod report;
 pub mod robots;
@@ -96,7 +96,11 @@ pub use error::{Error, Result};
 // A cell and its model; the model's parameters, completeness and identifiability.
 pub use cell::model_analysis::{analyze_model, ModelAnalysis, ModelRecord, ParameterRecord};
 pub use cell::Cell;
-pub use model::registry::ParameterStatus;
+pub use model::complete::LinkForm;
+pub use model::identifiability::{Identifiability, IdentifiabilitySettings, Measurement};
+pub use model::link::{Joint, JointKind};
+pub use model::registry::{ParameterStatus, Registry, Unit};
+pub use model::urdf::calibration::DEFAULT_K_SIGMA;
 pub use model::Model;
 // Kinematic trees and coupled joints: analysis, simulation and identification.
 pub use cell::tree::{analyze_tree_file, describes_tree, TreeAnalysis, TreeCell};
@@ -106,41 +110,59 @@ pub use sim::tree::simulate_tree;
 pub use model::frames::{frames, FramesRecord, PoseRecord};
 pub use model::kinematics::fk;
 // Measurements: from arrays, from several stations, simulated, predicted.
-pub use measure::{DataArrays, Dataset, RowKind};
+pub use measure::arrays::{DataArrays, RowKind};
+pub use measure::csv::{next_pose_ids, ReadReport};
+pub use measure::Dataset;
+pub use sim::simulate_poses;
 pub use sim::{perturbed_truth, predict, simulate, Perturbation};
 // Identification, its checks, the prediction σ of any configuration, joint axes by circle
 // point analysis.
 pub use identify::circle_point::record::{axes_record, AxesRecord};
+pub use identify::estimate::{ParameterEstimate, SolverReport};
 pub use identify::fit_checks::FitChecks;
+pub use identify::pivot::{pivot_calibration, PivotSettings};
 pub use identify::prediction_sigma::{csv_with_sigmas, prediction_sigmas, RowSigma};
-pub use identify::{identify, Acceptance, Estimate, IdentifySettings};
+pub use identify::uncertainty::TcpCovariance;
+pub use identify::{
+    identify, Acceptance, Candidate, Estimate, FramesRefit, IdentifySettings, LmSettings, Loss,
+    Method, NonGeometric, ToleranceSettings,
+};
 // Optimal design: plan, plan from the user's pose pool, assess any design.
-pub use design::assess::{assess, DesignAssessment};
+pub use design::assess::{assess, evaluate_design, DesignAssessment, PathPrecision};
+pub use design::cell_constraints::{unmeasurable_poses, unplaced_instrument, TrackerShift};
 pub use design::plan::{plan, PlanResult, PlanSettings};
-pub use design::user_pool::{plan_pool, PoolPlan, PoolSettings};
+pub use design::record::KindMargin;
+pub use design::user_pool::{plan_pool, PoolPlan, PoolReport, PoolSettings};
 pub use design::{Criterion, DesignRecord};
 // Compensation: calibrated inverse kinematics, programs from values.
-pub use compensate::program::{compensate, CompensatedRow, Program};
-pub use compensate::{calibrated_ik, IkResult, IkSettings, IkStatus, IkTarget};
+pub use compensate::ik::{calibrated_ik, IkResult, IkSettings, IkStatus, IkTarget};
+pub use compensate::joint_change::JointChangeLimit;
+pub use compensate::nonparametric::{CorrectionInputs, ResidualCorrection};
+pub use compensate::program::{
+    compensate, compensate_program, CompensatedRow, Program, ProgramFile,
+};
 // Robot programs in the controllers' languages (KRL, RAPID, UR script).
 pub use compensate::controller_program::{
     filter_controller_program, FilteredControllerProgram, Language as ProgramLanguage,
     ProgramSettings, TargetOutcome,
 };
 // Accuracy (ISO 9283 before and after calibration).
-pub use performance::{performance, Calibrated, PerformanceRecord, PerformanceSettings};
+pub use accuracy::ErrorStats;
+pub use performance::{
+    performance, Calibrated, ModelPerformance, PerformanceRecord, PerformanceSettings,
+};
 // The adaptive campaign (start, step, simulate), the drift check and the campaign after a
 // drift (the calibration as the prior).
 pub use campaign::drift::{check, CheckSettings, DriftCheck, DriftVerdict, GroupScore};
 pub use campaign::precision::WorkingSigma;
 pub use campaign::prior::CampaignPrior;
+pub use campaign::simulate::simulate as campaign_simulate;
 pub use campaign::simulate::{
     measure_until_stopped as campaign_measure_until_stopped, SimulatedCampaign,
 };
 pub use campaign::{
     fewest_poses as campaign_fewest_poses, largest_sigma as campaign_largest_sigma,
-    simulate as campaign_simulate, start_after_check as campaign_start_after_check,
-    step_with as campaign_step_with,
+    start_after_check as campaign_start_after_check, step_with as campaign_step_with,
 };
 pub use campaign::{start as campaign_start, step as campaign_step};
 pub use campaign::{

@@ -6,7 +6,6 @@
 use super::output::{load_cell, load_cell_to_measure, load_data, with_note, NoteStyle, Outputs};
 use super::progress::Progress;
 use anyhow::Context;
-use armcal::measure::csv;
 use armcal::Perturbation;
 use armcal::{
     campaign_coverage as coverage, campaign_coverage_with_floor as coverage_with_floor,
@@ -219,7 +218,7 @@ fn next_csv(cell: &armcal::Cell, state: &CampaignState) -> anyhow::Result<String
         .iter()
         .map(|(id, q)| (id.clone(), q.as_slice()))
         .collect();
-    let text = cell.with_controller_columns(csv::write_poses(&cell.model, &refs))?;
+    let text = cell.write_poses(&refs)?;
     let note = (state.decision != Decision::Measure).then(|| {
         format!(
             "armcal: the campaign has stopped ({}); nothing more to measure",

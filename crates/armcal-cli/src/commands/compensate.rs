@@ -5,11 +5,9 @@
 use super::output::{
     load_cell, load_data, warn_outside_fitted_ranges, with_note, Calibration, NoteStyle, Outputs,
 };
-use armcal::compensate::joint_change::JointChangeLimit;
-use armcal::compensate::nonparametric::{CorrectionInputs, ResidualCorrection};
-use armcal::compensate::program::{compensate_program, ProgramFile};
 use armcal::{
-    read_capped, IkSettings, ProgramLanguage as Language, ProgramSettings, DATA_CAP, TEXT_CAP,
+    compensate_program, read_capped, CorrectionInputs, IkSettings, JointChangeLimit, ProgramFile,
+    ProgramLanguage as Language, ProgramSettings, ResidualCorrection, DATA_CAP, TEXT_CAP,
 };
 use std::path::{Path, PathBuf};
 

@@ -5,8 +5,7 @@
 //! format: the vendor files are formats of it, and `deploy` (the name) is an alias.
 
 use super::output::{with_note, Calibration, NoteStyle, Outputs};
-use armcal::model::urdf::calibration::DEFAULT_K_SIGMA;
-use armcal::ExportFormat;
+use armcal::{ExportFormat, DEFAULT_K_SIGMA};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]

@@ -1,8 +1,7 @@
 //! `armcal fk <robot-or-cell> --joints ...`
 
 use anyhow::{bail, Context};
-use armcal::model::JointKind;
-use armcal::{frames, PoseRecord};
+use armcal::{frames, JointKind, PoseRecord};
 
 #[derive(clap::Args)]
 pub struct Args {

@@ -7,9 +7,9 @@ use super::output::{
 };
 use super::progress::Progress;
 use anyhow::bail;
-use armcal::identify::{
-    held_out, identify, Candidate, Estimate, FramesRefit, IdentifySettings, LmSettings, Loss,
-    Method, NonGeometric, ToleranceSettings,
+use armcal::{
+    identify, Candidate, ErrorStats, Estimate, FramesRefit, IdentifySettings, LmSettings, Loss,
+    Method, NonGeometric, ParameterEstimate, SolverReport, ToleranceSettings,
 };
 use std::path::{Path, PathBuf};
 
@@ -181,31 +181,7 @@ pub fn print_summary(e: &Estimate) {
         "{}: {} measurements at {} configurations from {}",
         e.cell, e.measurements, e.configurations, e.data
     );
-    println!(
-        "solver {}{}: {} after {} iterations, {:.1} ms",
-        e.solver.method.words(),
-        e.solver
-            .robust
-            .map(|l| format!(" + robust {}", l.words()))
-            .unwrap_or_default(),
-        e.solver.status,
-        e.solver.iterations,
-        e.solver.time_ms
-    );
-    println!(
-        "\n{:<14} {:>14} {:>14} {:>12} {:>5}",
-        "parameter", "nominal", "estimate", "± σ", "unit"
-    );
-    for p in e.parameters.iter().filter(|p| p.free) {
-        println!(
-            "{:<14} {:>14} {:>14} {:>12.5} {:>5}",
-            p.name,
-            fixed(p.nominal, 5),
-            fixed(p.estimate, 5),
-            p.sigma.unwrap_or(f64::NAN),
-            p.unit
-        );
-    }
+    print_solver_and_parameters(&e.solver, &e.parameters, 14);
     if !e.fixed_reasons.is_empty() {
         println!("\nfixed (not identifiable):");
         for (_, r) in &e.fixed_reasons {
@@ -359,8 +335,8 @@ pub fn print_summary(e: &Estimate) {
             ]);
         }
         let groups = [
-            ("station", held_out::by_station(&v.errors)),
-            ("temperature", held_out::by_temperature(&v.errors, 0.5)),
+            ("station", v.errors_by_station()),
+            ("temperature", v.errors_by_temperature(0.5)),
         ];
         for (what, rows) in groups.iter().filter(|(_, g)| !g.is_empty()) {
             println!("  {calibrated}, per {what}: n, position mean / RMS / max / p95 (mm), orientation (deg), mean °C");
@@ -381,6 +357,40 @@ pub fn print_summary(e: &Estimate) {
                 );
             }
         }
+    }
+}
+
+/// The solver line and the table of the free parameters (nominal, estimate, σ, unit) of a
+/// serial or a tree estimate; `name_width` is the width of the name column.
+pub fn print_solver_and_parameters(
+    solver: &SolverReport,
+    parameters: &[ParameterEstimate],
+    name_width: usize,
+) {
+    println!(
+        "solver {}{}: {} after {} iterations, {:.1} ms",
+        solver.method.words(),
+        solver
+            .robust
+            .map(|l| format!(" + robust {}", l.words()))
+            .unwrap_or_default(),
+        solver.status,
+        solver.iterations,
+        solver.time_ms
+    );
+    println!(
+        "\n{:<name_width$} {:>14} {:>14} {:>12} {:>5}",
+        "parameter", "nominal", "estimate", "± σ", "unit"
+    );
+    for p in parameters.iter().filter(|p| p.free) {
+        println!(
+            "{:<name_width$} {:>14} {:>14} {:>12.5} {:>5}",
+            p.name,
+            fixed(p.nominal, 5),
+            fixed(p.estimate, 5),
+            p.sigma.unwrap_or(f64::NAN),
+            p.unit
+        );
     }
 }
 
@@ -412,7 +422,7 @@ fn print_fit_checks(fit: &armcal::FitChecks) {
 }
 
 /// One line per model of the held-out table: mean, RMS, max and p95.
-fn print_stats_rows(rows: [(&str, &armcal::accuracy::ErrorStats); 3]) {
+fn print_stats_rows(rows: [(&str, &ErrorStats); 3]) {
     for (n, s) in rows {
         println!(
             "  {n:<24} {:>8.4} {:>9.4} {:>9.4} {:>9.4}",

@@ -23,7 +23,7 @@ pub struct Args {
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let outputs = Outputs::plan(a.force, &[Path::new(&a.cell), &a.data], &[&a.out])?;
     let cell = load_cell(&a.cell)?;
-    let import = armcal::measure::csv::import(&a.data, &cell.model, &cell.data_format())?;
+    let import = cell.import_data(&a.data)?;
     outputs.commit(&[(&a.out, &cell.with_controller_columns(import.csv.clone())?)])?;
     super::output::print_read_report(&import.report);
     println!(

@@ -5,10 +5,10 @@
 //! and the identifiability analysis are then those of the converted model.
 
 use super::digits::fixed;
-use armcal::model::complete::LinkForm;
-use armcal::model::identifiability::{Identifiability, IdentifiabilitySettings, Measurement};
-use armcal::model::{Joint, JointKind, Registry};
-use armcal::{analyze_model, ModelRecord, ParameterStatus};
+use armcal::{
+    analyze_model, Identifiability, IdentifiabilitySettings, Joint, JointKind, LinkForm,
+    Measurement, ModelRecord, ParameterStatus, Registry,
+};
 
 #[derive(clap::Args)]
 pub struct Args {

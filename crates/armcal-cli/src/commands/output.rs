@@ -170,10 +170,10 @@ pub fn load_cell(name_or_path: &str) -> anyhow::Result<armcal::Cell> {
 /// Loads a cell whose poses a command checks for measurability (plan, evaluate, simulate,
 /// campaign) and notes on stderr when its line of sight and incidence go unchecked because
 /// the cell does not place its instrument
-/// ([`armcal::design::cell_constraints::unplaced_instrument`]).
+/// ([`armcal::unplaced_instrument`]).
 pub fn load_cell_to_measure(name_or_path: &str) -> anyhow::Result<armcal::Cell> {
     let cell = load_cell(name_or_path)?;
-    if let Some(note) = armcal::design::cell_constraints::unplaced_instrument(&cell) {
+    if let Some(note) = armcal::unplaced_instrument(&cell) {
         eprintln!("note: {note}");
     }
     Ok(cell)
@@ -182,7 +182,7 @@ pub fn load_cell_to_measure(name_or_path: &str) -> anyhow::Result<armcal::Cell> 
 /// Reads a data file for a cell (its `[data]` column mapping), with the reader's remarks
 /// ([`print_read_report`]) and a note when the cell's noise model does not use the σ columns.
 pub fn load_data(cell: &armcal::Cell, path: &Path) -> anyhow::Result<armcal::Dataset> {
-    let (data, report) = armcal::measure::csv::read_with(path, &cell.model, &cell.data_format())?;
+    let (data, report) = cell.read_data(path)?;
     print_read_report(&report);
     if let Some(note) = cell.noise().unused_sigmas(&data) {
         eprintln!("note: {note}");
@@ -218,7 +218,7 @@ pub fn load_station_data(
 
 /// The reader's remarks on stderr: ignored columns, then rows read with a warning (the first
 /// few, and how many more).
-pub fn print_read_report(report: &armcal::measure::csv::ReadReport) {
+pub fn print_read_report(report: &armcal::ReadReport) {
     const SHOWN: usize = 5;
     if !report.ignored.is_empty() {
         eprintln!("note: ignored columns: {}", report.ignored.join(", "));

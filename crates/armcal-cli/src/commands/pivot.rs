@@ -3,8 +3,7 @@
 use super::output::{
     load_cell, warn_outside_fitted_ranges, with_note, CalibrationOrNominal, NoteStyle, Outputs,
 };
-use armcal::identify::pivot::{pivot_calibration, PivotSettings};
-use armcal::measure::csv;
+use armcal::{pivot_calibration, PivotSettings};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -36,7 +35,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let cell = load_cell(&a.cell)?;
     let model = &cell.model;
     let (params, note, _, est) = a.calibration.load_at_payload(model, None)?;
-    let configurations = csv::read_configurations(&a.poses, model, None)?;
+    let configurations = cell.read_armcal_poses(&a.poses)?;
     if let Some(est) = &est {
         warn_outside_fitted_ranges(est, model, &configurations);
     }

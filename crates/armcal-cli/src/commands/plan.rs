@@ -5,12 +5,10 @@ use super::digits::decimals_or_digits;
 use super::output::{load_cell_to_measure, Outputs};
 use super::progress::Progress;
 use anyhow::bail;
-use armcal::design::assess::{evaluate_design, PathPrecision};
-use armcal::design::cell_constraints::TrackerShift;
-use armcal::design::record::KindMargin;
-use armcal::design::user_pool::PoolReport;
-use armcal::measure::csv;
-use armcal::{Criterion, DesignAssessment, DesignRecord, PlanSettings, PoolSettings};
+use armcal::{
+    evaluate_design, next_pose_ids, Criterion, DesignAssessment, DesignRecord, KindMargin,
+    PathPrecision, PlanSettings, PoolReport, PoolSettings, TcpCovariance, TrackerShift,
+};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -92,9 +90,7 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
     let outputs = Outputs::plan(a.force, &inputs, &[&a.out, &report_path])?;
     let cell = load_cell_to_measure(&a.cell)?;
     let (measured_ids, measured): (Vec<String>, Vec<Vec<f64>>) = match &a.measured {
-        Some(p) => csv::read_configurations_with(p, &cell.model, &cell.data_format())?
-            .into_iter()
-            .unzip(),
+        Some(p) => cell.read_poses(p)?.into_iter().unzip(),
         None => Default::default(),
     };
     let criterion = Criterion::from_name(&a.criterion).expect("clap checked");
@@ -143,17 +139,14 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
     let rep = record.plan.as_ref().expect("a planned design");
     // The new poses are numbered on from the measured ones, so both files can be measured
     // into one data set.
-    let ids = csv::next_pose_ids(&measured_ids, rep.design.len());
+    let ids = next_pose_ids(&measured_ids, rep.design.len());
     let poses: Vec<(String, &[f64])> = ids
         .iter()
         .cloned()
         .zip(rep.design.iter().map(Vec::as_slice))
         .collect();
     outputs.commit(&[
-        (
-            &a.out,
-            &cell.with_controller_columns(csv::write_poses(&cell.model, &poses))?,
-        ),
+        (&a.out, &cell.write_poses(&poses)?),
         (&report_path, &serde_json::to_string_pretty(&record)?),
     ])?;
     let with_measured = match record.measured {
@@ -275,7 +268,7 @@ pub fn run_plan(a: &PlanArgs) -> anyhow::Result<()> {
 
 /// `; orientation (1/3) tr C_ω = … deg²` for a design whose instrument measures
 /// orientations, or nothing.
-fn orientation_note(t: &armcal::identify::uncertainty::TcpCovariance) -> String {
+fn orientation_note(t: &TcpCovariance) -> String {
     t.orientation_kpi_deg2
         .map(|v| {
             format!(
@@ -357,7 +350,8 @@ fn print_pool(pool: &PoolReport) {
 
 pub fn run_evaluate(a: &EvaluateArgs) -> anyhow::Result<()> {
     let cell = load_cell_to_measure(&a.cell)?;
-    let design: Vec<Vec<f64>> = csv::read_configurations(Path::new(&a.design), &cell.model, None)?
+    let design: Vec<Vec<f64>> = cell
+        .read_armcal_poses(Path::new(&a.design))?
         .into_iter()
         .map(|(_, q)| q)
         .collect();

@@ -3,7 +3,6 @@
 use super::output::{
     load_cell, warn_outside_fitted_ranges, with_note, CalibrationOrNominal, NoteStyle, Outputs,
 };
-use armcal::measure::csv;
 use armcal::predict;
 use armcal::{csv_with_sigmas, prediction_sigmas, RowSigma};
 use std::path::{Path, PathBuf};
@@ -39,7 +38,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let model = &cell.model;
     let (params, note, payload, est) =
         a.calibration.load_at_payload(model, a.payload.as_deref())?;
-    let poses = csv::read_configurations_with(&a.joints, model, &cell.data_format())?;
+    let poses = cell.read_poses(&a.joints)?;
     if let Some(est) = &est {
         warn_outside_fitted_ranges(est, model, &poses);
     }
@@ -48,10 +47,10 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         Some(est) => prediction_sigmas(model, &params, est, &data)?,
         None => None,
     };
-    let text = cell.with_controller_columns(match &sigmas {
-        Some(s) => csv_with_sigmas(&data, model, s)?,
-        None => csv::write_string(&data, model)?,
-    })?;
+    let text = match &sigmas {
+        Some(s) => cell.with_controller_columns(csv_with_sigmas(&data, model, s)?)?,
+        None => cell.write_data(&data)?,
+    };
     outputs.commit(&[(&a.out, &with_note(text, note.as_deref(), NoteStyle::Hash))])?;
     println!(
         "predicted {} measurements at {} configurations with the {} model → {}",

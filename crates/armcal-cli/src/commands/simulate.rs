@@ -2,10 +2,7 @@
 
 use super::output::{load_cell_to_measure, Outputs};
 use anyhow::bail;
-use armcal::design::cell_constraints::unmeasurable_poses;
-use armcal::measure::csv;
-use armcal::model::Unit;
-use armcal::sim::{simulate_poses, Perturbation};
+use armcal::{simulate_poses, unmeasurable_poses, Perturbation, Unit};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -104,7 +101,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let payload = model
         .payload_index(a.payload.as_deref().unwrap_or("none"))
         .map_err(|e| anyhow::anyhow!("--payload: {e}"))?;
-    let poses = csv::read_reachable_configurations(&a.poses, model, &cell.controller)?;
+    let poses = cell.read_reachable_poses(&a.poses)?;
     let unmeasurable = unmeasurable_poses(&cell, &poses)?;
     if !unmeasurable.is_empty() {
         let (n, total) = (unmeasurable.len(), poses.len());
@@ -144,16 +141,34 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         (!a.noise_free).then_some(&noise),
         a.seed,
     )?;
-    let data = cell.with_controller_columns(csv::write_string(&sim.data, model)?)?;
-    let truth = sim.truth.to_json()?;
-    let mut files = vec![(a.out.as_path(), data.as_str())];
-    files.extend(a.truth_out.as_deref().map(|t| (t, truth.as_str())));
-    outputs.commit(&files)?;
-    println!(
-        "simulated {} measurements at {} configurations of `{}` (seed {}) → {}",
+    let data = cell.write_data(&sim.data)?;
+    commit_and_print(
+        a,
+        &outputs,
+        &data,
+        &sim.truth.to_json()?,
         sim.data.measurements.len(),
         poses.len(),
-        cell.name,
+        &format!("`{}`", cell.name),
+    )
+}
+
+/// Writes the simulated data (and the true parameters, `--truth-out`) all or nothing and
+/// says what was simulated of `what` (a serial cell's or a tree's name) and where it went.
+pub fn commit_and_print(
+    a: &Args,
+    outputs: &Outputs,
+    data: &str,
+    truth: &str,
+    measurements: usize,
+    configurations: usize,
+    what: &str,
+) -> anyhow::Result<()> {
+    let mut files = vec![(a.out.as_path(), data)];
+    files.extend(a.truth_out.as_deref().map(|t| (t, truth)));
+    outputs.commit(&files)?;
+    println!(
+        "simulated {measurements} measurements at {configurations} configurations of {what} (seed {}) → {}",
         a.seed,
         a.out.display()
     );

@@ -1,7 +1,6 @@
 //! `armcal identify` and `armcal simulate` of a tree cell (links that name a `parent`,
 //! coupled joints, targets that name a `link`): parse, one library call, print.
 
-use super::digits::fixed;
 use super::output::{station_files, Outputs};
 use super::progress::Progress;
 use super::{identify, simulate};
@@ -54,31 +53,7 @@ fn print_tree_summary(e: &TreeEstimate) {
         "{} (a tree): {} measurements at {} configurations from {}",
         e.cell, e.measurements, e.configurations, e.data
     );
-    println!(
-        "solver {}{}: {} after {} iterations, {:.1} ms",
-        e.solver.method.words(),
-        e.solver
-            .robust
-            .map(|l| format!(" + robust {}", l.words()))
-            .unwrap_or_default(),
-        e.solver.status,
-        e.solver.iterations,
-        e.solver.time_ms
-    );
-    println!(
-        "\n{:<16} {:>14} {:>14} {:>12} {:>5}",
-        "parameter", "nominal", "estimate", "± σ", "unit"
-    );
-    for p in e.parameters.iter().filter(|p| p.free) {
-        println!(
-            "{:<16} {:>14} {:>14} {:>12.5} {:>5}",
-            p.name,
-            fixed(p.nominal, 5),
-            fixed(p.estimate, 5),
-            p.sigma.unwrap_or(f64::NAN),
-            p.unit
-        );
-    }
+    identify::print_solver_and_parameters(&e.solver, &e.parameters, 16);
     if !e.fixed_reasons.is_empty() {
         println!(
             "\n{} parameters fixed at nominal (not identifiable from these data)",
@@ -162,20 +137,13 @@ pub fn simulate(a: &simulate::Args, cell_path: &Path) -> anyhow::Result<()> {
         a.seed,
     )?;
     let data = cell.write_data(&sim.data)?;
-    let truth = sim.truth.to_json()?;
-    let mut files = vec![(a.out.as_path(), data.as_str())];
-    files.extend(a.truth_out.as_deref().map(|t| (t, truth.as_str())));
-    outputs.commit(&files)?;
-    println!(
-        "simulated {} measurements at {} configurations of tree `{}` (seed {}) → {}",
+    simulate::commit_and_print(
+        a,
+        &outputs,
+        &data,
+        &sim.truth.to_json()?,
         sim.data.measurements.len(),
         poses.len(),
-        cell.name,
-        a.seed,
-        a.out.display()
-    );
-    if let Some(t) = &a.truth_out {
-        println!("true parameters → {}", t.display());
-    }
-    Ok(())
+        &format!("tree `{}`", cell.name),
+    )
 }

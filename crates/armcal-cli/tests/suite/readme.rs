@@ -336,7 +336,7 @@ fn readme_joint_names_are_real_joints() {
         let text = std::fs::read_to_string(src.join(&page)).expect("a guide page");
         documents.push((format!("docs/src/{page}"), text));
     }
-    let joints: Vec<String> = armcal::robots::list()
+    let joints: Vec<String> = armcal::Cell::robots()
         .into_iter()
         .flat_map(|(name, _)| armcal::robots::robot(&name).expect("built-in").spec.links)
         .filter_map(|l| l.joint.map(|j| j.name))

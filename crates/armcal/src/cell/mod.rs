@@ -4,6 +4,7 @@
 //! Every error names the file, the line and the field.
 
 pub mod builtin;
+mod data_files;
 pub mod export;
 pub(crate) mod model_analysis;
 mod raw;

@@ -11,4 +11,4 @@ pub mod lqr;
 pub mod nonparametric;
 pub mod program;
 
-pub use ik::{calibrated_ik, CalibratedIk, IkResult, IkSettings, IkStatus, IkTarget};
+pub use ik::{CalibratedIk, IkSettings, IkStatus, IkTarget};

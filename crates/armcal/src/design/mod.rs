@@ -18,10 +18,8 @@ pub mod selection;
 pub(crate) mod small_cholesky;
 pub mod user_pool;
 
-pub use cell_constraints::{
-    ConstraintKind, ConstraintSet, ConstraintSettings, ConstraintWorkspace, Margin,
-};
-pub use criteria::{Criterion, CriterionValue};
+pub use cell_constraints::{ConstraintKind, ConstraintSet, ConstraintSettings};
+pub use criteria::Criterion;
 pub use information::{DesignModel, InformationWorkspace};
-pub use objective::{DesignObjective, ObjectiveWorkspace};
+pub use objective::DesignObjective;
 pub use record::DesignRecord;

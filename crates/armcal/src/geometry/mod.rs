@@ -16,7 +16,7 @@
 pub(crate) mod box_distance;
 pub(crate) mod cone_distance;
 pub(crate) mod fit;
-pub mod segment_distance;
+pub(crate) mod segment_distance;
 
 pub use box_distance::{segment_box_distance, Cuboid, SegmentBoxDistance};
 pub use cone_distance::segment_cone_distance;

@@ -116,6 +116,19 @@ pub fn by_temperature(rows: &[HeldOutError], width_c: f64) -> Vec<GroupErrors> {
         .collect()
 }
 
+impl super::Validation {
+    /// The calibrated model's validation errors per station ([`by_station`]).
+    pub fn errors_by_station(&self) -> Vec<GroupErrors> {
+        by_station(&self.errors)
+    }
+
+    /// The calibrated model's validation errors per temperature bin `width_c` °C wide
+    /// ([`by_temperature`]).
+    pub fn errors_by_temperature(&self, width_c: f64) -> Vec<GroupErrors> {
+        by_temperature(&self.errors, width_c)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

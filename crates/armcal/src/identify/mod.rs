@@ -35,8 +35,9 @@ mod weak_gain;
 
 pub use estimate::{
     Acceptance, AxisErrors, Estimate, HeldOutAxes, HeldOutOrientation, MeasurementResidual,
-    ParameterEstimate, ResidualReport, SolverReport, Usability, Validation,
+    ResidualReport, Usability, Validation,
 };
+pub(crate) use estimate::{ParameterEstimate, SolverReport};
 pub use fingerprint::ModelFingerprint;
 pub(crate) use fit_checks::FitChecks;
 use frames_first::frames_model;
@@ -50,7 +51,8 @@ pub use problem::Problem;
 pub use refit::{FramesRefit, RefitRecord};
 pub use robust::{robust_fit, Loss, Outlier};
 pub use solver::{SolverResult, ToleranceSettings};
-pub use uncertainty::{Chi2Outcome, Observability, ParameterUncertainty, TcpCovariance};
+pub(crate) use uncertainty::Observability;
+pub use uncertainty::{Chi2Outcome, ParameterUncertainty, TcpCovariance};
 pub use verdicts::{Chi2Verdict, IdentifiabilityVerdict, Verdicts};
 
 use crate::cell::Cell;

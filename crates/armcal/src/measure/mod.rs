@@ -9,7 +9,7 @@
 //! in one least-squares problem.
 
 pub mod angles;
-mod arrays;
+pub(crate) mod arrays;
 mod columns;
 pub mod csv;
 pub mod format;
@@ -17,7 +17,6 @@ pub(crate) mod noise;
 pub(crate) mod residual;
 pub mod stations;
 
-pub use arrays::{DataArrays, RowKind};
 pub use noise::NoiseModel;
 
 use crate::model::{Observed, Pose, Rows};

@@ -2,7 +2,7 @@
 //! Jacobians, identifiability, configuration sampling, conversions and URDF.
 
 pub(crate) mod branch;
-pub mod chain;
+pub(crate) mod chain;
 pub mod complete;
 pub mod compliance;
 pub mod controller;
@@ -11,7 +11,7 @@ pub mod export;
 pub mod fixed_kinematics;
 pub(crate) mod frames;
 pub mod identifiability;
-pub mod jacobian;
+pub(crate) mod jacobian;
 pub(crate) mod jacobian_dq_along;
 pub(crate) mod joint_correction;
 pub(crate) mod kinematics;
@@ -31,12 +31,12 @@ pub mod urdf;
 pub use chain::{LimitTolerance, Link, LinkSpec, Model, ModelSpec, MEASURED_LIMIT_TOLERANCE};
 pub use jacobian::{
     identification_jacobian, identification_jacobian_dq, joint_jacobian, observed_pose,
-    observed_position, ChainOrder, MixedWorkspace, Observed, Rows,
+    observed_position, observed_world, ChainOrder, MixedWorkspace, Observed, Rows,
 };
 pub use jacobian_dq_along::{identification_jacobian_dq_along, AlongWorkspace};
 pub use kinematics::{forward_kinematics, tool_pose, Data};
 pub use link::{Convention, Joint, JointKind, LinkGeometry, Motion};
-pub use pose::{Pose, Twist};
+pub use pose::Pose;
 pub(crate) use registry::ParameterStatus;
 pub use registry::{Parameter, Registry, Segment, Unit};
 pub use sampling::random_configurations;

@@ -19,7 +19,7 @@ pub(crate) mod documents;
 pub mod ellipse;
 pub(crate) mod estimate;
 pub mod figures;
-pub mod files;
+pub(crate) mod files;
 pub(crate) mod font;
 pub(crate) mod held_out;
 pub mod html;

@@ -101,7 +101,7 @@ pub fn transfer_capsules(
 }
 
 /// Name and summary of every built-in robot.
-pub fn list() -> Vec<(String, String)> {
+pub(crate) fn list() -> Vec<(String, String)> {
     NAMES
         .iter()
         .map(|n| {

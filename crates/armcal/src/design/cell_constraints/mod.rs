@@ -104,7 +104,8 @@
 use crate::cell::{box_cuboid, half_space_unit_normal, Cell, DesignClearance, Obstacle};
 use crate::geometry::{point_segment_distance, segment_box_distance, segment_distance, Cuboid};
 use crate::model::fixed_kinematics::FixedKinematics;
-use crate::model::{forward_kinematics, Data, Model, Twist};
+use crate::model::pose::Twist;
+use crate::model::{forward_kinematics, Data, Model};
 use crate::Error;
 use nalgebra::Vector3;
 

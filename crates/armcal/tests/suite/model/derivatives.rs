@@ -69,7 +69,7 @@ fn joint_jacobian_matches_finite_differences() {
                             let mut d = Data::new(&model);
                             forward_kinematics(&model, &mut d, &params, &qq);
                             // world frame: no instrument transform
-                            *armcal::model::jacobian::observed_world(&d, obs)
+                            *armcal::model::observed_world(&d, obs)
                         },
                         // poses of 10³ mm: at h = 1e-6 rounding (ε|x|/h ≈ 10⁻⁶) is the error
                         1e-5,

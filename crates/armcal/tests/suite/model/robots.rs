@@ -19,7 +19,7 @@ fn expected_dof(name: &str) -> Option<usize> {
 
 #[test]
 fn every_library_robot_is_consistent() {
-    assert_eq!(robots::list().len(), NAMES.len());
+    assert_eq!(armcal::Cell::robots().len(), NAMES.len());
     for name in NAMES {
         let robot = robots::robot(name).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(robot.name, *name);

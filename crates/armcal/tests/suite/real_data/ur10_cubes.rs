@@ -13,8 +13,8 @@ use armcal::accuracy::same_pose::{commanded_poses, SamePose};
 use armcal::cell::Cell;
 use armcal::identify::{identify, IdentifySettings};
 use armcal::measure::csv;
-use armcal::performance::{performance, Calibrated, PerformanceSettings};
 use armcal::Silent;
+use armcal::{performance, Calibrated, PerformanceSettings};
 use std::path::Path;
 
 #[test]

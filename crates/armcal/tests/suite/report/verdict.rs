@@ -7,12 +7,12 @@
 use super::html::fixtures;
 use armcal::compensate::program::{filter_joint_program, ProgramRecord};
 use armcal::compensate::IkSettings;
+use armcal::files_report;
 use armcal::identify::Acceptance;
 use armcal::identify::Chi2Outcome;
 use armcal::model::tool_pose;
 use armcal::report::compensation::joint_corrections;
 use armcal::report::figures::{colour, design_colour, ellipse_figure, EllipseSeries};
-use armcal::report::files::files_report;
 use armcal::report::parameter_charts::{correlation_colour, heatmap_figure};
 use armcal::report::parameter_view::{change_over_sigma, correlation, estimate_minus_truth};
 use armcal::report::verdict::{estimate_grade, held_out_gain, Grade};

@@ -20,7 +20,7 @@ use quote::ToTokens;
 use syn::{Attribute, ImplItem, Item, TraitItem, UseTree, Visibility};
 
 /// Items (methods apart) reachable by more than one path: may only go down.
-const MULTI_PATH_BUDGET: usize = 83;
+const MULTI_PATH_BUDGET: usize = 82;
 
 /// The variable that rewrites the committed list instead of comparing with it.
 const BLESS: &str = "ARMCAL_BLESS_API";
