@@ -157,7 +157,7 @@ pub(crate) fn compile(
 
 /// Per evaluation, the deflection of a tree's compliant joints ([`TreeData`]).
 #[derive(Clone, Debug)]
-pub struct DeflectionData<T: RealField + Copy> {
+pub(crate) struct DeflectionData<T: RealField + Copy> {
     /// Per branch, the lever pass (the branch at the lever parameters and commanded joints).
     levers: Vec<Data<T>>,
     /// Per branch, its commanded joints.
@@ -167,13 +167,13 @@ pub struct DeflectionData<T: RealField + Copy> {
     /// Per branch, whether a term's mass sits on it (its lever pass is needed).
     needed: Vec<bool>,
     /// Per term, `ℓ_t(q)` (mm).
-    pub lever: Vec<T>,
+    pub(crate) lever: Vec<T>,
     /// Per term and tree joint (row-major, `term · dof + j`), `∂ℓ_t/∂q_j`.
-    pub lever_rate: Vec<T>,
+    pub(crate) lever_rate: Vec<T>,
     /// The deflected tree joints `q + Δq`.
-    pub deflected: Vec<T>,
+    pub(crate) deflected: Vec<T>,
     /// Per term, κ at the last evaluation.
-    pub kappa: Vec<f64>,
+    pub(crate) kappa: Vec<f64>,
 }
 
 impl<T: RealField + Copy> DeflectionData<T> {

@@ -35,7 +35,7 @@ pub struct TreeData<T: RealField + Copy> {
     /// The compliance's term of each tree parameter that is a κ.
     kappa: Vec<Option<usize>>,
     /// The joint compliance's levers and deflected joints; `None` without compliance.
-    pub deflection: Option<Box<DeflectionData<T>>>,
+    pub(crate) deflection: Option<Box<DeflectionData<T>>>,
 }
 
 impl<T: RealField + Copy> TreeData<T> {

@@ -297,8 +297,8 @@ fn the_predicted_tcp_covariance_of_each_arm_of_a_compliant_tree_matches_monte_ca
 
 fn tcp_covariance_matches_monte_carlo(cell: &TreeCell) {
     let tree = &cell.tree;
-    let qs = poses(&cell, 30, 5);
-    let working = poses(&cell, 1, 11).remove(0).1;
+    let qs = poses(cell, 30, 5);
+    let working = poses(cell, 1, 11).remove(0).1;
     let exact = Perturbation {
         length: 0.0,
         angle: 0.0,
