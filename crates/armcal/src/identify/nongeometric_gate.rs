@@ -18,7 +18,7 @@
 //! bought nothing had |ρ| ≥ 0.99). A fit with `free = "auto"` drops a term that is not
 //! separable, names it and fits again ([`crate::identify::identify`]).
 
-use crate::model::{Model, Unit};
+use crate::model::{Model, Registry, Unit};
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
@@ -75,8 +75,28 @@ pub fn nongeometric_gate(
     covariance: &DMatrix<f64>,
     params: &[f64],
 ) -> Vec<TermVerdict> {
+    gate(
+        &model.registry,
+        |i| model.is_joint_correction(i),
+        free,
+        jacobian,
+        covariance,
+        params,
+    )
+}
+
+/// [`nongeometric_gate`] for the parameters of `registry` that `is_term` says are
+/// non-geometric terms (a serial model's joint corrections, a tree's compliance).
+pub(crate) fn gate(
+    registry: &Registry,
+    is_term: impl Fn(usize) -> bool,
+    free: &[usize],
+    jacobian: &DMatrix<f64>,
+    covariance: &DMatrix<f64>,
+    params: &[f64],
+) -> Vec<TermVerdict> {
     (0..free.len())
-        .filter(|&k| model.is_joint_correction(free[k]))
+        .filter(|&k| is_term(free[k]))
         .map(|k| {
             let others: Vec<usize> = (0..free.len()).filter(|&o| o != k).collect();
             let q = if others.is_empty() {
@@ -91,10 +111,10 @@ pub fn nongeometric_gate(
                 .iter()
                 .map(|&o| (o, covariance[(k, o)] / (sigma * covariance[(o, o)].sqrt())))
                 .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
-                .map(|(o, rho)| (model.registry.get(free[o]).name.clone(), rho));
+                .map(|(o, rho)| (registry.get(free[o]).name.clone(), rho));
             let norm = col.norm();
             let unabsorbed = if norm > 0.0 { rest.norm() / norm } else { 0.0 };
-            let p = model.registry.get(free[k]);
+            let p = registry.get(free[k]);
             let f = p.unit.display_factor();
             let value = params[free[k]];
             let rho = most_correlated.as_ref().map_or(0.0, |m| m.1.abs());

@@ -293,15 +293,8 @@ impl<'a> Problem<'a> {
         r: &mut DVector<f64>,
         jac: Option<&mut DMatrix<f64>>,
     ) {
-        let with_j = jac.is_some();
-        let mut scratch;
-        let jac = match jac {
-            Some(j) => j,
-            None => {
-                scratch = DMatrix::zeros(6, self.free.len());
-                &mut scratch
-            }
-        };
+        let mut scratch = None;
+        let (with_j, jac) = jacobian_or_scratch(jac, &mut scratch, self.free.len());
         self.visit(ws, params, with_j, |i, a, b, block_r| {
             let m = &self.data.measurements[i];
             let row = self.row_of[i];
@@ -365,6 +358,21 @@ impl<'a> Problem<'a> {
             }
         });
         errors
+    }
+}
+
+/// The Jacobian an `evaluate` writes into: the caller's (`true`: rows at each measurement's
+/// own row), or, for a residual alone, a 6 × `columns` scratch in `scratch` that every
+/// measurement's block overwrites at row 0 (`false`: [`residual_rows`] writes its Jacobian
+/// rows unconditionally, and nothing reads them).
+pub(crate) fn jacobian_or_scratch<'a>(
+    jac: Option<&'a mut DMatrix<f64>>,
+    scratch: &'a mut Option<DMatrix<f64>>,
+    columns: usize,
+) -> (bool, &'a mut DMatrix<f64>) {
+    match jac {
+        Some(j) => (true, j),
+        None => (false, scratch.insert(DMatrix::zeros(6, columns))),
     }
 }
 

@@ -125,6 +125,35 @@ pub struct Measurement {
     pub covariates: Covariates,
 }
 
+impl Measurement {
+    /// A noise-free simulated measurement (no σ, line 0) of `observed` at configuration
+    /// `config`: the frame's `pose` if `as_pose`, else its position.
+    pub(crate) fn simulated(
+        config: usize,
+        observed: Observed,
+        pose: Pose<f64>,
+        as_pose: bool,
+    ) -> Measurement {
+        Measurement {
+            config,
+            observed,
+            kind: if as_pose {
+                MeasurementKind::Pose {
+                    value: pose,
+                    sigma: None,
+                }
+            } else {
+                MeasurementKind::Position {
+                    value: pose.trans,
+                    sigma: None,
+                }
+            },
+            line: 0,
+            covariates: Default::default(),
+        }
+    }
+}
+
 /// Conditions recorded with a measurement that a model may use as covariates.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Covariates {

@@ -292,24 +292,7 @@ pub fn measurement_at(
         Observed::Target(k) => model.target_is_frame(k) && measured != Measured::Position,
         Observed::Tool => measured == Measured::Pose,
     };
-    let pose = observed_pose(fk, obs);
-    Measurement {
-        config,
-        observed: obs,
-        kind: if is_frame {
-            MeasurementKind::Pose {
-                value: pose,
-                sigma: None,
-            }
-        } else {
-            MeasurementKind::Position {
-                value: pose.trans,
-                sigma: None,
-            }
-        },
-        line: 0,
-        covariates: Default::default(),
-    }
+    Measurement::simulated(config, obs, observed_pose(fk, obs), is_frame)
 }
 
 /// One parameter of a simulated robot, display units (mm, deg).

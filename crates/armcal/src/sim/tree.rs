@@ -2,7 +2,7 @@
 //! simulate` makes of a tree cell, so users and tests can make tree data.
 
 use super::{add_noise, perturbed_registry, Perturbation, Simulation, TruthRecord};
-use crate::measure::{Dataset, Measurement, MeasurementKind, NoiseModel};
+use crate::measure::{Dataset, Measurement, NoiseModel};
 use crate::model::identifiability::{IdentifiabilitySettings, Measurement as Measured};
 use crate::model::tree::identifiability::analyze_tree;
 use crate::model::tree::kinematics::{branch_kinematics, tree_observed_pose, TreeData};
@@ -88,23 +88,7 @@ pub fn simulate_tree(
             branch_kinematics(tree, &mut fk, b, &truth, q);
             let pose = tree_observed_pose(tree, &fk, t);
             let frame = tree.branches[b].model.target_is_frame(k) && measured != Measured::Position;
-            let mut m = Measurement {
-                config,
-                observed: Observed::Target(t),
-                kind: if frame {
-                    MeasurementKind::Pose {
-                        value: pose,
-                        sigma: None,
-                    }
-                } else {
-                    MeasurementKind::Position {
-                        value: pose.trans,
-                        sigma: None,
-                    }
-                },
-                line: 0,
-                covariates: Default::default(),
-            };
+            let mut m = Measurement::simulated(config, Observed::Target(t), pose, frame);
             if let Some(noise) = noise {
                 add_noise(&mut m, noise, &mut || unit_normal.sample(&mut rng))?;
             }

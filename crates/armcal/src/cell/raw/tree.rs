@@ -2,12 +2,14 @@
 //! links name their `parent` (default: the previous link) and whose coupled joints say what
 //! they follow (`coupled = { q2 = -1, q3 = -1, offset_deg = 90 }`), and `[[targets]]` that
 //! name the `link` they hang from (default: the last link). Read with `[name]`,
-//! `[instrument]` and `[parameters] measurement`; the serial sections a fit of a tree does
-//! not use yet are refused, by name.
+//! `[instrument]`, `[parameters] measurement` and `compliance` (joint compliance over the
+//! tree, [`crate::model::tree::compliance`], with `[robot] gravity`); the serial sections a
+//! fit of a tree does not use yet are refused, by name.
 
 use super::fields::*;
 use super::*;
 use crate::cell::tree::TreeCell;
+use crate::model::tree::compliance::lumped_tree_compliance;
 use crate::model::tree::{Coupling, Tree, TreeLinkSpec, TreeSpec, TreeTargetSpec};
 
 /// The keys a `[[robot.links]]` entry or a `[[targets]]` entry has only in a tree cell, and
@@ -44,7 +46,6 @@ pub(in crate::cell) fn parse_tree(text: &str, file: &str) -> Result<TreeCell, Er
         ("robot.link_radius_mm", rr.link_radius_mm.is_some()),
         ("robot.link_radii_mm", rr.link_radii_mm.is_some()),
         ("robot.convention", rr.convention.is_some()),
-        ("robot.gravity", rr.gravity.is_some()),
         ("base", raw.base.is_some()),
         ("tool", raw.tool.is_some()),
         ("working", !raw.working.is_empty()),
@@ -61,8 +62,8 @@ pub(in crate::cell) fn parse_tree(text: &str, file: &str) -> Result<TreeCell, Er
             field,
             "a tree cell (links that name a `parent`, coupled joints, targets that name a \
              `link`) takes `[[robot.links]]` (each branch's base and tool frames as links), \
-             `[instrument]`, `[[targets]]` and `[parameters] measurement` for now; remove \
-             this field",
+             `[instrument]`, `[[targets]]`, `[parameters] measurement` and `compliance` \
+             (with `[robot] gravity`) for now; remove this field",
         ));
     }
     let mut links = Vec::new();
@@ -154,10 +155,11 @@ pub(in crate::cell) fn parse_tree(text: &str, file: &str) -> Result<TreeCell, Er
         }),
         links,
         targets,
+        compliance: None,
     };
     // a structural error (a cycle, a joint named twice, a coupling to an unknown joint, a
     // link no target hangs beyond) is placed at the first link it names
-    let tree = Tree::from_spec(&spec).map_err(|e| {
+    let mut tree = Tree::from_spec(&spec).map_err(|e| {
         let message = match e {
             Error::Model(m) => m,
             other => other.to_string(),
@@ -181,14 +183,14 @@ pub(in crate::cell) fn parse_tree(text: &str, file: &str) -> Result<TreeCell, Er
                 || !pr.priors.is_empty()
                 || pr.fixed_prior.is_some()
                 || !pr.fixed_priors.is_empty()
-                || pr.compliance.is_some()
                 || pr.periodic.is_some()
                 || !pr.values.is_empty()
             {
                 return Err(ctx.err(
                     p.span(),
                     "parameters",
-                    "a tree cell takes `measurement` here for now; remove the other fields",
+                    "a tree cell takes `measurement` and `compliance` here for now; remove the \
+                     other fields",
                 ));
             }
             match &pr.measurement {
@@ -206,6 +208,28 @@ pub(in crate::cell) fn parse_tree(text: &str, file: &str) -> Result<TreeCell, Er
             }
         }
     };
+    // joint compliance over the tree: the lumped terms of the named joints, on the rigid tree
+    let compliant = raw.parameters.as_ref().and_then(|p| {
+        p.get_ref()
+            .compliance
+            .as_ref()
+            .map(|joints| (p.span(), joints))
+    });
+    let mut spec = spec;
+    if let Some((span, joints)) = compliant {
+        let c = lumped_tree_compliance(&tree, joints, rr.gravity.unwrap_or([0.0, 0.0, -1.0]))
+            .map_err(|e| ctx.err(span.clone(), "parameters.compliance", e))?;
+        spec.compliance = Some(c);
+        tree = Tree::from_spec(&spec)
+            .map_err(|e| ctx.err(span, "parameters.compliance", e.to_string()))?;
+    } else if rr.gravity.is_some() {
+        return Err(ctx.err(
+            rspan,
+            "robot.gravity",
+            "gravity is used by `[parameters] compliance`, and this tree cell has none: add \
+             the compliant joints or remove `gravity`",
+        ));
+    }
     let all_frames = spec
         .targets
         .iter()

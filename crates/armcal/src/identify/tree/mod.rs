@@ -11,15 +11,23 @@
 //! ([`crate::model::tree::identifiability`]); the solvers, the covariance `C_p = σ̂₀² (JᵀJ)⁻¹`
 //! (book eq. 5.23) and the robust reweighting are the serial fit's ([`super::solver`]).
 //!
-//! What a tree fit does not have yet (the serial fit's): non-geometric terms, priors,
-//! instrument stations, payloads, distance measurements, the Kalman filter, the model floor
-//! and the fit checks; each is refused by name.
+//! Joint compliance over the tree ([`crate::model::tree::compliance`]) is fitted with the
+//! geometry: its κ are tree parameters like any other (their columns exact, their σ from the
+//! same covariance), and the serial identifiability gate
+//! ([`crate::identify::nongeometric_gate`]) judges each: a term that is not separable from
+//! the others on these data is dropped, named with its reason, and the tree fitted again.
+//!
+//! What a tree fit does not have yet (the serial fit's): periodic joint errors,
+//! `--nongeometric auto`, priors, instrument stations, payloads, distance measurements, the
+//! Kalman filter, the model floor and the fit checks; each is refused by name.
 
 use super::lm::minimise;
+use super::nongeometric_gate::{gate, TermVerdict};
 use super::robust::{robust_minimise, Outlier};
 use super::solver::LeastSquares;
 use super::uncertainty::{parameter_uncertainty, ParameterUncertainty};
 use super::{holdout_split, IdentifySettings, Method, ParameterEstimate, SolverReport};
+use super::{Candidate, NonGeometric};
 use crate::accuracy::ErrorStats;
 use crate::cell::tree::TreeCell;
 use crate::measure::{Dataset, MeasurementKind};
@@ -82,6 +90,9 @@ pub struct TreeEstimate {
     pub uncertainty: ParameterUncertainty,
     /// Measurements a robust fit found to be outliers.
     pub outliers: Vec<Outlier>,
+    /// The identifiability gate of the compliance terms fitted (empty for a rigid tree).
+    #[serde(default)]
+    pub nongeometric: Vec<TermVerdict>,
     /// The fit per target.
     pub targets: Vec<TreeTargetFit>,
     /// What held-out validation was done (empty: none).
@@ -247,9 +258,14 @@ fn data_measurement(data: &Dataset) -> Measurement {
 /// the position errors per target, fitted and held out (`opts.holdout` of the configurations
 /// at random, seeded, or `opts.test`). A fit that did not converge says so in its status.
 ///
+/// With the cell's joint compliance (`--nongeometric` as the cell, or `compliance`) the κ
+/// are fitted with the geometry and gated ([`crate::identify::nongeometric_gate`]): while a
+/// term is not separable, the least separable is dropped (its reason kept) and the tree
+/// fitted again; `--nongeometric none` fits the rigid tree.
+///
 /// Settings a tree fit does not take yet are refused by name: `method` Kalman, a `refit`, a
-/// warm `start`, non-geometric terms other than the cell's (a tree cell has none), the sign
-/// diagnosis.
+/// warm `start`, periodic terms (`--nongeometric periodic`, `both`), `--nongeometric auto`,
+/// the sign diagnosis.
 pub fn identify_tree(
     cell: &TreeCell,
     data: &Dataset,
@@ -264,8 +280,15 @@ pub fn identify_tree(
         ("a frames refit (--refit)", opts.refit.is_some()),
         ("a warm start", opts.start.is_some()),
         (
-            "non-geometric terms (--nongeometric)",
-            !matches!(opts.nongeometric, super::NonGeometric::AsCell),
+            "periodic joint errors (--nongeometric periodic or both)",
+            matches!(
+                opts.nongeometric,
+                NonGeometric::Only(Candidate::Periodic | Candidate::Both)
+            ),
+        ),
+        (
+            "the cross-validated choice of non-geometric terms (--nongeometric auto)",
+            matches!(opts.nongeometric, NonGeometric::Auto { .. }),
         ),
         (
             "the joint sign diagnosis (--diagnose-signs)",
@@ -298,28 +321,57 @@ pub fn identify_tree(
         minimise(&problem, &nominal, lm, observer)?
     };
     observer.finish();
-    // 2. the tree's identifiable set at the frames-first estimate, fitted
-    let (free, report) = identifiable_at(tree, &frames_fit.params, &train, measurement, |i| {
-        tree.registry.get(i).status.is_free()
-    })?;
-    let mut problem = TreeProblem::new(tree, &train, &cell.noise, free)?;
-    check_determined(&problem)?;
-    let (sol, outliers) = match opts.robust {
-        Some(loss) => {
-            let r = robust_minimise(&mut problem, &frames_fit.params, loss, lm, observer)?;
-            (r.solution, r.outliers)
-        }
-        None => {
-            let s = match opts.method {
-                Method::GaussNewton => super::gauss_newton::minimise(
-                    &problem,
-                    &frames_fit.params,
-                    &lm.tolerances,
-                    observer,
-                )?,
-                _ => minimise(&problem, &frames_fit.params, lm, observer)?,
-            };
-            (s, Vec::new())
+    // 2. the tree's identifiable set at the frames-first estimate, fitted; the compliance
+    // terms gated, the least separable dropped and the tree fitted again while one is not
+    let rigid = opts.nongeometric == NonGeometric::Only(Candidate::Kinematic);
+    let is_kappa = |i: usize| {
+        tree.compliance
+            .as_ref()
+            .is_some_and(|c| c.terms.iter().any(|t| t.param == i))
+    };
+    let mut dropped: Vec<(usize, String)> = Vec::new();
+    let (problem, sol, outliers, report, nongeometric) = loop {
+        let (free, report) = identifiable_at(tree, &frames_fit.params, &train, measurement, |i| {
+            tree.registry.get(i).status.is_free()
+                && !(is_kappa(i) && (rigid || dropped.iter().any(|d| d.0 == i)))
+        })?;
+        let mut problem = TreeProblem::new(tree, &train, &cell.noise, free)?;
+        check_determined(&problem)?;
+        let (sol, outliers) = match opts.robust {
+            Some(loss) => {
+                let r = robust_minimise(&mut problem, &frames_fit.params, loss, lm, observer)?;
+                (r.solution, r.outliers)
+            }
+            None => {
+                let s = match opts.method {
+                    Method::GaussNewton => super::gauss_newton::minimise(
+                        &problem,
+                        &frames_fit.params,
+                        &lm.tolerances,
+                        observer,
+                    )?,
+                    _ => minimise(&problem, &frames_fit.params, lm, observer)?,
+                };
+                (s, Vec::new())
+            }
+        };
+        let unc = parameter_uncertainty(&sol.jacobian, &sol.residual, &problem.free_names())?;
+        let verdicts = gate(
+            &tree.registry,
+            is_kappa,
+            &problem.free,
+            &sol.jacobian,
+            &unc.covariance,
+            &sol.params,
+        );
+        let worst = verdicts
+            .iter()
+            .filter(|v| !v.separable)
+            .rev()
+            .min_by(|a, b| a.unabsorbed.total_cmp(&b.unabsorbed));
+        match worst {
+            Some(v) => dropped.push((tree.registry.require(&v.name)?, v.reason())),
+            None => break (problem, sol, outliers, report, verdicts),
         }
     };
     let names = problem.free_names();
@@ -380,6 +432,11 @@ pub fn identify_tree(
             .excluded
             .into_iter()
             .map(|e| (e.name, e.reason))
+            .chain(
+                dropped
+                    .into_iter()
+                    .map(|(i, reason)| (tree.registry.get(i).name.clone(), reason)),
+            )
             .collect(),
         solver: SolverReport {
             method: opts.method,
@@ -391,6 +448,7 @@ pub fn identify_tree(
         },
         uncertainty: unc,
         outliers,
+        nongeometric,
         targets,
         validation,
         measurements: train.measurements.len(),

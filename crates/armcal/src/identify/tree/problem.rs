@@ -2,7 +2,7 @@
 //! target's branch, whitened, with the Jacobian over the tree's free parameters; what the
 //! solvers see of a tree ([`crate::identify::solver::LeastSquares`]).
 
-use crate::identify::problem::whiten;
+use crate::identify::problem::{jacobian_or_scratch, whiten};
 use crate::identify::solver::LeastSquares;
 use crate::measure::residual::{residual_rows, Prediction};
 use crate::measure::{Dataset, MeasurementKind, NoiseModel};
@@ -225,15 +225,8 @@ impl LeastSquares for TreeProblem<'_> {
         r: &mut DVector<f64>,
         jac: Option<&mut DMatrix<f64>>,
     ) {
-        let with_j = jac.is_some();
-        let mut scratch;
-        let jac = match jac {
-            Some(j) => j,
-            None => {
-                scratch = DMatrix::zeros(6, self.free.len());
-                &mut scratch
-            }
-        };
+        let mut scratch = None;
+        let (with_j, jac) = jacobian_or_scratch(jac, &mut scratch, self.free.len());
         self.visit(ws, params, with_j, |i, a, block_r| {
             let m = &self.data.measurements[i];
             let row = self.row_of[i];

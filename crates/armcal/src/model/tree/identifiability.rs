@@ -44,11 +44,13 @@ use nalgebra::DMatrix;
 /// The number of parameters a measurement type identifies on `tree` in generic geometry
 /// (module doc): `4R + 2P + 6F` for the pose of `F` frame targets, `4R + 2P + 3B` for the
 /// position of one point on each of `B` links. `None` with a coupled joint, several points
-/// on one link, a pose measurement of point targets, distances, or a tree that is not
+/// on one link, a pose measurement of point targets, distances, a tree that is not
 /// complete at a fork ([`Tree::incomplete_forks`]: two branches whose first axes the fork's
-/// frame sets alike).
+/// frame sets alike), or joint compliance (whether a κ is told apart from the geometry
+/// depends on the arm: the numerical rank and the gate say).
 pub fn expected_tree_count(tree: &Tree, m: Measurement) -> Option<usize> {
-    if !tree.coupled.is_empty() || !tree.incomplete_forks().is_empty() {
+    if !tree.coupled.is_empty() || !tree.incomplete_forks().is_empty() || tree.compliance.is_some()
+    {
         return None;
     }
     let r = tree

@@ -6,9 +6,17 @@
 //!   (`∂m/∂p_tree[t] = ∂m/∂p_b[i]` where branch parameter `i` is tree parameter `t`, zero
 //!   for a tree parameter not on the branch);
 //! * joint Jacobian w.r.t. the tree's joints: `J_b C_b` (chain rule through the coupling).
+//!
+//! With joint compliance ([`crate::model::tree::compliance`]) the branch runs at the
+//! deflected tree joints `q + Δq(q)`: the compliance's κ columns and the chain rule through
+//! `Δq` are added here.
 
-use crate::model::jacobian::{identification_jacobian, joint_jacobian, Observed, Rows};
+use crate::model::jacobian::{
+    identification_jacobian, joint_jacobian, observed_world, Observed, Rows,
+};
 use crate::model::kinematics::{forward_kinematics, Data};
+use crate::model::pose::Twist;
+use crate::model::tree::compliance::{coefficient, map_joints, DeflectionData};
 use crate::model::tree::Tree;
 use nalgebra::{DMatrix, RealField};
 
@@ -24,6 +32,10 @@ pub struct TreeData<T: RealField + Copy> {
     all_columns: Vec<Vec<usize>>,
     /// Per branch: the branch parameter index of each tree parameter, if on the branch.
     local: Vec<Vec<Option<usize>>>,
+    /// The compliance's term of each tree parameter that is a κ.
+    kappa: Vec<Option<usize>>,
+    /// The joint compliance's levers and deflected joints; `None` without compliance.
+    pub(crate) deflection: Option<Box<DeflectionData<T>>>,
 }
 
 impl<T: RealField + Copy> TreeData<T> {
@@ -60,6 +72,14 @@ impl<T: RealField + Copy> TreeData<T> {
                 .map(|b| (0..b.model.param_count()).collect())
                 .collect(),
             local,
+            kappa: (0..tree.param_count())
+                .map(|i| {
+                    tree.compliance
+                        .as_ref()
+                        .and_then(|c| c.terms.iter().position(|t| t.param == i))
+                })
+                .collect(),
+            deflection: DeflectionData::new(tree).map(Box::new),
         }
     }
 
@@ -70,7 +90,8 @@ impl<T: RealField + Copy> TreeData<T> {
 }
 
 /// Evaluates branch `b` of `tree` at tree parameters `params` and tree joints `q` into
-/// `data.branches[b]`. Allocates nothing.
+/// `data.branches[b]` (with compliance, at the deflected joints `q + Δq(q)`). Allocates
+/// nothing.
 pub fn branch_kinematics<T: RealField + Copy>(
     tree: &Tree,
     data: &mut TreeData<T>,
@@ -82,12 +103,12 @@ pub fn branch_kinematics<T: RealField + Copy>(
     for (x, &t) in data.params[b].iter_mut().zip(&branch.params) {
         *x = params[t];
     }
-    for (x, map) in data.q[b].iter_mut().zip(&branch.joints) {
-        let mut v: T = nalgebra::convert(map.offset);
-        for &(k, c) in &map.terms {
-            v += q[k] * nalgebra::convert::<f64, T>(c);
+    match data.deflection.as_mut() {
+        Some(d) => {
+            d.evaluate(tree, params, q);
+            map_joints(branch, &d.deflected, &mut data.q[b]);
         }
-        *x = v;
+        None => map_joints(branch, q, &mut data.q[b]),
     }
     forward_kinematics(
         &branch.model,
@@ -124,11 +145,69 @@ pub fn tree_identification_jacobian<T: RealField + Copy>(
         0,
     );
     for (c, &t) in columns.iter().enumerate() {
-        for r in 0..rows.count() {
-            out[(row + r, c)] = match data.local[b][t] {
-                Some(i) => scratch[(r, i)],
-                None => T::zero(),
-            };
+        match (data.local[b][t], data.kappa[t], &data.deflection) {
+            (Some(i), _, _) => {
+                for r in 0..rows.count() {
+                    out[(row + r, c)] = scratch[(r, i)];
+                }
+            }
+            (None, Some(term), Some(d)) => {
+                let k = tree.compliance.as_ref().expect("a κ").terms[term].joint;
+                kappa_column(
+                    tree,
+                    &data.branches[b],
+                    b,
+                    k,
+                    d.lever[term],
+                    target,
+                    rows,
+                    out,
+                    (row, c),
+                );
+            }
+            _ => {
+                for r in 0..rows.count() {
+                    out[(row + r, c)] = T::zero();
+                }
+            }
+        }
+    }
+}
+
+/// The column of a compliance κ of tree joint `k` with lever `lever` for tree target
+/// `target` of branch `b` (evaluated in `data`) at `out[at]`: the observed frame's motion
+/// under the twist `ℓ Σ_i C_b[i, k] ξ_i`, in the instrument frame (as
+/// [`identification_jacobian`] writes a chain parameter's).
+#[allow(clippy::too_many_arguments)]
+fn kappa_column<T: RealField + Copy>(
+    tree: &Tree,
+    data: &Data<T>,
+    b: usize,
+    k: usize,
+    lever: T,
+    target: usize,
+    rows: Rows,
+    out: &mut DMatrix<T>,
+    (row, c): (usize, usize),
+) {
+    let mut tw = Twist::zero();
+    for (i, joint) in data.joint_twists.iter().enumerate() {
+        let ci = coefficient(&tree.branches[b], i, k);
+        if ci != 0.0 {
+            let s: T = nalgebra::convert::<f64, T>(ci) * lever;
+            tw.w += joint.w * s;
+            tw.v += joint.v * s;
+        }
+    }
+    let (_, _, local) = tree.targets[target];
+    let p = observed_world(data, Observed::Target(local)).trans;
+    let rt = data.instrument.rot.transpose();
+    let dp = rt * tw.point_velocity(&p);
+    let dw = rt * tw.w;
+    for r in 0..3 {
+        out[(row + r, c)] = dp[r];
+        if rows == Rows::Pose {
+            out[(row + 3 + r, c)] = dw[r];
         }
     }
 }
@@ -148,6 +227,20 @@ pub fn tree_joint_jacobian<T: RealField + Copy>(
             let c: T = nalgebra::convert(c);
             for r in 0..6 {
                 j[(r, t)] += jb[(r, i)] * c;
+            }
+        }
+    }
+    if let (Some(c), Some(d)) = (&tree.compliance, &data.deflection) {
+        // w.r.t. the commanded joints: J̃ (I + Σ_t κ_t e_k ∇ℓ_tᵀ)
+        let deflected = j.clone_owned();
+        let dof = tree.dof();
+        for (t, term) in c.terms.iter().enumerate() {
+            let kappa: T = nalgebra::convert(d.kappa[t]);
+            for m in 0..dof {
+                let a = kappa * d.lever_rate[t * dof + m];
+                for r in 0..6 {
+                    j[(r, m)] += deflected[(r, term.joint)] * a;
+                }
             }
         }
     }

@@ -48,6 +48,7 @@ use crate::Error;
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 
+pub mod compliance;
 pub mod identifiability;
 pub mod kinematics;
 
@@ -96,6 +97,11 @@ pub struct TreeSpec {
     pub links: Vec<TreeLinkSpec>,
     /// The targets, each naming its link.
     pub targets: Vec<TreeTargetSpec>,
+    /// Joint compliance over the tree ([`compliance`]): gravity, the lever geometry (the
+    /// tree's nominal parameters) and the lumped terms, each naming its tree joint and the
+    /// joint on whose axis its mass sits.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compliance: Option<crate::model::compliance::ComplianceSpec>,
 }
 
 /// A coupled joint of a tree: its name, its link, its kind and what drives it.
@@ -150,6 +156,9 @@ pub struct Tree {
     pub targets: Vec<(String, usize, usize)>,
     /// Names of the links where several branches part (the last link they share).
     pub forks: Vec<String>,
+    /// Joint compliance over the tree (its κ follow the targets in the registry); `None`:
+    /// a rigid tree.
+    pub compliance: Option<compliance::TreeCompliance>,
     /// The links that hang from a fork with a joint whose axis the fork's frame places (a
     /// DH, Hayati or MDH link), after the first such link of that fork: their axes are tied
     /// to the first's (DH: on the fork frame's z; MDH: meeting its x at a right angle), so
@@ -329,12 +338,17 @@ impl Tree {
                 targets: ks.clone(),
             });
         }
-        let registry = tree_registry(spec, &branches, &targets)?;
+        let mut registry = tree_registry(spec, &branches, &targets)?;
         for b in &mut branches {
             b.params = (0..b.model.param_count())
                 .map(|i| registry.require(&b.model.registry.get(i).name))
                 .collect::<Result<_, _>>()?;
         }
+        let compliance = spec
+            .compliance
+            .as_ref()
+            .map(|c| compliance::compile(c, &joints, &branches, &mut registry))
+            .transpose()?;
         Ok(Tree {
             name: spec.name.clone(),
             registry,
@@ -343,6 +357,7 @@ impl Tree {
             branches,
             targets,
             forks,
+            compliance,
             incomplete,
             spec: spec.clone(),
         })
@@ -371,6 +386,11 @@ impl Tree {
             }
             for (k, t) in at.targets.into_iter().enumerate() {
                 spec.targets[b.targets[k]].target = t;
+            }
+        }
+        if let (Some(c), Some(given)) = (&self.compliance, spec.compliance.as_mut()) {
+            for (term, t) in c.terms.iter().zip(&mut given.terms) {
+                t.value = params[term.param];
             }
         }
         spec

@@ -7,6 +7,7 @@
 
 use crate::common::*;
 use armcal::model::identifiability::{IdentifiabilitySettings, Measurement};
+use armcal::model::tree::compliance::lumped_tree_compliance;
 use armcal::model::tree::identifiability::{analyze_tree, expected_tree_count};
 use armcal::model::tree::kinematics::*;
 use armcal::model::tree::*;
@@ -105,6 +106,7 @@ fn random_tree_in(
         instrument: Some(link("tracker", Convention::Frame6, None, &mut r)),
         links,
         targets,
+        compliance: None,
     }
 }
 
@@ -145,10 +147,38 @@ fn pose_of(tree: &Tree, params: &[f64], q: &[f64], target: usize) -> Pose<f64> {
     tree_observed_pose(tree, &data, target)
 }
 
+/// `spec` with joint compliance on the torso joint, the second joint of the right arm (it
+/// drives the coupled joint) and the third of the left, gravity oblique in the root frame, every κ at a
+/// value that deflects the joints by milliradians.
+fn compliant(spec: TreeSpec) -> TreeSpec {
+    let tree = Tree::from_spec(&spec).unwrap();
+    let joints = ["q_t1", "q_a0j2", "q_a1j3"].map(String::from);
+    let mut c = lumped_tree_compliance(&tree, &joints, [0.3, -0.2, -1.0]).unwrap();
+    for (i, t) in c.terms.iter_mut().enumerate() {
+        t.value = 2e-6 * (1.0 + 0.3 * i as f64);
+    }
+    TreeSpec {
+        compliance: Some(c),
+        ..spec
+    }
+}
+
 #[test]
 fn tree_identification_jacobian_matches_finite_differences() {
+    identification_jacobian_matches_finite_differences(coupled_dual_arm);
+}
+
+/// With joint compliance over the tree: the κ columns (the deflection of a torso joint by
+/// both arms' masses moves both arms' targets) and the geometric columns at the deflected
+/// joints.
+#[test]
+fn compliant_tree_identification_jacobian_matches_finite_differences() {
+    identification_jacobian_matches_finite_differences(|s| compliant(coupled_dual_arm(s)));
+}
+
+fn identification_jacobian_matches_finite_differences(spec: fn(u64) -> TreeSpec) {
     for seed in 0..3 {
-        let tree = Tree::from_spec(&coupled_dual_arm(seed)).unwrap();
+        let tree = Tree::from_spec(&spec(seed)).unwrap();
         assert_eq!(tree.branches.len(), 2);
         assert_eq!(tree.dof(), 8, "9 joints, one coupled");
         let params = tree.nominal();
@@ -173,15 +203,21 @@ fn tree_identification_jacobian_matches_finite_differences() {
                 );
                 let mut zero_columns = 0;
                 for j in 0..n {
+                    let name = &tree.registry.get(j).name;
+                    // a κ of 1e-6 rad/mm turns a joint by a milliradian: a step of its own
+                    let h = if name.contains(".compliance.") {
+                        1e-7
+                    } else {
+                        1e-6
+                    };
                     let fd = fd_pose(
                         |h| {
                             let mut p = params.clone();
                             p[j] += h;
                             pose_of(&tree, &p, &q, target)
                         },
-                        1e-6,
+                        h,
                     );
-                    let name = &tree.registry.get(j).name;
                     for row in 0..6 {
                         assert_close(
                             jac[(row, j)],
@@ -201,9 +237,20 @@ fn tree_identification_jacobian_matches_finite_differences() {
 
 #[test]
 fn tree_joint_jacobian_matches_finite_differences_and_dual_numbers() {
+    joint_jacobian_matches_finite_differences_and_dual_numbers(coupled_dual_arm);
+}
+
+/// With joint compliance over the tree: the chain rule through the deflection
+/// `q + Δq(q)`, whose levers turn with every joint before the masses.
+#[test]
+fn compliant_tree_joint_jacobian_matches_finite_differences_and_dual_numbers() {
+    joint_jacobian_matches_finite_differences_and_dual_numbers(|s| compliant(coupled_dual_arm(s)));
+}
+
+fn joint_jacobian_matches_finite_differences_and_dual_numbers(spec: fn(u64) -> TreeSpec) {
     use num_dual::Dual64;
     for seed in 0..3 {
-        let tree = Tree::from_spec(&coupled_dual_arm(seed)).unwrap();
+        let tree = Tree::from_spec(&spec(seed)).unwrap();
         let params = tree.nominal();
         let mut r = rng(60 + seed);
         let q = random_tree_q(&tree, &mut r);
@@ -530,6 +577,7 @@ fn palletizer(coupled: bool) -> TreeSpec {
             },
             parent: "j5".into(),
         }],
+        compliance: None,
     }
 }
 
@@ -618,4 +666,47 @@ fn a_one_branch_tree_is_its_serial_chain() {
     let p = pose_of(&tree, &tree.nominal(), q, 0);
     let m = measure(serial, &serial.nominal(), q, Observed::Target(0));
     assert_eq!(p.trans, m.trans);
+}
+
+/// The lumped masses of a tree: the torso joint takes terms of both arms' masses (both
+/// arms load it), an arm's joint only its own arm's; every term deflects its joint (κ
+/// moves it) and a coupled joint is refused by name.
+#[test]
+fn a_torso_joint_is_loaded_by_both_arms_and_an_arm_joint_by_its_own() {
+    let spec = compliant(coupled_dual_arm(1));
+    let c = spec.compliance.as_ref().unwrap();
+    let on = |joint: &str, arm: &str| {
+        c.terms
+            .iter()
+            .filter(|t| t.joint == joint && t.at.as_deref().unwrap().starts_with(arm))
+            .count()
+    };
+    assert!(
+        on("q_t1", "q_a0") >= 1 && on("q_t1", "q_a1") >= 1,
+        "{:?}",
+        c.terms
+    );
+    assert_eq!(on("q_a0j2", "q_a1"), 0, "{:?}", c.terms);
+    assert_eq!(on("q_a1j3", "q_a0"), 0, "{:?}", c.terms);
+    assert!(on("q_a1j3", "q_a1") >= 1);
+    let tree = Tree::from_spec(&spec).unwrap();
+    assert_eq!(tree.compliance.as_ref().unwrap().terms.len(), c.terms.len());
+    // the estimate's spec carries the κ back
+    let mut params = tree.nominal();
+    let last = tree.param_count() - 1;
+    params[last] = 7e-6;
+    assert_eq!(
+        tree.spec_at(&params)
+            .compliance
+            .unwrap()
+            .terms
+            .last()
+            .unwrap()
+            .value,
+        7e-6
+    );
+    // a coupled joint deflects with the joints it follows: the error says so
+    let rigid = Tree::from_spec(&coupled_dual_arm(1)).unwrap();
+    let err = lumped_tree_compliance(&rigid, &["q_a0j3".into()], [0.0, 0.0, -1.0]).unwrap_err();
+    assert!(err.contains("q_a0j3") && err.contains("coupled"), "{err}");
 }
