@@ -36,9 +36,13 @@ fn identification(c: &mut Criterion) {
     });
     group.bench_function("identify (the root call), 1000 poses, 27 parameters", |b| {
         b.iter(|| {
-            let estimate =
-                armcal::identify(&cell, &data, &armcal::IdentifySettings::default(), &mut Silent)
-                    .expect("identify");
+            let estimate = armcal::identify(
+                &cell,
+                &data,
+                &armcal::IdentifySettings::default(),
+                &mut Silent,
+            )
+            .expect("identify");
             assert!(estimate.solver.status.is_converged());
             estimate
         })
