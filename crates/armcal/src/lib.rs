@@ -104,7 +104,7 @@ pub use model::urdf::calibration::DEFAULT_K_SIGMA;
 pub use model::Model;
 // Kinematic trees and coupled joints: analysis, simulation and identification.
 pub use cell::tree::{analyze_tree_file, describes_tree, TreeAnalysis, TreeCell};
-pub use identify::tree::{identify_tree, TreeEstimate, TreeTargetFit};
+pub use identify::tree::{export_tree_estimate, identify_tree, TreeEstimate, TreeTargetFit};
 pub use sim::tree::simulate_tree;
 // Kinematics over many configurations; every frame at one configuration.
 pub use model::frames::{frames, FramesRecord, PoseRecord};

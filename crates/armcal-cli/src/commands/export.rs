@@ -35,6 +35,9 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
+    if let Some(est) = armcal::TreeEstimate::read_if_tree(&a.calibration.estimate)? {
+        return super::tree::export(a, &est);
+    }
     let format = match ExportFormat::from_name(&a.format).expect("clap checked") {
         ExportFormat::UrdfCalibration(Some(_)) => ExportFormat::UrdfCalibration(Some(a.k_sigma)),
         f => f,

@@ -1,11 +1,12 @@
 //! `armcal identify` and `armcal simulate` of a tree cell (links that name a `parent`,
 //! coupled joints, targets that name a `link`): parse, one library call, print.
 
-use super::output::{station_files, Outputs};
+use super::digits::fixed;
+use super::output::{station_files, with_note, NoteStyle, Outputs};
 use super::progress::Progress;
-use super::{identify, simulate};
+use super::{export, identify, simulate};
 use anyhow::bail;
-use armcal::{Perturbation, TreeCell, TreeEstimate};
+use armcal::{ExportFormat, Perturbation, TreeCell, TreeEstimate};
 use std::path::Path;
 
 /// `armcal identify --cell <tree cell>`: one fit of the whole tree over every data file.
@@ -146,4 +147,38 @@ pub fn simulate(a: &simulate::Args, cell_path: &Path) -> anyhow::Result<()> {
         poses.len(),
         &format!("tree `{}`", cell.name),
     )
+}
+
+/// `armcal export --estimate <tree estimate>`: the tree at the estimate as one URDF file or a
+/// tree cell (`--cell`: the tree cell it was identified in, for its noise and measurement).
+pub fn export(a: &export::Args, est: &TreeEstimate) -> anyhow::Result<()> {
+    let format = ExportFormat::from_name(&a.format).expect("clap checked");
+    let mut inputs = vec![a.calibration.estimate.as_path()];
+    inputs.extend(a.cell.as_deref().map(Path::new));
+    let outputs = Outputs::plan(a.force, &inputs, &[&a.out])?;
+    let cell = a
+        .cell
+        .as_deref()
+        .map(|c| TreeCell::from_file(Path::new(c)))
+        .transpose()?;
+    let exported = armcal::export_tree_estimate(
+        est,
+        cell.as_ref(),
+        format,
+        &a.calibration.accept.acceptance(),
+    )?;
+    for w in &exported.warnings {
+        eprintln!("warning: {w}");
+    }
+    for n in &exported.notes {
+        eprintln!("note: {n}");
+    }
+    let style = match format {
+        ExportFormat::Urdf => NoteStyle::Xml,
+        _ => NoteStyle::Hash,
+    };
+    let note = exported.warnings.first().map(String::as_str);
+    outputs.commit(&[(&a.out, &with_note(exported.content, note, style))])?;
+    println!("{} of tree `{}` → {}", a.format, est.cell, a.out.display());
+    Ok(())
 }

@@ -139,4 +139,63 @@ fn a_dual_arm_tree_measured_arm_by_arm_is_fitted_as_one_tree() {
         dir.join("right.json").to_str().unwrap(),
     ]);
     assert!(ok, "{stdout}\n{stderr}");
+    // the tree estimate exported: one URDF file of the whole tree, and a tree cell that the
+    // tree commands read back
+    let urdf = dir.join("tree.urdf");
+    let (ok, stdout, stderr) = armcal(&[
+        "export",
+        "--estimate",
+        est.to_str().unwrap(),
+        "--format",
+        "urdf",
+        "--out",
+        urdf.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stdout}\n{stderr}");
+    assert!(stderr.contains("instrument frame `tracker`"), "{stderr}");
+    let xml = std::fs::read_to_string(&urdf).unwrap();
+    for j in ["torso", "r_t", "l_t", "smr_r_fixed", "smr_l_fixed"] {
+        assert!(xml.contains(&format!("name=\"{j}\"")), "{j}: {xml}");
+    }
+    let exported = dir.join("tree-cell.toml");
+    let (ok, stdout, stderr) = armcal(&[
+        "export",
+        "--estimate",
+        est.to_str().unwrap(),
+        "--format",
+        "cell",
+        "--cell",
+        cell,
+        "--out",
+        exported.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stdout}\n{stderr}");
+    let (ok, stdout, stderr) = armcal(&["model", exported.to_str().unwrap()]);
+    assert!(ok, "{stdout}\n{stderr}");
+    assert!(
+        stdout.contains("smr_r") && stdout.contains("smr_l"),
+        "{stdout}"
+    );
+    // a serial format is refused for a tree, by name
+    let (ok, _, stderr) = armcal(&[
+        "export",
+        "--estimate",
+        est.to_str().unwrap(),
+        "--format",
+        "dh",
+        "--out",
+        dir.join("tree-dh.toml").to_str().unwrap(),
+    ]);
+    assert!(!ok);
+    assert!(
+        stderr.contains("a tree exports as `urdf`") && !dir.join("tree-dh.toml").exists(),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn a_urdf_with_a_mimic_joint_is_a_tree_cell() {
+    let (ok, stdout, stderr) = armcal(&["model", "examples/dual-arm-urdf-tree-cell.toml"]);
+    assert!(ok, "{stdout}\n{stderr}");
+    assert!(stdout.contains("torso_level"), "{stdout}");
 }

@@ -55,20 +55,7 @@ pub fn to_cell_toml(cell: &Cell, identified: &Model, spec: &ModelSpec) -> Result
     }
     if let Some(i) = &cell.instrument {
         let _ = writeln!(s.instrument, "kind = {}", toml_text::string(&i.kind));
-        let noise = match &i.noise {
-            NoiseModel::Constant { sigma, sigma_angle } => format!(
-                "{{ model = \"constant\", sigma_mm = {:?}, sigma_angle_deg = {:?} }}",
-                sigma,
-                sigma_angle.to_degrees()
-            ),
-            NoiseModel::Range { a, b_per_m } => format!(
-                "{{ model = \"range\", a_mm = {a:?}, b_um_per_m = {:?} }}",
-                b_per_m * 1000.0
-            ),
-            NoiseModel::PerMeasurement { floor } => {
-                format!("{{ model = \"per-measurement\", floor_mm = {floor:?} }}")
-            }
-        };
+        let noise = noise_toml(&i.noise);
         let _ = writeln!(s.instrument, "noise = {noise}");
         if let Some(a) = i.max_incidence {
             let _ = writeln!(s.instrument, "max_incidence_deg = {:?}", a.to_degrees());
@@ -141,6 +128,24 @@ pub fn to_cell_toml(cell: &Cell, identified: &Model, spec: &ModelSpec) -> Result
         let _ = writeln!(s.tail, "\n[data]\n{}", d.format.to_toml());
     }
     to_cell_toml_with(spec, &s)
+}
+
+/// A noise model as the inline table of `[instrument] noise`.
+pub(crate) fn noise_toml(noise: &NoiseModel) -> String {
+    match noise {
+        NoiseModel::Constant { sigma, sigma_angle } => format!(
+            "{{ model = \"constant\", sigma_mm = {:?}, sigma_angle_deg = {:?} }}",
+            sigma,
+            sigma_angle.to_degrees()
+        ),
+        NoiseModel::Range { a, b_per_m } => format!(
+            "{{ model = \"range\", a_mm = {a:?}, b_um_per_m = {:?} }}",
+            b_per_m * 1000.0
+        ),
+        NoiseModel::PerMeasurement { floor } => {
+            format!("{{ model = \"per-measurement\", floor_mm = {floor:?} }}")
+        }
+    }
 }
 
 /// The `[parameters]` body: `free = "auto"` (or `"all"`, as the cell had it), the cell's

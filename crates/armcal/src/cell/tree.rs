@@ -202,3 +202,93 @@ pub fn analyze_tree_file(
         identifiability,
     })
 }
+
+/// `spec` (a tree, e.g. at an estimate) as a tree cell file that [`TreeCell::from_file`]
+/// reads back to the same tree: every link with its convention, values (mm, degrees),
+/// joint, `parent` (written on every link but the root) and `coupled` (coefficients as
+/// given, the offset in `offset_deg` or `offset_mm`), the instrument frame with `noise`, the
+/// targets with the `link` each hangs from, and `[parameters] measurement`.
+pub(crate) fn tree_cell_toml(
+    name: &str,
+    spec: &TreeSpec,
+    measurement: Measurement,
+    noise: Option<&NoiseModel>,
+) -> Result<String, Error> {
+    use crate::model::export::{frame_fields, link_toml_with};
+    use crate::model::{Convention, JointKind};
+    use crate::toml_text::string;
+    use std::fmt::Write;
+    Tree::from_spec(spec)?;
+    let mut out = format!(
+        "# armcal tree export: {}\nname = {}\n\n[robot]\nname = {}\n\n",
+        string(&spec.name),
+        string(name),
+        string(&spec.name)
+    );
+    for (i, l) in spec.links.iter().enumerate() {
+        let mut extra = String::new();
+        let parent = match (&l.parent, i) {
+            (Some(p), _) => Some(p.as_str()),
+            (None, 0) => None,
+            (None, _) => Some(spec.links[i - 1].link.name.as_str()),
+        };
+        if let Some(p) = parent {
+            let _ = writeln!(extra, "parent = {}", string(p));
+        }
+        if let (Some(c), Some(j)) = (&l.coupling, &l.link.joint) {
+            let mut terms: Vec<String> = c
+                .terms
+                .iter()
+                .map(|(n, a)| format!("{} = {a:?}", string(n)))
+                .collect();
+            terms.push(match j.kind {
+                JointKind::Revolute => format!("offset_deg = {:?}", c.offset.to_degrees()),
+                JointKind::Prismatic => format!("offset_mm = {:?}", c.offset),
+            });
+            let _ = writeln!(extra, "coupled = {{ {} }}", terms.join(", "));
+        }
+        link_toml_with(&mut out, "robot.links", &l.link, true, &extra);
+    }
+    if let Some(i) = &spec.instrument {
+        if i.geometry.convention != Convention::Frame6 {
+            return Err(Error::Conversion(format!(
+                "instrument `{}` is not a frame6 and cannot be written to a cell",
+                i.name
+            )));
+        }
+        let _ = writeln!(
+            out,
+            "[instrument]\nname = {}\n{}",
+            string(&i.name),
+            frame_fields(&i.geometry.values)
+        );
+        if let Some(n) = noise {
+            let _ = writeln!(out, "noise = {}\n", super::export::noise_toml(n));
+        }
+    }
+    for t in &spec.targets {
+        let v = &t.target.geometry.values;
+        let geometry = match t.target.geometry.convention {
+            Convention::Point => format!("xyz_mm = [{:?}, {:?}, {:?}]\n", v[0], v[1], v[2]),
+            Convention::Frame6 => frame_fields(v),
+            c => {
+                return Err(Error::Conversion(format!(
+                    "target `{}` ({c}) has no cell-file form",
+                    t.target.name
+                )))
+            }
+        };
+        let _ = writeln!(
+            out,
+            "[[targets]]\nname = {}\nlink = {}\n{geometry}",
+            string(&t.target.name),
+            string(&t.parent)
+        );
+    }
+    let _ = writeln!(
+        out,
+        "[parameters]\nmeasurement = \"{}\"",
+        measurement.words()
+    );
+    Ok(out)
+}

@@ -31,7 +31,15 @@ fn display(u: Unit, v: f64) -> f64 {
     v * u.display_factor()
 }
 
-fn link_toml(out: &mut String, table: &str, l: &LinkSpec, with_convention: bool) {
+/// One link as a `[[table]]` entry of a cell file (name, convention, joint, axis, values in
+/// display units); `extra` lines (a tree link's `parent`, `coupled`) close the entry.
+pub(crate) fn link_toml_with(
+    out: &mut String,
+    table: &str,
+    l: &LinkSpec,
+    with_convention: bool,
+    extra: &str,
+) {
     let kind = l.joint.as_ref().map(|j| j.kind);
     let _ = writeln!(out, "[[{table}]]\nname = {}", toml_text::string(&l.name));
     if with_convention {
@@ -64,11 +72,16 @@ fn link_toml(out: &mut String, table: &str, l: &LinkSpec, with_convention: bool)
     {
         let _ = writeln!(out, "{field}{} = {:?}", suffix(*unit), display(*unit, *v));
     }
+    out.push_str(extra);
     out.push('\n');
 }
 
+fn link_toml(out: &mut String, table: &str, l: &LinkSpec, with_convention: bool) {
+    link_toml_with(out, table, l, with_convention, "");
+}
+
 /// `xyz_mm` and `rpy_deg` lines of a frame6 (x, y, z in mm, rx, ry, rz in rad).
-fn frame_fields(v: &[f64]) -> String {
+pub(crate) fn frame_fields(v: &[f64]) -> String {
     format!(
         "xyz_mm = [{:?}, {:?}, {:?}]\nrpy_deg = [{:?}, {:?}, {:?}]\n",
         v[0],

@@ -14,6 +14,7 @@ mod model {
     mod identifiability;
     mod robots;
     mod tree;
+    mod urdf_tree;
 }
 mod identify {
     mod compliance;

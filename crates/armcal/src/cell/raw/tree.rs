@@ -39,7 +39,6 @@ pub(in crate::cell) fn parse_tree(text: &str, file: &str) -> Result<TreeCell, Er
     let rr = raw.robot.into_inner();
     let unsupported = [
         ("robot.builtin", rr.builtin.is_some()),
-        ("robot.urdf", rr.urdf.is_some()),
         ("robot.tip", rr.tip.is_some()),
         ("robot.limits", rr.limits.is_some()),
         ("robot.capsules", !rr.capsules.is_empty()),
@@ -62,92 +61,55 @@ pub(in crate::cell) fn parse_tree(text: &str, file: &str) -> Result<TreeCell, Er
             field,
             "a tree cell (links that name a `parent`, coupled joints, targets that name a \
              `link`) takes `[[robot.links]]` (each branch's base and tool frames as links), \
-             `[instrument]`, `[[targets]]`, `[parameters] measurement` and `compliance` \
-             (with `[robot] gravity`) for now; remove this field",
-        ));
-    }
-    let mut links = Vec::new();
-    let mut joint_index = 0;
-    let mut names: Vec<(String, std::ops::Range<usize>)> = Vec::new();
-    for (i, l) in rr.links.iter().enumerate() {
-        let t = l.get_ref();
-        let field = format!("robot.links[{i}]");
-        let has_joint = matches!(
-            t.get("joint").and_then(|v| v.as_str()),
-            Some("revolute") | Some("prismatic")
-        );
-        joint_index += usize::from(has_joint);
-        let default_name = if has_joint {
-            format!("j{joint_index}")
-        } else {
-            format!("fixed{}", i + 1)
-        };
-        let link = robot::inline_link(t, default_name, joint_index)
-            .map_err(|e| ctx.err(l.span(), &field, e))?;
-        robot::check_values(&ctx, std::slice::from_ref(&link), l.span(), &field)?;
-        let parent = string_field(t, "parent")
-            .map_err(|e| ctx.err(l.span(), &format!("{field}.parent"), e))?
-            .map(str::to_string);
-        if let Some(p) = &parent {
-            if !rr.links.iter().enumerate().any(|(k, o)| {
-                string_field(o.get_ref(), "name").ok().flatten() == Some(p.as_str())
-                    || (k != i && default_link_name(&rr.links, k) == *p)
-            }) {
-                return Err(ctx.err(
-                    l.span(),
-                    &format!("{field}.parent"),
-                    format!("names `{p}`, which is no link of the robot; a parent is the `name` of another `[[robot.links]]` entry"),
-                ));
-            }
-        }
-        let coupling = match t.get("coupled") {
-            None => None,
-            Some(v) => Some(
-                coupling(v, link.joint.as_ref().map(|j| j.kind))
-                    .map_err(|e| ctx.err(l.span(), &format!("{field}.coupled"), e))?,
-            ),
-        };
-        names.push((link.name.clone(), l.span()));
-        links.push(TreeLinkSpec {
-            link,
-            parent,
-            coupling,
-        });
-    }
-    if links.is_empty() {
-        return Err(ctx.err(
-            rspan,
-            "robot.links",
-            "a tree cell lists its links in `[[robot.links]]`",
+             or `urdf`, `[instrument]`, `[[targets]]`, `[parameters] measurement` and \
+             `compliance` (with `[robot] gravity`) for now; remove this field",
         ));
     }
     let (instrument, instrument_geometry, instrument_name) =
         instrument::instrument(&ctx, raw.instrument)?;
-    let last = links
-        .last()
-        .map(|l| l.link.name.clone())
-        .unwrap_or_default();
-    let mut targets = Vec::new();
-    for (i, (target, link)) in frames::targets(&ctx, &raw.targets)?.into_iter().enumerate() {
-        let parent = link.unwrap_or_else(|| last.clone());
-        if !links.iter().any(|l| l.link.name == parent) {
-            return Err(ctx.err(
-                raw.targets[i].span(),
-                &format!("targets[{i}].link"),
-                format!("names `{parent}`, which is no link of the robot"),
-            ));
+    let given_targets = frames::targets(&ctx, &raw.targets)?;
+    let (spec_name, links, targets, names) = match &rr.urdf {
+        Some(u) => {
+            if !rr.links.is_empty() {
+                return Err(ctx.err(
+                    rspan,
+                    "robot.urdf",
+                    "give either `urdf` or `[[robot.links]]`, not both",
+                ));
+            }
+            let targets = urdf_targets(&ctx, &raw.targets, given_targets)?;
+            let path = Path::new(file)
+                .parent()
+                .map(|d| d.join(u))
+                .unwrap_or_else(|| u.into());
+            let spec = crate::model::urdf::read_urdf_tree(&path, targets.as_deref())
+                .map_err(|e| ctx.err(rspan.clone(), "robot.urdf", e))?;
+            robot::check_values(
+                &ctx,
+                &spec
+                    .links
+                    .iter()
+                    .map(|l| l.link.clone())
+                    .collect::<Vec<_>>(),
+                rspan.clone(),
+                "robot.urdf",
+            )?;
+            // a structural error names URDF joints, not entries of the cell
+            (spec.name, spec.links, spec.targets, Vec::new())
         }
-        targets.push(TreeTargetSpec { target, parent });
-    }
-    if targets.is_empty() {
-        return Err(ctx.err(
-            rspan,
-            "targets",
-            "a tree cell needs `[[targets]]`, each naming the `link` it hangs from",
-        ));
-    }
+        None => {
+            let (links, names) = inline_links(&ctx, &rr.links, rspan.clone())?;
+            let targets = inline_targets(&ctx, &raw.targets, given_targets, &links, rspan.clone())?;
+            (
+                rr.name.clone().unwrap_or_else(|| "inline".into()),
+                links,
+                targets,
+                names,
+            )
+        }
+    };
     let spec = TreeSpec {
-        name: rr.name.clone().unwrap_or_else(|| "inline".into()),
+        name: rr.name.clone().unwrap_or(spec_name),
         instrument: instrument_geometry.map(|g| LinkSpec {
             name: instrument_name,
             geometry: g,
@@ -171,6 +133,7 @@ pub(in crate::cell) fn parse_tree(text: &str, file: &str) -> Result<TreeCell, Er
             .find_map(|n| names.iter().position(|(name, _)| name == n));
         match named {
             Some(i) => ctx.err(names[i].1.clone(), &format!("robot.links[{i}]"), message),
+            None if rr.urdf.is_some() => ctx.err(rspan.clone(), "robot.urdf", message),
             None => ctx.err(rspan.clone(), "robot.links", message),
         }
     })?;
@@ -248,6 +211,132 @@ pub(in crate::cell) fn parse_tree(text: &str, file: &str) -> Result<TreeCell, Er
         instrument.map(|i| i.noise).unwrap_or_default(),
     )
     .map_err(|e| ctx.err(rspan, "robot.links", e))
+}
+
+/// The links of `[[robot.links]]`, each with its parent and coupling, and each link's name
+/// with the span of its entry.
+#[allow(clippy::type_complexity)]
+fn inline_links(
+    ctx: &Ctx,
+    raw_links: &[Spanned<toml::Table>],
+    rspan: std::ops::Range<usize>,
+) -> Result<(Vec<TreeLinkSpec>, Vec<(String, std::ops::Range<usize>)>), Error> {
+    let mut links = Vec::new();
+    let mut joint_index = 0;
+    let mut names: Vec<(String, std::ops::Range<usize>)> = Vec::new();
+    for (i, l) in raw_links.iter().enumerate() {
+        let t = l.get_ref();
+        let field = format!("robot.links[{i}]");
+        let has_joint = matches!(
+            t.get("joint").and_then(|v| v.as_str()),
+            Some("revolute") | Some("prismatic")
+        );
+        joint_index += usize::from(has_joint);
+        let default_name = if has_joint {
+            format!("j{joint_index}")
+        } else {
+            format!("fixed{}", i + 1)
+        };
+        let link = robot::inline_link(t, default_name, joint_index)
+            .map_err(|e| ctx.err(l.span(), &field, e))?;
+        robot::check_values(ctx, std::slice::from_ref(&link), l.span(), &field)?;
+        let parent = string_field(t, "parent")
+            .map_err(|e| ctx.err(l.span(), &format!("{field}.parent"), e))?
+            .map(str::to_string);
+        if let Some(p) = &parent {
+            if !raw_links.iter().enumerate().any(|(k, o)| {
+                string_field(o.get_ref(), "name").ok().flatten() == Some(p.as_str())
+                    || (k != i && default_link_name(raw_links, k) == *p)
+            }) {
+                return Err(ctx.err(
+                    l.span(),
+                    &format!("{field}.parent"),
+                    format!("names `{p}`, which is no link of the robot; a parent is the `name` of another `[[robot.links]]` entry"),
+                ));
+            }
+        }
+        let coupling = match t.get("coupled") {
+            None => None,
+            Some(v) => Some(
+                coupling(v, link.joint.as_ref().map(|j| j.kind))
+                    .map_err(|e| ctx.err(l.span(), &format!("{field}.coupled"), e))?,
+            ),
+        };
+        names.push((link.name.clone(), l.span()));
+        links.push(TreeLinkSpec {
+            link,
+            parent,
+            coupling,
+        });
+    }
+    if links.is_empty() {
+        return Err(ctx.err(
+            rspan,
+            "robot.links",
+            "a tree cell lists its links in `[[robot.links]]`",
+        ));
+    }
+    Ok((links, names))
+}
+
+/// The targets of `[[targets]]` over inline links: each on the link it names, or the last
+/// link.
+fn inline_targets(
+    ctx: &Ctx,
+    raw_targets: &[Spanned<toml::Table>],
+    given: Vec<(LinkSpec, Option<String>)>,
+    links: &[TreeLinkSpec],
+    rspan: std::ops::Range<usize>,
+) -> Result<Vec<TreeTargetSpec>, Error> {
+    let last = links
+        .last()
+        .map(|l| l.link.name.clone())
+        .unwrap_or_default();
+    let mut targets = Vec::new();
+    for (i, (target, link)) in given.into_iter().enumerate() {
+        let parent = link.unwrap_or_else(|| last.clone());
+        if !links.iter().any(|l| l.link.name == parent) {
+            return Err(ctx.err(
+                raw_targets[i].span(),
+                &format!("targets[{i}].link"),
+                format!("names `{parent}`, which is no link of the robot"),
+            ));
+        }
+        targets.push(TreeTargetSpec { target, parent });
+    }
+    if targets.is_empty() {
+        return Err(ctx.err(
+            rspan,
+            "targets",
+            "a tree cell needs `[[targets]]`, each naming the `link` it hangs from",
+        ));
+    }
+    Ok(targets)
+}
+
+/// The targets of `[[targets]]` over a URDF robot, each naming the URDF `link` it hangs from;
+/// `None` without `[[targets]]` (a frame at every leaf link of the URDF).
+fn urdf_targets(
+    ctx: &Ctx,
+    raw_targets: &[Spanned<toml::Table>],
+    given: Vec<(LinkSpec, Option<String>)>,
+) -> Result<Option<Vec<TreeTargetSpec>>, Error> {
+    if given.is_empty() {
+        return Ok(None);
+    }
+    given
+        .into_iter()
+        .enumerate()
+        .map(|(i, (target, link))| match link {
+            Some(parent) => Ok(TreeTargetSpec { target, parent }),
+            None => Err(ctx.err(
+                raw_targets[i].span(),
+                &format!("targets[{i}].link"),
+                "a target of a URDF tree names the URDF `link` it hangs from (`link = \"l_tool\"`)",
+            )),
+        })
+        .collect::<Result<_, _>>()
+        .map(Some)
 }
 
 /// The name an unnamed `[[robot.links]]` entry `k` gets (as [`robot::inline_link`] names it).

@@ -43,7 +43,9 @@ use crate::Error;
 use nalgebra::{DMatrix, Matrix3};
 use serde::{Deserialize, Serialize};
 
+mod export;
 mod problem;
+pub use export::export_tree_estimate;
 pub(crate) use problem::TreeProblem;
 
 /// The fit of one target (one branch's reflector) in a tree estimate: how well the model
@@ -66,8 +68,9 @@ pub struct TreeTargetFit {
 
 /// The estimate of a tree (`armcal identify` of a tree cell, `estimate.json`): the tree at
 /// its estimated parameters, every parameter with its σ, the covariance, the solver and the
-/// fit per target. Read by no other command yet: `predict`, `report`, `compensate`,
-/// `accuracy` and the others take a serial estimate and refuse this one by name.
+/// fit per target. `armcal export` writes it as a URDF or a tree cell
+/// ([`export_tree_estimate`]); `predict`, `report`, `compensate`, `accuracy` and the others
+/// take a serial estimate and refuse this one by name.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct TreeEstimate {
     /// Always `tree-estimate` (what the other commands recognise and refuse).
@@ -107,6 +110,24 @@ impl TreeEstimate {
     /// The record as JSON (keys in alphabetical order, [`crate::json`]).
     pub fn to_json(&self) -> Result<String, Error> {
         crate::json::sorted_pretty(self)
+    }
+
+    /// Reads the estimate at `path` if it is a tree's (`kind` `tree-estimate`); `None` for
+    /// any other JSON (a serial estimate, read by [`crate::Estimate::from_file`]). Errors
+    /// name the file.
+    pub fn read_if_tree(path: &std::path::Path) -> Result<Option<TreeEstimate>, Error> {
+        let file = |message: String| Error::File {
+            file: path.display().to_string(),
+            message,
+        };
+        let text = crate::input::read_capped(path, crate::input::TEXT_CAP)
+            .map_err(|e| file(e.to_string()))?;
+        if tree_estimate_refusal(&text).is_none() {
+            return Ok(None);
+        }
+        serde_json::from_str(&text)
+            .map(Some)
+            .map_err(|e| file(format!("not a readable tree estimate: {e}")))
     }
 
     /// The tree parameter vector of the estimate (internal units), in `cell`'s registry
@@ -186,10 +207,10 @@ impl TreeEstimate {
 pub(crate) fn tree_estimate_refusal(text: &str) -> Option<String> {
     let value: serde_json::Value = serde_json::from_str(text).ok()?;
     (value.get("kind")?.as_str()? == "tree-estimate").then(|| {
-        "the estimate of a kinematic tree (`armcal identify` of a tree cell): predict, \
-         compensate, accuracy, report, export and the other commands that read an estimate \
-         take a serial chain's for now (issue 32); the tree's parameters, σ and per-target \
-         fit are in this file"
+        "the estimate of a kinematic tree (`armcal identify` of a tree cell): `armcal \
+         export` writes it as a URDF or a tree cell; predict, compensate, accuracy, report \
+         and the other commands that read an estimate take a serial chain's for now (issue \
+         32); the tree's parameters, σ and per-target fit are in this file"
             .to_string()
     })
 }

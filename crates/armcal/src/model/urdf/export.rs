@@ -137,7 +137,7 @@ pub(crate) fn urdf_robot(spec: &ModelSpec, offsets: &[f64]) -> Result<urdf_rs::R
     })
 }
 
-fn empty_link(name: &str) -> urdf_rs::Link {
+pub(super) fn empty_link(name: &str) -> urdf_rs::Link {
     urdf_rs::Link {
         name: name.into(),
         inertial: Default::default(),
@@ -147,7 +147,7 @@ fn empty_link(name: &str) -> urdf_rs::Link {
 }
 
 /// A URDF joint with origin `pose` (mm → m), `axis` and optional limits (m or rad).
-fn urdf_joint(
+pub(super) fn urdf_joint(
     name: &str,
     joint_type: urdf_rs::JointType,
     parent: &str,

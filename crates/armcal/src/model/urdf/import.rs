@@ -43,6 +43,15 @@ pub fn from_urdf_str_with_collisions(
 
 /// The chain of `xml` and its links' collision shapes.
 fn parse(xml: &str, tip: Option<&str>) -> Result<(ModelSpec, Vec<CollisionShape>), Error> {
+    let robot = parse_robot(xml)?;
+    let (spec, frames) = import(&robot, tip)?;
+    let shapes = collision_shapes(&robot, &frames)?;
+    Ok((spec, shapes))
+}
+
+/// The parsed URDF robot of `xml`; a text nesting deeper than [`super::depth::MAX_DEPTH`]
+/// is refused before parsing.
+pub(super) fn parse_robot(xml: &str) -> Result<urdf_rs::Robot, Error> {
     super::depth::check_depth(xml)?;
     // The XML parser under urdf-rs (RustyXML 0.3) panics on some malformed documents instead
     // of returning an error: an attribute name with an undeclared namespace prefix
@@ -64,10 +73,7 @@ fn parse(xml: &str, tip: Option<&str>) -> Result<(ModelSpec, Vec<CollisionShape>
                 .into(),
         )
     })?;
-    let robot = parsed.map_err(|e| Error::Input(format!("not a valid URDF document: {e}")))?;
-    let (spec, frames) = import(&robot, tip)?;
-    let shapes = collision_shapes(&robot, &frames)?;
-    Ok((spec, shapes))
+    parsed.map_err(|e| Error::Input(format!("not a valid URDF document: {e}")))
 }
 
 /// A `<collision>` shape of a chain link, in armcal's units.
@@ -173,6 +179,108 @@ fn import(
     tip: Option<&str>,
 ) -> Result<(ModelSpec, Vec<(String, String)>), Error> {
     let err = |m: String| Error::Input(format!("URDF robot `{}`: {m}", robot.name));
+    let Structure {
+        root,
+        links,
+        parent_joint,
+        has_children,
+    } = structure(robot)?;
+    let tip = match tip {
+        Some(t) => {
+            if !links.contains(t) {
+                let mut known: Vec<&str> = links.iter().copied().collect();
+                known.sort_unstable();
+                return Err(err(format!(
+                    "unknown tip link `{t}`; links: {}",
+                    known.join(", ")
+                )));
+            }
+            t
+        }
+        None => {
+            let leaves: Vec<&str> = robot
+                .links
+                .iter()
+                .map(|l| l.name.as_str())
+                .filter(|l| !has_children.contains(l))
+                .collect();
+            match leaves.as_slice() {
+                [l] => *l,
+                _ => {
+                    return Err(err(format!(
+                        "the tree branches into several leaf links ({}); choose the tip link \
+                         the chain ends in (`tip`), or load the whole tree (a cell whose \
+                         `[[targets]]` name the URDF `link` they hang from)",
+                        leaves.join(", ")
+                    )))
+                }
+            }
+        }
+    };
+    // Walk up from the tip to the root.
+    let mut path = Vec::new();
+    let mut link = tip;
+    let mut seen = HashSet::new();
+    while let Some(j) = parent_joint.get(link) {
+        if !seen.insert(link) {
+            return Err(err(format!("the joints above link `{tip}` form a cycle")));
+        }
+        path.push(*j);
+        link = &j.parent.link;
+    }
+    debug_assert_eq!(link, root);
+    path.reverse();
+
+    let mut names: HashSet<String> = ["base".to_string(), "tool".to_string()].into();
+    let mut out = vec![identity_frame("base")];
+    let mut frames = vec![(root.to_string(), "base".to_string())];
+    for j in path {
+        if let Some(m) = &j.mimic {
+            return Err(err(format!(
+                "joint `{}` mimics `{}`: a serial chain has no coupled joints; load the URDF \
+                 as a kinematic tree (a cell whose `[[targets]]` name the URDF `link` they \
+                 hang from), where a <mimic> joint is a coupled joint",
+                j.name, m.joint
+            )));
+        }
+        let name = unique(&sanitise(&j.name), &mut names);
+        frames.push((j.child.link.clone(), name.clone()));
+        out.push(import_joint(j, name).map_err(|m| err(format!("joint `{}`: {m}", j.name)))?);
+    }
+    if out.iter().all(|l| l.joint.is_none()) {
+        return Err(err(format!(
+            "no movable joint between the root link `{root}` and the tip link `{tip}`"
+        )));
+    }
+    out.push(identity_frame("tool"));
+    let spec = ModelSpec {
+        compliance: None,
+        periodic: None,
+        payloads: Vec::new(),
+        name: robot.name.clone(),
+        instrument: None,
+        links: out,
+        targets: Vec::new(),
+    };
+    Ok((spec, frames))
+}
+
+/// The link graph of a URDF robot, checked: link and joint names unique, every joint's links
+/// known, every link the child of at most one joint, one root.
+pub(super) struct Structure<'a> {
+    /// The one link that is no joint's child.
+    pub root: &'a str,
+    /// Every link's name.
+    pub links: HashSet<&'a str>,
+    /// The joint whose child each link is (every link but the root).
+    pub parent_joint: HashMap<&'a str, &'a urdf_rs::Joint>,
+    /// The links some joint leaves.
+    pub has_children: HashSet<&'a str>,
+}
+
+/// The checked link graph of `robot`; errors name the robot and the link or joint.
+pub(super) fn structure(robot: &urdf_rs::Robot) -> Result<Structure<'_>, Error> {
+    let err = |m: String| Error::Input(format!("URDF robot `{}`: {m}", robot.name));
     if robot.links.is_empty() {
         return Err(err("has no links".into()));
     }
@@ -228,79 +336,16 @@ fn import(
             )))
         }
     };
-    let tip = match tip {
-        Some(t) => {
-            if !links.contains(t) {
-                let mut known: Vec<&str> = links.iter().copied().collect();
-                known.sort_unstable();
-                return Err(err(format!(
-                    "unknown tip link `{t}`; links: {}",
-                    known.join(", ")
-                )));
-            }
-            t
-        }
-        None => {
-            let leaves: Vec<&str> = robot
-                .links
-                .iter()
-                .map(|l| l.name.as_str())
-                .filter(|l| !has_children.contains(l))
-                .collect();
-            match leaves.as_slice() {
-                [l] => *l,
-                _ => {
-                    return Err(err(format!(
-                        "the tree branches into several leaf links ({}); choose the tip link \
-                         the chain ends in",
-                        leaves.join(", ")
-                    )))
-                }
-            }
-        }
-    };
-    // Walk up from the tip to the root.
-    let mut path = Vec::new();
-    let mut link = tip;
-    let mut seen = HashSet::new();
-    while let Some(j) = parent_joint.get(link) {
-        if !seen.insert(link) {
-            return Err(err(format!("the joints above link `{tip}` form a cycle")));
-        }
-        path.push(*j);
-        link = &j.parent.link;
-    }
-    debug_assert_eq!(link, root);
-    path.reverse();
-
-    let mut names: HashSet<String> = ["base".to_string(), "tool".to_string()].into();
-    let mut out = vec![identity_frame("base")];
-    let mut frames = vec![(root.to_string(), "base".to_string())];
-    for j in path {
-        let name = unique(&sanitise(&j.name), &mut names);
-        frames.push((j.child.link.clone(), name.clone()));
-        out.push(import_joint(j, name).map_err(|m| err(format!("joint `{}`: {m}", j.name)))?);
-    }
-    if out.iter().all(|l| l.joint.is_none()) {
-        return Err(err(format!(
-            "no movable joint between the root link `{root}` and the tip link `{tip}`"
-        )));
-    }
-    out.push(identity_frame("tool"));
-    let spec = ModelSpec {
-        compliance: None,
-        periodic: None,
-        payloads: Vec::new(),
-        name: robot.name.clone(),
-        instrument: None,
-        links: out,
-        targets: Vec::new(),
-    };
-    Ok((spec, frames))
+    Ok(Structure {
+        root,
+        links,
+        parent_joint,
+        has_children,
+    })
 }
 
 /// One URDF joint as a link spec (lengths in mm).
-fn import_joint(j: &urdf_rs::Joint, name: String) -> Result<LinkSpec, String> {
+pub(super) fn import_joint(j: &urdf_rs::Joint, name: String) -> Result<LinkSpec, String> {
     use urdf_rs::JointType as T;
     let xyz = j.origin.xyz.0.map(|v| v / M_PER_MM);
     let rpy = j.origin.rpy.0;
@@ -324,12 +369,6 @@ fn import_joint(j: &urdf_rs::Joint, name: String) -> Result<LinkSpec, String> {
             ))
         }
     };
-    if let Some(m) = &j.mimic {
-        return Err(format!(
-            "mimics `{}`: mimic joints are not supported (every chain joint is independent)",
-            m.joint
-        ));
-    }
     let axis = Vector3::from(j.axis.xyz.0);
     if !axis.iter().all(|v| v.is_finite()) || axis.norm() < 1e-12 {
         return Err(format!(
@@ -401,7 +440,7 @@ fn import_joint(j: &urdf_rs::Joint, name: String) -> Result<LinkSpec, String> {
     })
 }
 
-fn identity_frame(name: &str) -> LinkSpec {
+pub(super) fn identity_frame(name: &str) -> LinkSpec {
     LinkSpec {
         name: name.into(),
         geometry: LinkGeometry::frame6([0.0; 3], [0.0; 3]),
@@ -410,7 +449,7 @@ fn identity_frame(name: &str) -> LinkSpec {
 }
 
 /// A URDF name as an armcal frame name: `.` and `*` become `_`; empty becomes `joint`.
-fn sanitise(name: &str) -> String {
+pub(super) fn sanitise(name: &str) -> String {
     let s: String = name
         .chars()
         .map(|c| if c == '.' || c == '*' { '_' } else { c })

@@ -19,8 +19,10 @@
 //! shape of every armcal robot. [`read_urdf_with_collisions`] also returns the chain links'
 //! `<collision>` shapes (box, cylinder, capsule, sphere; a mesh by its file name, which armcal
 //! does not read), each on the chain frame its link moves with; the cell bounds them by
-//! capsules (`robots/bounding.rs`). Inertia, visual geometry, mimic targets off the
-//! chain, and links off the chain are ignored.
+//! capsules (`robots/bounding.rs`). Inertia, visual geometry and links off the chain are
+//! ignored; a `<mimic>` joint on the chain is refused (a serial chain has no coupled
+//! joints): a URDF that branches or has mimic joints loads as a kinematic tree
+//! ([`read_urdf_tree`], module [`tree`]).
 //!
 //! **Export** ([`to_urdf`]) writes any chain, in any convention, as a URDF serial chain. Every
 //! link transform is split at its joint motion, `T_i(q) = A_i · J(q) · B_i`, with `A_i` the
@@ -40,12 +42,14 @@ pub mod depth;
 pub(crate) mod export;
 pub(crate) mod import;
 pub mod joint_corrections;
+pub(crate) mod tree;
 
 pub use export::to_urdf;
 pub use import::{
     from_urdf_robot, from_urdf_str, from_urdf_str_with_collisions, read_urdf,
     read_urdf_with_collisions, CollisionGeometry, CollisionShape,
 };
+pub use tree::{read_urdf_tree, tree_from_urdf_str, tree_to_urdf};
 
 use std::collections::HashSet;
 
