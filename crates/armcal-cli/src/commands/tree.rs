@@ -1,7 +1,6 @@
 //! `armcal identify` and `armcal simulate` of a tree cell (links that name a `parent`,
 //! coupled joints, targets that name a `link`): parse, one library call, print.
 
-use super::digits::fixed;
 use super::output::{station_files, with_note, NoteStyle, Outputs};
 use super::progress::Progress;
 use super::{export, identify, simulate};
@@ -177,7 +176,8 @@ pub fn export(a: &export::Args, est: &TreeEstimate) -> anyhow::Result<()> {
         ExportFormat::Urdf => NoteStyle::Xml,
         _ => NoteStyle::Hash,
     };
-    let note = exported.warnings.first().map(String::as_str);
+    let note = exported.warnings.join("; ");
+    let note = (!note.is_empty()).then_some(note.as_str());
     outputs.commit(&[(&a.out, &with_note(exported.content, note, style))])?;
     println!("{} of tree `{}` → {}", a.format, est.cell, a.out.display());
     Ok(())

@@ -2,11 +2,13 @@
 //! distance `max_q ‖p_a(q) − p_b(q)‖` between their tool positions over seeded random
 //! configurations within the joint limits. It is what a model file that cannot hold part of a
 //! calibration costs (the part left out: a non-geometric term, a tool frame), and what the
-//! corrections a conservative export drops cost.
+//! corrections a conservative export drops cost. A tree's alike, over every target.
 
 use crate::model::chain::{Model, ModelSpec};
 use crate::model::kinematics::tool_pose;
-use crate::model::sampling::random_configurations;
+use crate::model::sampling::{random_configurations, random_joint_values};
+use crate::model::tree::kinematics::{branch_kinematics, tree_observed_pose, TreeData};
+use crate::model::tree::{Tree, TreeSpec};
 use crate::Error;
 use serde::{Deserialize, Serialize};
 
@@ -81,6 +83,48 @@ pub(crate) fn without_nongeometric(
         rigid,
         Some(NotHeld {
             what: format!("the non-geometric terms ({})", terms.join(", ")),
+            tcp_shift_mm: shift,
+        }),
+    ))
+}
+
+/// The tree `spec` without its joint compliance, and what leaving it out costs: the
+/// largest distance between a target's positions in the two trees over
+/// [`SHIFT_CONFIGURATIONS`] random configurations of the tree's joints (seed
+/// [`SHIFT_SEED`]), every target; `None` when it has no compliance.
+pub(crate) fn tree_without_compliance(
+    spec: &TreeSpec,
+) -> Result<(TreeSpec, Option<NotHeld>), Error> {
+    let mut rigid = spec.clone();
+    rigid.compliance = None;
+    let compliant = Tree::from_spec(spec)?;
+    let Some(compliance) = &compliant.compliance else {
+        return Ok((rigid, None));
+    };
+    let terms: Vec<&str> = compliance
+        .terms
+        .iter()
+        .map(|t| compliant.registry.get(t.param).name.as_str())
+        .collect();
+    let stiff = Tree::from_spec(&rigid)?;
+    let (pc, ps) = (compliant.nominal(), stiff.nominal());
+    let (mut dc, mut ds) = (TreeData::new(&compliant), TreeData::new(&stiff));
+    let mut shift = 0.0f64;
+    for q in random_joint_values(&compliant.joints, SHIFT_CONFIGURATIONS, SHIFT_SEED) {
+        for (t, &(_, b, _)) in compliant.targets.iter().enumerate() {
+            branch_kinematics(&compliant, &mut dc, b, &pc, &q);
+            branch_kinematics(&stiff, &mut ds, b, &ps, &q);
+            let (a, r) = (
+                tree_observed_pose(&compliant, &dc, t),
+                tree_observed_pose(&stiff, &ds, t),
+            );
+            shift = shift.max((a.trans - r.trans).norm());
+        }
+    }
+    Ok((
+        rigid,
+        Some(NotHeld {
+            what: format!("the joint compliance ({})", terms.join(", ")),
             tcp_shift_mm: shift,
         }),
     ))

@@ -8,6 +8,7 @@ use crate::cell::export::{ExportFormat, Exported};
 use crate::cell::tree::{tree_cell_toml, TreeCell};
 use crate::identify::estimate::Acceptance;
 use crate::model::identifiability::Measurement;
+use crate::model::tcp_shift::tree_without_compliance;
 use crate::model::urdf::tree_to_urdf;
 use crate::model::Convention;
 use crate::Error;
@@ -15,7 +16,8 @@ use crate::Error;
 /// The tree of the estimate `est` in `format`: `urdf` (one URDF file of the whole tree; the
 /// instrument frame is the cell's and is not in it, a note says so) or `cell` (a tree cell at
 /// the estimate; with the `cell` it was identified in, its instrument noise and measurement
-/// type, else the measurement its targets imply). A fit that did not converge is refused
+/// type, else the measurement its targets imply). Neither holds a joint compliance: the
+/// tree is written rigid and a warning says how far a target moves without it. A fit that did not converge is refused
 /// unless `acceptance` accepts it; the other formats are a serial chain's and are refused.
 pub fn export_tree_estimate(
     est: &TreeEstimate,
@@ -40,9 +42,13 @@ pub fn export_tree_estimate(
     if let Some(c) = cell {
         est.params_for(&c.tree)?;
     }
+    // neither file holds a joint compliance: the tree is written rigid, and the warning
+    // says what that costs
+    let (rigid, not_held) = tree_without_compliance(&est.tree)?;
+    warnings.extend(not_held.map(|n| n.sentence()));
     let (content, notes) = match format {
         ExportFormat::Urdf => (
-            tree_to_urdf(&est.tree)?,
+            tree_to_urdf(&rigid)?,
             vec![format!(
                 "the instrument frame{} belongs to the cell and is not in the URDF; export \
                  `cell` to keep it",
@@ -69,7 +75,7 @@ pub fn export_tree_estimate(
             (
                 tree_cell_toml(
                     cell.map(|c| c.name.as_str()).unwrap_or(&est.cell),
-                    &est.tree,
+                    &rigid,
                     measurement,
                     cell.map(|c| &c.noise),
                 )?,

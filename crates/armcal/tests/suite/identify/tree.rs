@@ -5,6 +5,7 @@ use crate::common::*;
 use armcal::identify::{Candidate, NonGeometric};
 use armcal::model::identifiability::Measurement;
 use armcal::model::tree::kinematics::{branch_kinematics, tree_observed_pose, TreeData};
+use armcal::model::tree::Tree;
 use armcal::progress::Silent;
 use armcal::sim::{Perturbation, TruthRecord};
 use armcal::TreeEstimate;
@@ -201,6 +202,91 @@ fn a_noise_free_compliant_two_arm_tree_is_recovered_exactly() {
     for t in &est.targets {
         assert!(t.fitted.max < 1e-6, "{}: {}", t.target, t.fitted.max);
     }
+}
+
+/// A compliant tree's estimate exported: neither a URDF nor a tree cell holds a joint
+/// compliance, so both are written rigid and warn with every κ's name and how far a target
+/// moves without them; the cell read back is the tree at the estimate with κ = 0 (to 1e-9
+/// mm), and the stated shift is the compliance's (the largest over 200 other random
+/// configurations is of its size).
+#[test]
+fn a_compliant_tree_exports_rigid_and_says_what_that_costs() {
+    let cell = compliant_dual_arm("");
+    let sim = simulate_tree(
+        &cell.tree,
+        cell.measurement,
+        None,
+        &poses(&cell, 60, 3),
+        &[],
+        &Perturbation::default(),
+        7,
+    )
+    .unwrap();
+    let est = identify_tree(&cell, &sim.data, &IdentifySettings::default(), &mut Silent).unwrap();
+    assert!(est.solver.status.is_converged(), "{}", est.solver.status);
+    let acceptance = armcal::Acceptance {
+        accepted: false,
+        accept: "--accept-unconverged",
+        raise_iterations: "--max-iterations",
+    };
+    let export = |format| armcal::export_tree_estimate(&est, Some(&cell), format, &acceptance);
+    let as_cell = export(armcal::ExportFormat::Cell(
+        armcal::model::complete::LinkForm::AsGiven,
+    ))
+    .unwrap();
+    let as_urdf = export(armcal::ExportFormat::Urdf).unwrap();
+    let fitted = Tree::from_spec(&est.tree).unwrap();
+    let kappas: Vec<usize> = (0..fitted.registry.len())
+        .filter(|&i| fitted.registry.get(i).name.contains(".compliance."))
+        .collect();
+    assert!(!kappas.is_empty());
+    let warning = as_cell
+        .warnings
+        .iter()
+        .find(|w| w.starts_with("not held: the joint compliance ("))
+        .unwrap_or_else(|| panic!("{:?}", as_cell.warnings));
+    assert!(as_urdf.warnings.contains(warning), "{:?}", as_urdf.warnings);
+    for &k in &kappas {
+        assert!(warning.contains(&fitted.registry.get(k).name), "{warning}");
+    }
+    let stated: f64 = warning
+        .split("moves up to ")
+        .nth(1)
+        .and_then(|r| r.split(" mm").next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("{warning}"));
+    let reread = TreeCell::from_toml(&as_cell.content, "exported.toml").unwrap();
+    assert!(reread.tree.compliance.is_none());
+    let compliant = fitted.nominal();
+    let mut rigid = compliant.clone();
+    for &k in &kappas {
+        rigid[k] = 0.0;
+    }
+    let at = |tree: &Tree, params: &[f64], q: &[f64], t: usize| {
+        let mut data = TreeData::new(tree);
+        branch_kinematics(tree, &mut data, tree.targets[t].1, params, q);
+        tree_observed_pose(tree, &data, t).trans
+    };
+    let mut r = rng(12);
+    let mut largest = 0.0f64;
+    for _ in 0..200 {
+        let q: Vec<f64> = fitted
+            .joints
+            .iter()
+            .map(|j| r.random_range(j.lower..j.upper))
+            .collect();
+        for t in 0..fitted.targets.len() {
+            assert_eq!(reread.tree.targets[t].0, fitted.targets[t].0);
+            let p = at(&reread.tree, &reread.tree.nominal(), &q, t);
+            let d = (p - at(&fitted, &rigid, &q, t)).norm();
+            assert!(d < 1e-9, "{}: {d} mm", fitted.targets[t].0);
+            largest = largest.max((p - at(&fitted, &compliant, &q, t)).norm());
+        }
+    }
+    assert!(
+        largest > 1e-3 && largest <= 1.5 * stated && largest >= 0.3 * stated,
+        "stated {stated} mm, largest over 200 configurations {largest} mm"
+    );
 }
 
 /// The split-chain fit of the evidence: each arm fitted alone as its own chain with
