@@ -120,6 +120,8 @@ pub use sim::{perturbed_truth, predict, simulate, Perturbation};
 pub use identify::circle_point::record::{axes_record, AxesRecord};
 pub use identify::estimate::{ParameterEstimate, SolverReport};
 pub use identify::fit_checks::FitChecks;
+pub use identify::nongeometric_choice::NonGeometricChoice;
+pub use identify::nongeometric_gate::TermVerdict;
 pub use identify::pivot::{pivot_calibration, PivotSettings};
 pub use identify::prediction_sigma::{csv_with_sigmas, prediction_sigmas, RowSigma};
 pub use identify::uncertainty::TcpCovariance;

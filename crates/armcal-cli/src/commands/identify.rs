@@ -9,7 +9,8 @@ use super::progress::Progress;
 use anyhow::bail;
 use armcal::{
     identify, Candidate, ErrorStats, Estimate, FramesRefit, IdentifySettings, LmSettings, Loss,
-    Method, NonGeometric, ParameterEstimate, SolverReport, ToleranceSettings,
+    Method, NonGeometric, NonGeometricChoice, ParameterEstimate, SolverReport, TermVerdict,
+    ToleranceSettings,
 };
 use std::path::{Path, PathBuf};
 
@@ -197,8 +198,8 @@ pub fn print_summary(e: &Estimate) {
     if let Some(d) = &e.rank_deficit {
         println!("\nbelow the generic count: {d}");
     }
-    print_nongeometric(e);
-    print_choice(e);
+    print_nongeometric(&e.nongeometric);
+    print_choice(e.nongeometric_choice.as_ref());
     if !e.strong_correlations.is_empty() {
         println!("\nstrongly correlated pairs (|ρ| > 0.95):");
         for (a, b, r) in &e.strong_correlations {
@@ -432,8 +433,8 @@ fn print_stats_rows(rows: [(&str, &ErrorStats); 3]) {
 }
 
 /// `--nongeometric auto`: every candidate's cross-validated held-out errors and the choice.
-fn print_choice(e: &Estimate) {
-    let Some(c) = &e.nongeometric_choice else {
+pub(super) fn print_choice(choice: Option<&NonGeometricChoice>) {
+    let Some(c) = choice else {
         return;
     };
     println!(
@@ -466,8 +467,8 @@ non-geometric terms chosen by {}-fold cross-validation on the {} training config
 
 /// The gate of the non-geometric terms: per term estimate ± σ, its largest correlation with
 /// another parameter, the share of its effect the others cannot absorb, and the verdict.
-fn print_nongeometric(e: &Estimate) {
-    if e.nongeometric.is_empty() {
+pub(super) fn print_nongeometric(verdicts: &[TermVerdict]) {
+    if verdicts.is_empty() {
         return;
     }
     println!(
@@ -475,7 +476,7 @@ fn print_nongeometric(e: &Estimate) {
 non-geometric terms (compliance κ in µrad per m of lever, periodic amplitudes in arcsec):"
     );
     println!("  term                        estimate ± σ          max |ρ| with another    not absorbed   verdict");
-    for v in &e.nongeometric {
+    for v in verdicts {
         let rho = v
             .most_correlated
             .as_ref()

@@ -90,6 +90,8 @@ fn print_tree_summary(e: &TreeEstimate) {
     if !e.validation.is_empty() {
         println!("held out: {}", e.validation);
     }
+    identify::print_nongeometric(&e.nongeometric);
+    identify::print_choice(e.nongeometric_choice.as_ref());
 }
 
 /// `armcal simulate --cell <tree cell>`: the tree measured at the poses, each pose at every

@@ -324,7 +324,8 @@ fn the_transcript_matcher_checks_what_it_should() {
 
 /// The joint names the non-geometric examples of README and the guide use (`compliance = ["q2", "q3"]`,
 /// `periodic = { joints = [...] }`, `"q2.compliance.elbow"`) are joints of a built-in robot:
-/// a user who copies an example into a cell of a built-in robot gets a cell that loads.
+/// a user who copies an example into a cell of a built-in robot gets a cell that loads (a
+/// tree's examples: joints of a shipped tree cell, `examples/*tree-cell.toml`).
 #[test]
 fn readme_joint_names_are_real_joints() {
     let src = root().join("docs/src");
@@ -336,11 +337,20 @@ fn readme_joint_names_are_real_joints() {
         let text = std::fs::read_to_string(src.join(&page)).expect("a guide page");
         documents.push((format!("docs/src/{page}"), text));
     }
-    let joints: Vec<String> = armcal::Cell::robots()
+    let mut joints: Vec<String> = armcal::Cell::robots()
         .into_iter()
         .flat_map(|(name, _)| armcal::robots::robot(&name).expect("built-in").spec.links)
         .filter_map(|l| l.joint.map(|j| j.name))
         .collect();
+    // a tree's examples name the joints of the shipped tree cells (`examples/*tree-cell.toml`)
+    for entry in std::fs::read_dir(root().join("examples")).expect("examples/") {
+        let path = entry.expect("an examples/ entry").path();
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        if name.ends_with("tree-cell.toml") {
+            let cell = armcal::TreeCell::from_file(&path).expect("a shipped tree cell loads");
+            joints.extend(cell.tree.joints.iter().map(|j| j.name.clone()));
+        }
+    }
     // The quoted names inside `compliance = [...]` and `joints = [...]`, and the joint of every
     // `"<joint>.compliance.…"` / `<joint>.periodic.…` term.
     let mut named = Vec::new();

@@ -180,27 +180,6 @@ pub(super) fn choose(
     folds: usize,
     observer: &mut dyn Observer,
 ) -> Result<NonGeometricChoice, Error> {
-    let n = train.configurations.len();
-    if folds < 2 || folds > n {
-        return Err(Error::Input(format!(
-            "{folds} cross-validation folds of {n} training configurations: give 2 to {n}"
-        )));
-    }
-    let mut order: Vec<usize> = (0..n).collect();
-    order.shuffle(&mut ChaCha8Rng::seed_from_u64(opts.seed));
-    let fold_of = |f: usize| -> (Vec<usize>, Vec<usize>) {
-        let (mut fit, mut held): (Vec<usize>, Vec<usize>) = (Vec::new(), Vec::new());
-        for (k, &c) in order.iter().enumerate() {
-            if k % folds == f {
-                held.push(c)
-            } else {
-                fit.push(c)
-            }
-        }
-        fit.sort_unstable();
-        held.sort_unstable();
-        (fit, held)
-    };
     let inner = IdentifySettings {
         holdout: 0.0,
         test: None,
@@ -208,16 +187,11 @@ pub(super) fn choose(
         ..opts.clone()
     };
     let offered = Candidate::offered(&cell.model);
+    let folds_of = deal_folds(train, folds, opts.seed)?;
     observer.start(
         "cross-validating the non-geometric terms",
         Some(offered.len() * folds),
     );
-    let folds_of: Vec<(Dataset, Dataset)> = (0..folds)
-        .map(|f| {
-            let (fit_idx, held_idx) = fold_of(f);
-            (train.subset(&fit_idx), train.subset(&held_idx))
-        })
-        .collect();
     // Every candidate's term count and fold errors; the candidates and their folds run in
     // parallel.
     let fitted: Vec<(usize, Vec<Vec<f64>>)> = offered
@@ -239,6 +213,57 @@ pub(super) fn choose(
             Ok((terms, errors))
         })
         .collect::<Result<_, Error>>()?;
+    Ok(scored(
+        &offered,
+        fitted,
+        train.configurations.len(),
+        observer,
+    ))
+}
+
+/// The `folds` folds of `train`'s configurations, each (the data fitted, the data held out):
+/// the configurations shuffled (seed `seed`) and dealt in turn.
+pub(super) fn deal_folds(
+    train: &Dataset,
+    folds: usize,
+    seed: u64,
+) -> Result<Vec<(Dataset, Dataset)>, Error> {
+    let n = train.configurations.len();
+    if folds < 2 || folds > n {
+        return Err(Error::Input(format!(
+            "{folds} cross-validation folds of {n} training configurations: give 2 to {n}"
+        )));
+    }
+    let mut order: Vec<usize> = (0..n).collect();
+    order.shuffle(&mut ChaCha8Rng::seed_from_u64(seed));
+    Ok((0..folds)
+        .map(|f| {
+            let (mut fit, mut held): (Vec<usize>, Vec<usize>) = (Vec::new(), Vec::new());
+            for (k, &c) in order.iter().enumerate() {
+                if k % folds == f {
+                    held.push(c)
+                } else {
+                    fit.push(c)
+                }
+            }
+            fit.sort_unstable();
+            held.sort_unstable();
+            (train.subset(&fit), train.subset(&held))
+        })
+        .collect())
+}
+
+/// Scores each candidate of `offered` from its (term count, held-out position errors of
+/// each fold) in `fitted`, and chooses one by the one-standard-error rule (module notes);
+/// `configurations` were dealt into the folds. Steps `observer` once per fold (its `start`
+/// is the caller's).
+pub(super) fn scored(
+    offered: &[Candidate],
+    fitted: Vec<(usize, Vec<Vec<f64>>)>,
+    configurations: usize,
+    observer: &mut dyn Observer,
+) -> NonGeometricChoice {
+    let folds = fitted.first().map_or(0, |(_, f)| f.len());
     let mut candidates = Vec::new();
     for (&candidate, (terms, fold_errors)) in offered.iter().zip(fitted) {
         let mut errors = Vec::new();
@@ -270,9 +295,9 @@ pub(super) fn choose(
         .min_by_key(|c| c.terms)
         .expect("the best is within its own bound")
         .candidate;
-    Ok(NonGeometricChoice {
+    NonGeometricChoice {
         folds,
-        configurations: n,
+        configurations,
         rule: format!(
             "the candidate with the fewest terms whose cross-validated RMS is within one \
              standard error of the best ({:.4} + {:.4} mm)",
@@ -280,5 +305,5 @@ pub(super) fn choose(
         ),
         candidates,
         chosen,
-    })
+    }
 }

@@ -17,17 +17,18 @@
 //! ([`crate::identify::nongeometric_gate`]) judges each: a term that is not separable from
 //! the others on these data is dropped, named with its reason, and the tree fitted again.
 //!
-//! What a tree fit does not have yet (the serial fit's): periodic joint errors,
-//! `--nongeometric auto`, priors, instrument stations, payloads, distance measurements, the
+//! `--nongeometric auto` cross-validates the kinematic tree against the compliant one as a
+//! serial fit's candidates are ([`fit`]). What a tree fit does not have yet (the serial
+//! fit's): periodic joint errors, priors, instrument stations, payloads, distance measurements, the
 //! Kalman filter, the model floor and the fit checks; each is refused by name.
 
 use super::lm::minimise;
-use super::nongeometric_gate::{gate, TermVerdict};
-use super::robust::{robust_minimise, Outlier};
+use super::nongeometric_gate::TermVerdict;
+use super::robust::Outlier;
 use super::solver::LeastSquares;
 use super::uncertainty::{parameter_uncertainty, ParameterUncertainty};
 use super::{holdout_split, IdentifySettings, Method, ParameterEstimate, SolverReport};
-use super::{Candidate, NonGeometric};
+use super::{Candidate, NonGeometric, NonGeometricChoice};
 use crate::accuracy::ErrorStats;
 use crate::cell::tree::TreeCell;
 use crate::measure::{Dataset, MeasurementKind};
@@ -44,8 +45,10 @@ use nalgebra::{DMatrix, Matrix3};
 use serde::{Deserialize, Serialize};
 
 mod export;
+mod fit;
 mod problem;
 pub use export::export_tree_estimate;
+use fit::{choose_tree, fit_tree_free_set, TreeFit};
 pub(crate) use problem::TreeProblem;
 
 /// The fit of one target (one branch's reflector) in a tree estimate: how well the model
@@ -96,6 +99,9 @@ pub struct TreeEstimate {
     /// The identifiability gate of the compliance terms fitted (empty for a rigid tree).
     #[serde(default)]
     pub nongeometric: Vec<TermVerdict>,
+    /// `--nongeometric auto`: every candidate's cross-validated score and the choice.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nongeometric_choice: Option<NonGeometricChoice>,
     /// The fit per target.
     pub targets: Vec<TreeTargetFit>,
     /// What held-out validation was done (empty: none).
@@ -285,7 +291,7 @@ fn data_measurement(data: &Dataset) -> Measurement {
 /// fitted again; `--nongeometric none` fits the rigid tree.
 ///
 /// Settings a tree fit does not take yet are refused by name: `method` Kalman, a `refit`, a
-/// warm `start`, periodic terms (`--nongeometric periodic`, `both`), `--nongeometric auto`,
+/// warm `start`, periodic terms (`--nongeometric periodic`, `both`),
 /// the sign diagnosis.
 pub fn identify_tree(
     cell: &TreeCell,
@@ -306,10 +312,6 @@ pub fn identify_tree(
                 opts.nongeometric,
                 NonGeometric::Only(Candidate::Periodic | Candidate::Both)
             ),
-        ),
-        (
-            "the cross-validated choice of non-geometric terms (--nongeometric auto)",
-            matches!(opts.nongeometric, NonGeometric::Auto { .. }),
         ),
         (
             "the joint sign diagnosis (--diagnose-signs)",
@@ -342,59 +344,40 @@ pub fn identify_tree(
         minimise(&problem, &nominal, lm, observer)?
     };
     observer.finish();
-    // 2. the tree's identifiable set at the frames-first estimate, fitted; the compliance
-    // terms gated, the least separable dropped and the tree fitted again while one is not
-    let rigid = opts.nongeometric == NonGeometric::Only(Candidate::Kinematic);
-    let is_kappa = |i: usize| {
-        tree.compliance
-            .as_ref()
-            .is_some_and(|c| c.terms.iter().any(|t| t.param == i))
-    };
-    let mut dropped: Vec<(usize, String)> = Vec::new();
-    let (problem, sol, outliers, report, nongeometric) = loop {
-        let (free, report) = identifiable_at(tree, &frames_fit.params, &train, measurement, |i| {
-            tree.registry.get(i).status.is_free()
-                && !(is_kappa(i) && (rigid || dropped.iter().any(|d| d.0 == i)))
-        })?;
-        let mut problem = TreeProblem::new(tree, &train, &cell.noise, free)?;
-        check_determined(&problem)?;
-        let (sol, outliers) = match opts.robust {
-            Some(loss) => {
-                let r = robust_minimise(&mut problem, &frames_fit.params, loss, lm, observer)?;
-                (r.solution, r.outliers)
-            }
-            None => {
-                let s = match opts.method {
-                    Method::GaussNewton => super::gauss_newton::minimise(
-                        &problem,
-                        &frames_fit.params,
-                        &lm.tolerances,
-                        observer,
-                    )?,
-                    _ => minimise(&problem, &frames_fit.params, lm, observer)?,
-                };
-                (s, Vec::new())
-            }
-        };
-        let unc = parameter_uncertainty(&sol.jacobian, &sol.residual, &problem.free_names())?;
-        let verdicts = gate(
-            &tree.registry,
-            is_kappa,
-            &problem.free,
-            &sol.jacobian,
-            &unc.covariance,
-            &sol.params,
-        );
-        let worst = verdicts
-            .iter()
-            .filter(|v| !v.separable)
-            .rev()
-            .min_by(|a, b| a.unabsorbed.total_cmp(&b.unabsorbed));
-        match worst {
-            Some(v) => dropped.push((tree.registry.require(&v.name)?, v.reason())),
-            None => break (problem, sol, outliers, report, verdicts),
+    // 2. the non-geometric model (the cell's, none, or cross-validated), then the tree's
+    // identifiable set at the frames-first estimate fitted with it
+    let (rigid, nongeometric_choice) = match opts.nongeometric {
+        NonGeometric::Auto { folds } => {
+            let choice = choose_tree(
+                cell,
+                &train,
+                &frames_fit.params,
+                measurement,
+                opts,
+                folds,
+                observer,
+            )?;
+            (choice.chosen == Candidate::Kinematic, Some(choice))
         }
+        NonGeometric::Only(Candidate::Kinematic) => (true, None),
+        _ => (false, None),
     };
+    let TreeFit {
+        problem,
+        solution: sol,
+        outliers,
+        report,
+        verdicts: nongeometric,
+        dropped,
+    } = fit_tree_free_set(
+        cell,
+        &train,
+        &frames_fit.params,
+        measurement,
+        rigid,
+        opts,
+        observer,
+    )?;
     let names = problem.free_names();
     let unc = parameter_uncertainty(&sol.jacobian, &sol.residual, &names)?;
     // fit per target: the fitted rows, and the held-out rows with the estimate and with the
@@ -470,6 +453,7 @@ pub fn identify_tree(
         uncertainty: unc,
         outliers,
         nongeometric,
+        nongeometric_choice,
         targets,
         validation,
         measurements: train.measurements.len(),

@@ -289,6 +289,70 @@ fn a_compliant_tree_exports_rigid_and_says_what_that_costs() {
     );
 }
 
+/// `--nongeometric auto` on a tree: 5-fold cross-validation between the kinematic tree and
+/// the compliant one keeps the compliance where the truth has it (κ drawn with σ = 1000
+/// µrad/m) and the kinematic tree where it has none (the one-standard-error rule), and the
+/// estimate records both candidates' scores with the fit of the one chosen.
+#[test]
+fn auto_on_a_tree_keeps_the_compliance_only_where_the_data_need_it() {
+    let cell = compliant_dual_arm("");
+    let opts = IdentifySettings {
+        nongeometric: NonGeometric::Auto { folds: 5 },
+        ..IdentifySettings::default()
+    };
+    for (compliance, expected) in [(1e-6, Candidate::Compliance), (0.0, Candidate::Kinematic)] {
+        let truth = Perturbation {
+            compliance,
+            ..Perturbation::default()
+        };
+        let sim = simulate_tree(
+            &cell.tree,
+            cell.measurement,
+            Some(&cell.noise),
+            &poses(&cell, 60, 31),
+            &[],
+            &truth,
+            13,
+        )
+        .unwrap();
+        let est = identify_tree(&cell, &sim.data, &opts, &mut Silent).unwrap();
+        assert!(est.solver.status.is_converged(), "{}", est.solver.status);
+        let choice = est
+            .nongeometric_choice
+            .as_ref()
+            .expect("the choice is recorded");
+        let scores: Vec<String> = choice
+            .candidates
+            .iter()
+            .map(|c| {
+                format!(
+                    "{}: {:.4} ± {:.4} mm",
+                    c.candidate.words(),
+                    c.held_out.rms,
+                    c.standard_error
+                )
+            })
+            .collect();
+        assert_eq!(choice.candidates.len(), 2, "{scores:?}");
+        assert_eq!(choice.chosen, expected, "κ σ {compliance}: {scores:?}");
+        let kappas = est
+            .free
+            .iter()
+            .filter(|n| n.contains(".compliance."))
+            .count();
+        assert_eq!(
+            kappas > 0,
+            expected == Candidate::Compliance,
+            "{:?}",
+            est.free
+        );
+        assert_eq!(
+            est.nongeometric.is_empty(),
+            expected == Candidate::Kinematic
+        );
+    }
+}
+
 /// The split-chain fit of the evidence: each arm fitted alone as its own chain with
 /// its own torso compliance cannot see the other arm's weight on the torso, so on held-out
 /// poses of the same compliant truth (both arms moving) it is measurably worse than the
@@ -511,7 +575,7 @@ fn tree_data_name_their_target_and_a_wrong_one_says_file_line_and_field() {
 
 /// A tree cell's compliance errors name the file, line and field: an unknown or coupled
 /// joint, a joint with no gravity torque (the torso axis along gravity), gravity without
-/// compliance; `--nongeometric auto` and `periodic` are refused by name and `none` fits
+/// compliance; `--nongeometric periodic` and `both` are refused by name and `none` fits
 /// the rigid tree.
 #[test]
 fn a_tree_cell_with_compliance_says_file_line_and_field_of_what_it_cannot_model() {
@@ -557,8 +621,8 @@ fn a_tree_cell_with_compliance_says_file_line_and_field_of_what_it_cannot_model(
     )
     .unwrap();
     for (asked, refused) in [
-        (NonGeometric::Auto { folds: 5 }, "--nongeometric auto"),
         (NonGeometric::Only(Candidate::Periodic), "periodic"),
+        (NonGeometric::Only(Candidate::Both), "periodic"),
     ] {
         let opts = IdentifySettings {
             nongeometric: asked,
