@@ -39,93 +39,93 @@ const BOX_MARGIN: f64 = 200.0;
 
 /// A robot capsule's fixed data: the chain frame it moves with and its radius (mm).
 #[derive(Serialize)]
-struct RobotCapsule {
-    frame: String,
+pub(super) struct RobotCapsule {
+    pub(super) frame: String,
     /// `frame#k`: the k-th capsule on that frame, as the constraint names call it.
-    label: String,
-    r: f64,
+    pub(super) label: String,
+    pub(super) r: f64,
 }
 
 /// An obstacle capsule in world coordinates (mm).
 #[derive(Serialize)]
-struct ObstacleCapsule {
-    name: String,
-    a: [f64; 3],
-    b: [f64; 3],
-    r: f64,
+pub(super) struct ObstacleCapsule {
+    pub(super) name: String,
+    pub(super) a: [f64; 3],
+    pub(super) b: [f64; 3],
+    pub(super) r: f64,
 }
 
 /// The boundary of a half-space, clipped to the scene box; or a face of a box obstacle.
 #[derive(Serialize)]
-struct Plane {
-    name: String,
+pub(super) struct Plane {
+    pub(super) name: String,
     /// Unit normal, pointing into the free side.
-    normal: [f64; 3],
+    pub(super) normal: [f64; 3],
     /// Polygon corners in order (mm).
-    corners: Vec<[f64; 3]>,
+    pub(super) corners: Vec<[f64; 3]>,
 }
 
 /// A joint's name and the unit its values are shown in.
 #[derive(Serialize)]
-struct JointLabel {
-    name: String,
-    unit: &'static str,
+pub(super) struct JointLabel {
+    pub(super) name: String,
+    pub(super) unit: &'static str,
 }
 
 /// One pose of a design in world coordinates.
 #[derive(Serialize)]
-struct PoseView {
+pub(super) struct PoseView {
     /// Joint values in display units (deg, mm), rounded to 0.01.
-    q: Vec<f64>,
+    pub(super) q: Vec<f64>,
     /// Robot capsule endpoints `[ax, ay, az, bx, by, bz]` (mm), in the order of `robot`.
-    caps: Vec<[f64; 6]>,
+    pub(super) caps: Vec<[f64; 6]>,
     /// World position of each target (mm).
-    targets: Vec<[f64; 3]>,
+    pub(super) targets: Vec<[f64; 3]>,
     /// Within the joint limits and every constraint ≥ 0.
-    ok: bool,
+    pub(super) ok: bool,
     /// Smallest clearance over the distance constraints (mm) and the constraint's name.
-    clearance: Option<(f64, String)>,
+    pub(super) clearance: Option<(f64, String)>,
     /// Angle between the reflector's z axis and the beam to the tracker (deg, paper eq. 4).
-    incidence: Option<f64>,
+    pub(super) incidence: Option<f64>,
     /// Joints outside their limits and violated constraints.
-    violations: Vec<String>,
+    pub(super) violations: Vec<String>,
     /// Constraints met but closer than the cell's `[design]` asks (a distance under
     /// `clearance_mm`, a joint within `joint_margin_deg` of a limit, …), each with its value.
-    below_required: Vec<String>,
+    pub(super) below_required: Vec<String>,
     /// Indices (into `robot`) of the capsules named in violated constraints.
-    hit: Vec<usize>,
+    pub(super) hit: Vec<usize>,
     /// Names of the obstacles and half-spaces named in violated constraints.
-    hit_obstacles: Vec<String>,
+    pub(super) hit_obstacles: Vec<String>,
 }
 
 #[derive(Serialize)]
-struct DesignView {
-    name: String,
-    poses: Vec<PoseView>,
+pub(super) struct DesignView {
+    pub(super) name: String,
+    pub(super) poses: Vec<PoseView>,
 }
 
 /// Everything the script draws.
 #[derive(Serialize)]
-struct Scene {
-    cell: String,
+pub(super) struct Scene {
+    pub(super) cell: String,
     /// Scene bounding box `[min, max]` (mm).
-    bounds: [[f64; 3]; 2],
+    pub(super) bounds: [[f64; 3]; 2],
     /// What the initial view frames: the robot at every pose, the targets, the tracker and
     /// the foot of its plumb line on the ground (mm).
-    focus: [[f64; 3]; 2],
+    pub(super) focus: [[f64; 3]; 2],
     /// Height of the ground grid: the offset of a half-space with normal +z (the floor), else
     /// the bottom of the box (mm).
-    ground: f64,
-    robot: Vec<RobotCapsule>,
-    obstacles: Vec<ObstacleCapsule>,
+    pub(super) ground: f64,
+    pub(super) robot: Vec<RobotCapsule>,
+    pub(super) obstacles: Vec<ObstacleCapsule>,
     /// Box obstacles: each one's six faces (outward normals), named for the box.
-    boxes: Vec<Vec<Plane>>,
-    planes: Vec<Plane>,
+    pub(super) boxes: Vec<Vec<Plane>>,
+    pub(super) planes: Vec<Plane>,
     /// The instrument frame's origin (mm), if the cell has an instrument.
-    tracker: Option<[f64; 3]>,
-    target_names: Vec<String>,
-    joints: Vec<JointLabel>,
-    designs: Vec<DesignView>,
+    pub(super) tracker: Option<[f64; 3]>,
+    pub(super) target_names: Vec<String>,
+    pub(super) joints: Vec<JointLabel>,
+    pub(super) designs: Vec<DesignView>,
 }
 
 /// The HTML fragment of the 3D view: a `<section class="cell-view">` with a heading, a
@@ -138,8 +138,21 @@ struct Scene {
 /// bytes and different views on one page get different ids; the script finds its elements
 /// through its own section, never through global ids.
 pub fn cell_view_section(cell: &Cell, designs: &[(&str, &[Vec<f64>])]) -> Result<String, Error> {
-    let scene = scene(cell, designs)?;
-    let json = serde_json::to_string(&scene)
+    view_section(
+        &scene(cell, designs)?,
+        &format!("3D view of the cell: {}", cell.name),
+        "Robot capsules (orange), obstacles (blue-grey capsules and boxes), wall and \
+         floor (translucent), tracker and laser beam to the reflector (green; red when the \
+         pose violates a constraint, with the capsules involved). Drag to orbit, wheel to \
+         zoom, arrow keys or the slider to step through the poses.",
+    )
+}
+
+/// The HTML fragment of a 3D view of `scene` (its designs' poses steppable) under `heading`,
+/// with `help` below it (plain text): what [`cell_view_section`] writes for a cell, and
+/// [`super::tree`] for a kinematic tree.
+pub(super) fn view_section(scene: &Scene, heading: &str, help: &str) -> Result<String, Error> {
+    let json = serde_json::to_string(scene)
         .map_err(|e| Error::Output(format!("3D view: cannot serialise the scene: {e}")))?;
     // JSON can only hold `<` inside strings, where `\u003c` means the same; this keeps a
     // `</script>` in a name from ending the element.
@@ -147,23 +160,21 @@ pub fn cell_view_section(cell: &Cell, designs: &[(&str, &[Vec<f64>])]) -> Result
     let id = format!("cell-view-{:012x}", fnv1a(json.as_bytes()) >> 16);
     let mut html = String::with_capacity(json.len() + SCRIPT.len() + 2048);
     html.push_str(&format!(
-        "<section class=\"cell-view\" id=\"{id}\">\n<h2>3D view of the cell: {}</h2>\n",
-        escape(&cell.name)
+        "<section class=\"cell-view\" id=\"{id}\">\n<h2>{}</h2>\n<p class=\"cell-view-help\">{}</p>\n",
+        escape(heading),
+        escape(help)
     ));
-    html.push_str(
-        "<p class=\"cell-view-help\">Robot capsules (orange), obstacles (blue-grey capsules and boxes), wall and \
-         floor (translucent), tracker and laser beam to the reflector (green; red when the \
-         pose violates a constraint, with the capsules involved). Drag to orbit, wheel to \
-         zoom, arrow keys or the slider to step through the poses.</p>\n",
-    );
     html.push_str("<div class=\"cell-view-controls\">\n");
-    if designs.len() > 1 {
+    if scene.designs.len() > 1 {
         html.push_str(&format!(
             "<label for=\"{id}-design\">design</label> <select id=\"{id}-design\" \
              class=\"cell-view-design\">"
         ));
-        for (k, (name, _)) in designs.iter().enumerate() {
-            html.push_str(&format!("<option value=\"{k}\">{}</option>", escape(name)));
+        for (k, d) in scene.designs.iter().enumerate() {
+            html.push_str(&format!(
+                "<option value=\"{k}\">{}</option>",
+                escape(&d.name)
+            ));
         }
         html.push_str("</select>\n");
     }
@@ -511,9 +522,9 @@ fn box_faces(name: &str, b: &crate::geometry::Cuboid) -> Vec<Plane> {
 
 /// An axis-aligned box that grows to hold points and spheres.
 #[derive(Clone)]
-struct Bounds {
-    min: Vector3<f64>,
-    max: Vector3<f64>,
+pub(super) struct Bounds {
+    pub(super) min: Vector3<f64>,
+    pub(super) max: Vector3<f64>,
 }
 
 impl Default for Bounds {
@@ -526,17 +537,17 @@ impl Default for Bounds {
 }
 
 impl Bounds {
-    fn add(&mut self, p: &Vector3<f64>, radius: f64) {
+    pub(super) fn add(&mut self, p: &Vector3<f64>, radius: f64) {
         let r = Vector3::repeat(radius);
         self.min = self.min.inf(&(p - r));
         self.max = self.max.sup(&(p + r));
     }
 
-    fn center(&self) -> Vector3<f64> {
+    pub(super) fn center(&self) -> Vector3<f64> {
         0.5 * (self.min + self.max)
     }
 
-    fn pad(&mut self, margin: f64) {
+    pub(super) fn pad(&mut self, margin: f64) {
         self.min -= Vector3::repeat(margin);
         self.max += Vector3::repeat(margin);
     }
@@ -598,12 +609,12 @@ impl Bounds {
 }
 
 /// Rounds to `1/scale` and turns −0 into 0.
-fn round_to(x: f64, scale: f64) -> f64 {
+pub(super) fn round_to(x: f64, scale: f64) -> f64 {
     (x * scale).round() / scale + 0.0
 }
 
 /// A length rounded to 0.1 mm.
-fn mm(x: f64) -> f64 {
+pub(super) fn mm(x: f64) -> f64 {
     round_to(x, 10.0)
 }
 

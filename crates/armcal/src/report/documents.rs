@@ -7,6 +7,7 @@
 use crate::campaign::drift::DriftCheck;
 use crate::campaign::CampaignState;
 use crate::design::DesignRecord;
+use crate::identify::tree::TreeEstimate;
 use crate::identify::Estimate;
 use crate::sim::TruthRecord;
 use crate::study::demo::DemoSummary;
@@ -31,6 +32,8 @@ pub enum Document {
     Campaign(Box<CampaignState>),
     /// A drift check (`check.json` of `armcal check`).
     Check(Box<DriftCheck>),
+    /// The estimate of a kinematic tree (`armcal identify` of a tree cell).
+    TreeEstimate(Box<TreeEstimate>),
 }
 
 const EXPECTED: &str = "expected an armcal estimate (from `armcal identify`), design (the .json \
@@ -55,8 +58,10 @@ impl Document {
             let what = what.to_string();
             move |e: serde_json::Error| fail(format!("looks like an armcal {what}, but: {e}"))
         };
-        if let Some(refusal) = crate::identify::tree::tree_estimate_refusal(text) {
-            return Err(fail(refusal));
+        if obj.get("kind").and_then(|k| k.as_str()) == Some("tree-estimate") {
+            return Ok(Document::TreeEstimate(Box::new(
+                serde_json::from_value(value).map_err(read("tree estimate"))?,
+            )));
         }
         if let Some(study) = obj.get("study") {
             return match study.as_str() {
@@ -140,6 +145,7 @@ impl Document {
             Document::Truth(_) => "truth",
             Document::Campaign(_) => "campaign",
             Document::Check(_) => "drift check",
+            Document::TreeEstimate(_) => "tree estimate",
         }
     }
 }

@@ -91,6 +91,12 @@ pub fn files_report(
             })?;
             notes.extend(usable.overridden.map(|o| format!("{}: {o}", f.display())));
         }
+        if let Document::TreeEstimate(e) = &document {
+            notes.extend(e.check_usable(acceptance).map_err(|e| Error::File {
+                file: f.display().to_string(),
+                message: e.to_string(),
+            })?);
+        }
         let stem = f
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())

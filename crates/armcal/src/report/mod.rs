@@ -4,7 +4,7 @@
 //! [`documents`] recognises armcal's JSON results; the page opens with the [`verdict`]
 //! panels, then one module per kind builds its section ([`estimate`] with
 //! [`parameter_view`] and [`held_out`], [`design`], [`study`], [`tcp`] for the Figure 7
-//! comparison, [`demo_summary`] and [`compensation`]); [`figures`] and
+//! comparison, [`demo_summary`] and [`compensation`], [`tree`] for a tree's estimate); [`figures`] and
 //! [`parameter_charts`] draw plain data to SVG; [`html`] assembles the page. A design (and
 //! the estimate made from it) keeps one colour in every figure ([`design_key`]).
 
@@ -28,6 +28,7 @@ pub mod parameter_view;
 pub(crate) mod study;
 pub(crate) mod tcp;
 pub(crate) mod temperature;
+pub(crate) mod tree;
 pub mod verdict;
 
 pub use documents::Document;
@@ -110,6 +111,11 @@ fn inputs_section(inputs: &[Input], notes: &[String]) -> Section {
                     escape(&c.cell),
                     c.poses,
                     escape(c.verdict.words())
+                ),
+                Document::TreeEstimate(e) => format!(
+                    "tree cell <em>{}</em>, data {}",
+                    escape(&e.cell),
+                    escape(&e.data)
                 ),
             };
             vec![
@@ -241,7 +247,8 @@ pub fn page(c: &ReportContent) -> Result<Page, Error> {
             | Document::Demo(_)
             | Document::Truth(_)
             | Document::Campaign(_)
-            | Document::Check(_) => (&[], false, &None),
+            | Document::Check(_)
+            | Document::TreeEstimate(_) => (&[], false, &None),
         };
         // every working pose, not only the first
         for t in tcp {
@@ -286,6 +293,14 @@ pub fn page(c: &ReportContent) -> Result<Page, Error> {
             parameter_view::parameter_blocks(&mut section, &i.label, e, truth, fill)
                 .map_err(of(i))?;
             sections.push(section);
+        }
+    }
+    for (k, i) in c.inputs.iter().enumerate() {
+        if let Document::TreeEstimate(e) = &i.document {
+            sections.push(
+                tree::tree_estimate_section(&format!("tree-estimate-{}", k + 1), &i.label, e)
+                    .map_err(of(i))?,
+            );
         }
     }
     for (k, i) in c.inputs.iter().enumerate() {

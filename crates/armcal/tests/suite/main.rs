@@ -98,6 +98,7 @@ mod report {
     mod cell_view;
     mod decimation;
     mod html;
+    mod tree;
     mod verdict;
 }
 mod repository {

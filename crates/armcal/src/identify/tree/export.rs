@@ -6,7 +6,7 @@
 use super::TreeEstimate;
 use crate::cell::export::{ExportFormat, Exported};
 use crate::cell::tree::{tree_cell_toml, TreeCell};
-use crate::identify::estimate::Acceptance;
+use crate::identify::Acceptance;
 use crate::model::identifiability::Measurement;
 use crate::model::tcp_shift::tree_without_compliance;
 use crate::model::urdf::tree_to_urdf;
@@ -25,20 +25,7 @@ pub fn export_tree_estimate(
     format: ExportFormat,
     acceptance: &Acceptance,
 ) -> Result<Exported, Error> {
-    let mut warnings = Vec::new();
-    if !est.solver.status.is_converged() {
-        if !acceptance.accepted {
-            return Err(Error::Input(format!(
-                "the fit of tree `{}` did not converge ({}): its estimate is no calibration; \
-                 refit (raise the iteration limit with {}), or pass {} to export it anyway",
-                est.cell, est.solver.status, acceptance.raise_iterations, acceptance.accept
-            )));
-        }
-        warnings.push(format!(
-            "the fit did not converge ({}); exported because {} was given",
-            est.solver.status, acceptance.accept
-        ));
-    }
+    let mut warnings: Vec<String> = est.check_usable(acceptance)?.into_iter().collect();
     if let Some(c) = cell {
         est.params_for(&c.tree)?;
     }

@@ -27,7 +27,7 @@ use super::nongeometric_gate::TermVerdict;
 use super::robust::Outlier;
 use super::solver::LeastSquares;
 use super::uncertainty::{parameter_uncertainty, ParameterUncertainty};
-use super::{holdout_split, IdentifySettings, Method, ParameterEstimate, SolverReport};
+use super::{holdout_split, Acceptance, IdentifySettings, Method, ParameterEstimate, SolverReport};
 use super::{Candidate, NonGeometric, NonGeometricChoice};
 use crate::accuracy::ErrorStats;
 use crate::cell::tree::TreeCell;
@@ -113,6 +113,25 @@ pub struct TreeEstimate {
 }
 
 impl TreeEstimate {
+    /// Whether the estimate may be used (exported, reported): a fit that did not converge is
+    /// refused unless `acceptance` accepts it, and then the returned note says so.
+    pub fn check_usable(&self, acceptance: &Acceptance) -> Result<Option<String>, Error> {
+        if self.solver.status.is_converged() {
+            return Ok(None);
+        }
+        if !acceptance.accepted {
+            return Err(Error::Input(format!(
+                "the fit of tree `{}` did not converge ({}): its estimate is no calibration; \
+                 refit (raise the iteration limit with {}), or pass {} to use it anyway",
+                self.cell, self.solver.status, acceptance.raise_iterations, acceptance.accept
+            )));
+        }
+        Ok(Some(format!(
+            "the fit did not converge ({}); used because {} was given",
+            self.solver.status, acceptance.accept
+        )))
+    }
+
     /// The record as JSON (keys in alphabetical order, [`crate::json`]).
     pub fn to_json(&self) -> Result<String, Error> {
         crate::json::sorted_pretty(self)
@@ -214,9 +233,10 @@ pub(crate) fn tree_estimate_refusal(text: &str) -> Option<String> {
     let value: serde_json::Value = serde_json::from_str(text).ok()?;
     (value.get("kind")?.as_str()? == "tree-estimate").then(|| {
         "the estimate of a kinematic tree (`armcal identify` of a tree cell): `armcal \
-         export` writes it as a URDF or a tree cell; predict, compensate, accuracy, report \
-         and the other commands that read an estimate take a serial chain's for now (issue \
-         32); the tree's parameters, σ and per-target fit are in this file"
+         export` writes it as a URDF or a tree cell and `armcal report` shows it; predict, \
+         compensate, accuracy and the other commands that read an estimate take a serial \
+         chain's for now (issue 32); the tree's parameters, σ and per-target fit are in this \
+         file"
             .to_string()
     })
 }
