@@ -474,7 +474,7 @@ impl ComplianceSpec {
     }
 
     /// Name of bending term `t`'s parameter: `<joint>.bending.<mass>`.
-    pub fn bending_name(term: &ComplianceTerm) -> String {
+    pub(crate) fn bending_name(term: &ComplianceTerm) -> String {
         format!("{}.bending.{}", term.joint, term.mass)
     }
 }
