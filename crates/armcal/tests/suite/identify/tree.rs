@@ -322,8 +322,8 @@ fn a_split_chain_fit_of_a_compliant_tree_is_worse_on_held_out_poses() {
 }
 
 /// The same with lateral compliance in the truth and in both fits (the torso bent by both
-/// arms; the split chain bends its torso under the right arm only). Prints the figures of
-/// `docs/src/trees.md`.
+/// arms; the split chain bends its torso under the right arm only), and the tree fitted
+/// without its bending terms worse too. Prints the figures of `docs/src/trees.md`.
 #[test]
 fn a_split_chain_fit_of_a_bent_tree_is_worse_on_held_out_poses() {
     split_chain_is_worse(true);
@@ -408,6 +408,26 @@ fn split_chain_is_worse(bending: bool) {
         split_rms > 1.25 * tree_rms,
         "split {split_rms:.4} mm vs tree {tree_rms:.4} mm"
     );
+    if bending {
+        // the same tree without its lateral terms, on the same bent data
+        let stiff = identify_tree(
+            &compliant_dual_arm("", false),
+            &fit.data,
+            &IdentifySettings {
+                test: Some(held.data.clone()),
+                ..IdentifySettings::default()
+            },
+            &mut Silent,
+        )
+        .unwrap();
+        assert!(stiff.solver.status.is_converged());
+        let stiff_rms = stiff.targets[0].held_out.rms;
+        println!("right arm, tree fit without the bending terms: {stiff_rms:.4} mm");
+        assert!(
+            stiff_rms > 1.25 * tree_rms,
+            "without bending {stiff_rms:.4} mm vs with {tree_rms:.4} mm"
+        );
+    }
 }
 
 #[test]
