@@ -26,7 +26,8 @@ use nalgebra::{DMatrix, RealField, Vector3};
 /// joints and parameters, and a scratch Jacobian of the branch's columns.
 #[derive(Clone, Debug)]
 pub struct TreeData<T: RealField + Copy> {
-    /// Per branch, the serial model's evaluation (frames, targets, twists).
+    /// Per branch, the serial model's evaluation (frames, targets, twists); with bending,
+    /// its targets are bent by the branch's bend (the frames and twists stay rigid).
     pub branches: Vec<Data<T>>,
     q: Vec<Vec<T>>,
     params: Vec<Vec<f64>>,

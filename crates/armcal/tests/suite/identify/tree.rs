@@ -646,8 +646,9 @@ fn a_tree_cell_with_compliance_says_file_line_and_field_of_what_it_cannot_model(
 
 /// A tree cell's bending errors name the file, line and field: an unknown joint, a coupled
 /// joint, a joint with no mass beyond it (no bending moment), a term whose mass is not
-/// beyond its joint; a serial cell refuses `bending` by name. A bent tree's estimate
-/// exported warns with every κ⊥ too.
+/// beyond its joint; a serial cell refuses `bending` by name. `--nongeometric compliance`
+/// fits the bending terms, `none` does not; a bent tree's estimate exported warns with
+/// every κ⊥ too.
 #[test]
 fn a_cell_with_bending_says_file_line_and_field_of_what_it_cannot_model() {
     let text = include_str!("../../../../../examples/dual-arm-tree-cell.toml");
@@ -716,6 +717,22 @@ fn a_cell_with_bending_says_file_line_and_field_of_what_it_cannot_model() {
     )
     .unwrap();
     let est = identify_tree(&cell, &sim.data, &IdentifySettings::default(), &mut Silent).unwrap();
+    // `--nongeometric compliance` fits the bending terms with the joint terms; `none` neither
+    for (asked, kept) in [(Candidate::Compliance, true), (Candidate::Kinematic, false)] {
+        let opts = IdentifySettings {
+            nongeometric: NonGeometric::Only(asked),
+            ..IdentifySettings::default()
+        };
+        let e = identify_tree(&cell, &sim.data, &opts, &mut Silent).unwrap();
+        for kind in [".bending.", ".compliance."] {
+            assert_eq!(
+                e.free.iter().any(|n| n.contains(kind)),
+                kept,
+                "{asked:?}: {:?}",
+                e.free
+            );
+        }
+    }
     let acceptance = armcal::Acceptance {
         accepted: false,
         accept: "--accept-unconverged",
