@@ -256,7 +256,9 @@ fn kappa_twist<T: RealField + Copy>(
 }
 
 /// Geometric joint Jacobian (world frame, 6 × tree joints) of tree target `target`, its
-/// branch evaluated by [`branch_kinematics`]: the branch's `J_b` times `∂q_b/∂q = C_b`.
+/// branch evaluated by [`branch_kinematics`]: the branch's `J_b` times `∂q_b/∂q = C_b`,
+/// with compliance through `q + Δq(q)`, with bending mapped by the bend and through
+/// `δ_b(q)`, `t_b(q)` ([`crate::model::tree::bending`]).
 pub fn tree_joint_jacobian<T: RealField + Copy>(
     tree: &Tree,
     data: &TreeData<T>,
