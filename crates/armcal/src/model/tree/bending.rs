@@ -120,15 +120,16 @@ impl TreeBendingTerm {
     }
 }
 
-/// The unit-κ lateral moment `w = r × ĝ − (z·(r × ĝ)) z`, `r = x − o` (mm).
-fn lateral<T: RealField + Copy>(
+/// The unit-κ gravity moment `M = r × ĝ`, `r = x − o` (mm), and its lateral part
+/// `w = M − (z·M) z`.
+fn moments<T: RealField + Copy>(
     x: &Vector3<T>,
     o: &Vector3<T>,
     z: &Vector3<T>,
     g: &Vector3<T>,
-) -> Vector3<T> {
+) -> (Vector3<T>, Vector3<T>) {
     let m = (x - o).cross(g);
-    m - z * z.dot(&m)
+    (m, m - z * z.dot(&m))
 }
 
 /// The bend of one branch at the last evaluation: `D_b = (Exp(δ), t)` and its rates.
@@ -211,8 +212,7 @@ impl<T: RealField + Copy> BendingData<T> {
             let d = &levers[b];
             let tw = &d.joint_twists;
             let (x, o, z) = (d.joint_points[a], d.joint_points[i], tw[i].w);
-            let m = (x - o).cross(g);
-            let w = m - z * z.dot(&m);
+            let (m, w) = moments(&x, &o, &z, g);
             self.w[t] = w;
             self.u[t] = o.cross(&w);
             self.kappa[t] = params[term.param];
@@ -352,7 +352,7 @@ pub fn lumped_tree_bending(
                     0 => Matrix3::identity(),
                     l => d.frames[l - 1].rot.transpose(),
                 };
-                let w = lateral(
+                let (_, w) = moments(
                     &d.joint_points[masses[m].axis],
                     &d.joint_points[i],
                     &d.joint_twists[i].w,
