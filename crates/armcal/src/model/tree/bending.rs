@@ -63,7 +63,7 @@
 //! lateral moment of a mass on the torso itself is constant in the world) and **the same
 //! function twice** (within the span of the constants and the joint's kept levers) drop the
 //! term; a bending joint with no term left is an error. What the data
-//! separate is judged, term by term, by the fit's gate ([`crate::identify::tree`]).
+//! separate is judged, term by term, by the tree fit's gate (`armcal identify`).
 
 use crate::model::compliance::{gravity_direction, ComplianceTerm};
 use crate::model::kinematics::Data;
