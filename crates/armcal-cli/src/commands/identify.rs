@@ -62,7 +62,8 @@ pub struct Args {
     /// The estimate (estimate.json of the same cell) whose robot parameters --refit keeps.
     #[arg(long, requires = "refit")]
     pub estimate: Option<PathBuf>,
-    /// The cell's non-geometric terms ([parameters] compliance / periodic) the fit keeps:
+    /// The cell's non-geometric terms ([parameters] compliance / periodic; a tree cell's
+    /// bending counts as compliance) the fit keeps:
     /// `as-cell` (all), `none` (the kinematic model), `compliance`, `periodic`, `both`, or
     /// `auto`: the candidate chosen by k-fold cross-validation on the training data (the
     /// fewest terms within one standard error of the best held-out RMS), every candidate's

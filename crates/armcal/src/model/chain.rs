@@ -449,6 +449,7 @@ impl Model {
                         ..t.spec.clone()
                     })
                     .collect(),
+                bending: Vec::new(),
             }),
             periodic: (!self.periodic.is_empty()).then(|| PeriodicSpec {
                 terms: self

@@ -183,6 +183,11 @@ pub struct ComplianceSpec {
     pub levers: Vec<f64>,
     /// The lumped terms (then, with payloads, one payload term per compliant joint).
     pub terms: Vec<ComplianceTerm>,
+    /// The lateral (bending) terms of a tree's joints ([`crate::model::tree::bending`]):
+    /// each names its joint and the joint on whose axis its mass sits. A serial chain takes
+    /// none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub bending: Vec<ComplianceTerm>,
 }
 
 /// A term compiled against a model.
@@ -377,6 +382,7 @@ impl ComplianceSpec {
             gravity: [g.x, g.y, g.z],
             levers,
             terms,
+            bending: Vec::new(),
         })
     }
 
@@ -392,6 +398,13 @@ impl ComplianceSpec {
         let c = self;
         let g =
             gravity_direction(c.gravity).map_err(|e| Error::Model(format!("compliance: {e}")))?;
+        if let Some(t) = c.bending.first() {
+            return Err(Error::Model(format!(
+                "compliance: the bending term `{}` is for a kinematic tree; a serial chain \
+                 takes none (describe the robot as a tree cell, links naming a `parent`)",
+                Self::bending_name(t)
+            )));
+        }
         if c.levers.len() != link_params || !c.levers.iter().all(|x| x.is_finite()) {
             return Err(Error::Model(format!(
                 "compliance: the lever geometry has {} values, the chain {link_params}",
@@ -458,6 +471,11 @@ impl ComplianceSpec {
     /// Name of term `t`'s parameter: `<joint>.compliance.<mass>`.
     pub fn parameter_name(term: &ComplianceTerm) -> String {
         format!("{}.compliance.{}", term.joint, term.mass)
+    }
+
+    /// Name of bending term `t`'s parameter: `<joint>.bending.<mass>`.
+    pub(crate) fn bending_name(term: &ComplianceTerm) -> String {
+        format!("{}.bending.{}", term.joint, term.mass)
     }
 }
 

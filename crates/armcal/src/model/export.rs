@@ -345,6 +345,7 @@ pub fn export_form(spec: &ModelSpec, form: LinkForm) -> Result<ModelSpec, Error>
             gravity: g.into(),
             levers,
             terms: c.terms.clone(),
+            bending: c.bending.clone(),
         });
     }
     out.periodic = spec.periodic.clone();

@@ -88,7 +88,8 @@ pub(crate) fn without_nongeometric(
     ))
 }
 
-/// The tree `spec` without its joint compliance, and what leaving it out costs: the
+/// The tree `spec` without its joint and lateral (bending) compliance, and what leaving it
+/// out costs (the warning names every κ and κ⊥): the
 /// largest distance between a target's positions in the two trees over
 /// [`SHIFT_CONFIGURATIONS`] random configurations of the tree's joints (seed
 /// [`SHIFT_SEED`]), every target; `None` when it has no compliance.
@@ -104,8 +105,15 @@ pub(crate) fn tree_without_compliance(
     let terms: Vec<&str> = compliance
         .terms
         .iter()
-        .map(|t| compliant.registry.get(t.param).name.as_str())
+        .map(|t| t.param)
+        .chain(compliance.bending.iter().map(|t| t.param))
+        .map(|i| compliant.registry.get(i).name.as_str())
         .collect();
+    let what = if compliance.bending.is_empty() {
+        "the joint compliance"
+    } else {
+        "the joint and lateral (bending) compliance"
+    };
     let stiff = Tree::from_spec(&rigid)?;
     let (pc, ps) = (compliant.nominal(), stiff.nominal());
     let (mut dc, mut ds) = (TreeData::new(&compliant), TreeData::new(&stiff));
@@ -124,7 +132,7 @@ pub(crate) fn tree_without_compliance(
     Ok((
         rigid,
         Some(NotHeld {
-            what: format!("the joint compliance ({})", terms.join(", ")),
+            what: format!("{what} ({})", terms.join(", ")),
             tcp_shift_mm: shift,
         }),
     ))

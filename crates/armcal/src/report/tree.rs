@@ -281,7 +281,9 @@ fn tree_scene(tree: &Tree, name: &str) -> Result<Scene, Error> {
             let fk = &data.branches[b];
             // a link runs from the end of the one before it (the root frame's origin for
             // the first) to its own end
-            let a = k.checked_sub(1).map_or(Vector3::zeros(), |p| fk.frames[p].trans);
+            let a = k
+                .checked_sub(1)
+                .map_or(Vector3::zeros(), |p| fk.frames[p].trans);
             let z = fk.frames[k].trans;
             bounds.add(&a, LINK_RADIUS);
             bounds.add(&z, LINK_RADIUS);

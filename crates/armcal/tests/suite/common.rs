@@ -139,6 +139,7 @@ pub fn compliant_model(seed: u64) -> Model {
         gravity,
         levers,
         terms,
+        bending: Vec::new(),
     });
     Model::from_spec(&spec).expect("valid compliant model")
 }

@@ -111,6 +111,9 @@ struct RawParameters {
     measurement: Option<String>,
     /// Compliant joints, `["j2", "j3"]` ([`crate::model::compliance`]).
     compliance: Option<Vec<String>>,
+    /// Joints whose structure bends laterally, `["torso"]` (a tree cell only,
+    /// [`crate::model::tree::bending`]).
+    bending: Option<Vec<String>>,
     /// Periodic joint errors ([`crate::model::periodic`]).
     periodic: Option<RawPeriodic>,
     /// Values of the compliance and periodic terms, `{ "j2.compliance.elbow" = {

@@ -216,6 +216,14 @@ pub(super) fn joint_corrections(
     };
     let span = p.span();
     let p = p.get_ref();
+    if p.bending.is_some() {
+        return Err(ctx.err(
+            span,
+            "parameters.bending",
+            "lateral (bending) compliance is modelled on kinematic trees only (links that name \
+             a `parent`); for a serial chain use `compliance`, or remove `bending`",
+        ));
+    }
     if p.compliance.is_none() && p.periodic.is_none() {
         return match p.values.keys().next() {
             Some(name) => Err(ctx.err(

@@ -2,13 +2,16 @@
 //! links name their `parent` (default: the previous link) and whose coupled joints say what
 //! they follow (`coupled = { q2 = -1, q3 = -1, offset_deg = 90 }`), and `[[targets]]` that
 //! name the `link` they hang from (default: the last link). Read with `[name]`,
-//! `[instrument]`, `[parameters] measurement` and `compliance` (joint compliance over the
-//! tree, [`crate::model::tree::compliance`], with `[robot] gravity`); the serial sections a
-//! fit of a tree does not use yet are refused, by name.
+//! `[instrument]`, `[parameters] measurement`, `compliance` (joint compliance over the
+//! tree, [`crate::model::tree::compliance`]) and `bending` (lateral compliance,
+//! [`crate::model::tree::bending`]), both with `[robot] gravity`; the serial sections a fit
+//! of a tree does not use yet are refused, by name.
 
 use super::fields::*;
 use super::*;
 use crate::cell::tree::TreeCell;
+use crate::model::compliance::{gravity_direction, ComplianceSpec};
+use crate::model::tree::bending::lumped_tree_bending;
 use crate::model::tree::compliance::lumped_tree_compliance;
 use crate::model::tree::{Coupling, Tree, TreeLinkSpec, TreeSpec, TreeTargetSpec};
 
@@ -61,8 +64,8 @@ pub(in crate::cell) fn parse_tree(text: &str, file: &str) -> Result<TreeCell, Er
             field,
             "a tree cell (links that name a `parent`, coupled joints, targets that name a \
              `link`) takes `[[robot.links]]` (each branch's base and tool frames as links), \
-             or `urdf`, `[instrument]`, `[[targets]]`, `[parameters] measurement` and \
-             `compliance` (with `[robot] gravity`) for now; remove this field",
+             or `urdf`, `[instrument]`, `[[targets]]`, `[parameters] measurement`, \
+             `compliance` and `bending` (with `[robot] gravity`) for now; remove this field",
         ));
     }
     let (instrument, instrument_geometry, instrument_name) =
@@ -152,8 +155,8 @@ pub(in crate::cell) fn parse_tree(text: &str, file: &str) -> Result<TreeCell, Er
                 return Err(ctx.err(
                     p.span(),
                     "parameters",
-                    "a tree cell takes `measurement` and `compliance` here for now; remove the \
-                     other fields",
+                    "a tree cell takes `measurement`, `compliance` and `bending` here for now; \
+                     remove the other fields",
                 ));
             }
             match &pr.measurement {
@@ -171,26 +174,50 @@ pub(in crate::cell) fn parse_tree(text: &str, file: &str) -> Result<TreeCell, Er
             }
         }
     };
-    // joint compliance over the tree: the lumped terms of the named joints, on the rigid tree
-    let compliant = raw.parameters.as_ref().and_then(|p| {
-        p.get_ref()
-            .compliance
-            .as_ref()
-            .map(|joints| (p.span(), joints))
+    // joint and lateral compliance over the tree: the lumped terms of the named joints, on
+    // the rigid tree
+    let elastic = raw.parameters.as_ref().and_then(|p| {
+        let pr = p.get_ref();
+        (pr.compliance.is_some() || pr.bending.is_some()).then(|| (p.span(), pr))
     });
     let mut spec = spec;
-    if let Some((span, joints)) = compliant {
-        let c = lumped_tree_compliance(&tree, joints, rr.gravity.unwrap_or([0.0, 0.0, -1.0]))
-            .map_err(|e| ctx.err(span.clone(), "parameters.compliance", e))?;
+    if let Some((span, p)) = elastic {
+        let gravity = rr.gravity.unwrap_or([0.0, 0.0, -1.0]);
+        let field = |what: &str| format!("parameters.{what}");
+        let mut c = match &p.compliance {
+            Some(joints) => lumped_tree_compliance(&tree, joints, gravity)
+                .map_err(|e| ctx.err(span.clone(), &field("compliance"), e))?,
+            None => {
+                let g = gravity_direction(gravity)
+                    .map_err(|e| ctx.err(rspan.clone(), "robot.gravity", e))?;
+                ComplianceSpec {
+                    gravity: g.into(),
+                    levers: tree.nominal(),
+                    terms: Vec::new(),
+                    bending: Vec::new(),
+                }
+            }
+        };
+        if let Some(joints) = &p.bending {
+            c.bending = lumped_tree_bending(&tree, joints, gravity)
+                .map_err(|e| ctx.err(span.clone(), &field("bending"), e))?;
+        }
         spec.compliance = Some(c);
-        tree = Tree::from_spec(&spec)
-            .map_err(|e| ctx.err(span, "parameters.compliance", e.to_string()))?;
+        tree = Tree::from_spec(&spec).map_err(|e| {
+            let e = e.to_string();
+            let what = if e.contains(".bending.") {
+                "bending"
+            } else {
+                "compliance"
+            };
+            ctx.err(span, &field(what), e)
+        })?;
     } else if rr.gravity.is_some() {
         return Err(ctx.err(
             rspan,
             "robot.gravity",
-            "gravity is used by `[parameters] compliance`, and this tree cell has none: add \
-             the compliant joints or remove `gravity`",
+            "gravity is used by `[parameters] compliance` and `bending`, and this tree cell \
+             has neither: add the compliant joints or remove `gravity`",
         ));
     }
     let all_frames = spec

@@ -51,9 +51,9 @@ pub(super) fn fit_tree_free_set<'a>(
     let tree = &cell.tree;
     let lm = &opts.lm;
     let is_kappa = |i: usize| {
-        tree.compliance
-            .as_ref()
-            .is_some_and(|c| c.terms.iter().any(|t| t.param == i))
+        tree.compliance.as_ref().is_some_and(|c| {
+            c.terms.iter().any(|t| t.param == i) || c.bending.iter().any(|t| t.param == i)
+        })
     };
     let mut dropped: Vec<(usize, String)> = Vec::new();
     // where the free set is decided and the fit starts: the frames-first fit, then, once
@@ -137,7 +137,7 @@ pub(super) fn fit_tree_free_set<'a>(
 }
 
 /// `--nongeometric auto` on a tree: the kinematic tree and, when the cell declares joint
-/// compliance, the compliant one, cross-validated on `train` with `folds` folds as a serial
+/// compliance or bending, the compliant one (every term of both kinds), cross-validated on `train` with `folds` folds as a serial
 /// fit's candidates are ([`super::nongeometric_choice`]: each candidate's free set decided
 /// once on all of `train`, its folds fitted from that fit, the one-standard-error rule).
 pub(super) fn choose_tree(
@@ -150,7 +150,10 @@ pub(super) fn choose_tree(
     observer: &mut dyn Observer,
 ) -> Result<NonGeometricChoice, Error> {
     let tree = &cell.tree;
-    let terms = tree.compliance.as_ref().map_or(0, |c| c.terms.len());
+    let terms = tree
+        .compliance
+        .as_ref()
+        .map_or(0, |c| c.terms.len() + c.bending.len());
     let mut offered = vec![Candidate::Kinematic];
     offered.extend((terms > 0).then_some(Candidate::Compliance));
     let folds_of = deal_folds(train, folds, opts.seed)?;

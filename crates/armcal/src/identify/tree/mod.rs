@@ -11,9 +11,10 @@
 //! ([`crate::model::tree::identifiability`]); the solvers, the covariance `C_p = σ̂₀² (JᵀJ)⁻¹`
 //! (book eq. 5.23) and the robust reweighting are the serial fit's ([`super::solver`]).
 //!
-//! Joint compliance over the tree ([`crate::model::tree::compliance`]) is fitted with the
-//! geometry: its κ are tree parameters like any other (their columns exact, their σ from the
-//! same covariance), and the serial identifiability gate
+//! Joint and lateral (bending) compliance over the tree ([`crate::model::tree::compliance`],
+//! [`crate::model::tree::bending`]) is fitted with the geometry: its κ and κ⊥ are tree
+//! parameters like any other (their columns exact, their σ from the same covariance), and
+//! the serial identifiability gate
 //! ([`crate::identify::nongeometric_gate`]) judges each: a term that is not separable from
 //! the others on these data is dropped, named with its reason, and the tree fitted again.
 //!
@@ -305,10 +306,11 @@ fn data_measurement(data: &Dataset) -> Measurement {
 /// the position errors per target, fitted and held out (`opts.holdout` of the configurations
 /// at random, seeded, or `opts.test`). A fit that did not converge says so in its status.
 ///
-/// With the cell's joint compliance (`--nongeometric` as the cell, or `compliance`) the κ
-/// are fitted with the geometry and gated ([`crate::identify::nongeometric_gate`]): while a
-/// term is not separable, the least separable is dropped (its reason kept) and the tree
-/// fitted again; `--nongeometric none` fits the rigid tree.
+/// With the cell's joint compliance and bending (`--nongeometric` as the cell, or
+/// `compliance`: both kinds) the κ and κ⊥ are fitted with the geometry and gated
+/// ([`crate::identify::nongeometric_gate`]): while a term is not separable, the least
+/// separable is dropped (its reason kept) and the tree fitted again; `--nongeometric none`
+/// fits the rigid tree.
 ///
 /// Settings a tree fit does not take yet are refused by name: `method` Kalman, a `refit`, a
 /// warm `start`, periodic terms (`--nongeometric periodic`, `both`),

@@ -50,6 +50,7 @@
 use crate::model::compliance::{gravity_direction, ComplianceSpec, ComplianceTerm};
 use crate::model::kinematics::{forward_kinematics, Data};
 use crate::model::registry::{Registry, Segment};
+use crate::model::tree::bending::BendingData;
 use crate::model::tree::kinematics::{branch_kinematics, TreeData};
 use crate::model::tree::{Branch, Tree};
 use crate::model::JointKind;
@@ -57,7 +58,7 @@ use crate::Error;
 use nalgebra::{convert, RealField, Vector3};
 
 /// Random tree configurations the lever tests of [`lumped_tree_compliance`] sample.
-const LEVER_SAMPLES: usize = 200;
+pub(crate) const LEVER_SAMPLES: usize = 200;
 
 /// A lever whose part outside the span of the constant and the kept levers is below this
 /// share of its norm is dropped (the serial test's threshold).
@@ -84,6 +85,9 @@ pub struct TreeCompliance {
     pub levers: Vec<f64>,
     /// The terms, in registry order.
     pub terms: Vec<TreeComplianceTerm>,
+    /// The lateral (bending) terms ([`crate::model::tree::bending`]), in registry order
+    /// after the joint terms.
+    pub bending: Vec<crate::model::tree::bending::TreeBendingTerm>,
 }
 
 /// Checks a tree's [`ComplianceSpec`] against its joints and branches and adds its κ to the
@@ -105,46 +109,19 @@ pub(crate) fn compile(
     }
     let mut terms = Vec::new();
     for t in &spec.terms {
-        let name = ComplianceSpec::parameter_name(t);
-        let joint = joints
-            .iter()
-            .position(|j| j.name == t.joint && j.kind == JointKind::Revolute)
-            .ok_or_else(|| {
-                err(format!(
-                    "term `{name}`: `{}` is not a revolute joint of the tree with a variable of \
-                     its own (a coupled joint deflects with the joints it follows)",
-                    t.joint
-                ))
-            })?;
-        let mass =
-            t.at.as_deref()
-                .and_then(|at| {
-                    branches.iter().enumerate().find_map(|(b, br)| {
-                        br.model
-                            .joints
-                            .iter()
-                            .position(|j| j.name == at)
-                            .map(|a| (b, a))
-                    })
-                })
-                .ok_or_else(|| {
-                    err(format!(
-                        "term `{name}`: its mass names no joint of the tree (`at` = {:?}; a tree \
-                     takes no payload terms)",
-                        t.at
-                    ))
-                })?;
-        let unit = t.unit();
-        if !unit.holds(t.value) {
-            return Err(err(format!(
-                "term `{name}` = {:e} {} is outside {}",
-                t.value * unit.display_factor(),
-                unit.display_name(),
-                unit.range_text()
-            )));
-        }
-        let param = registry.add(name, unit, t.value, Segment::Chain)?;
+        let (joint, mass) =
+            resolve(t, &ComplianceSpec::parameter_name(t), joints, branches).map_err(err)?;
+        let param = add_term(t, ComplianceSpec::parameter_name(t), registry)?;
         terms.push(TreeComplianceTerm { joint, mass, param });
+    }
+    let mut bending = Vec::new();
+    for t in &spec.bending {
+        let name = ComplianceSpec::bending_name(t);
+        let (joint, mass) = resolve(t, &name, joints, branches).map_err(err)?;
+        let term = crate::model::tree::bending::TreeBendingTerm::new(joints, branches, joint, mass)
+            .map_err(|m| err(format!("term `{name}`: {m}")))?;
+        let param = add_term(t, name, registry)?;
+        bending.push(crate::model::tree::bending::TreeBendingTerm { param, ..term });
     }
     let mut levers = spec.levers.clone();
     levers.resize(registry.len(), 0.0);
@@ -152,7 +129,61 @@ pub(crate) fn compile(
         gravity,
         levers,
         terms,
+        bending,
     })
+}
+
+/// The tree joint of term `t` (named `name`) and its mass (branch, branch joint); the
+/// error names the term and why.
+fn resolve(
+    t: &ComplianceTerm,
+    name: &str,
+    joints: &[crate::model::link::Joint],
+    branches: &[Branch],
+) -> Result<(usize, (usize, usize)), String> {
+    let joint = joints
+        .iter()
+        .position(|j| j.name == t.joint && j.kind == JointKind::Revolute)
+        .ok_or_else(|| {
+            format!(
+                "term `{name}`: `{}` is not a revolute joint of the tree with a variable of its \
+                 own (a coupled joint deflects with the joints it follows)",
+                t.joint
+            )
+        })?;
+    let mass =
+        t.at.as_deref()
+            .and_then(|at| {
+                branches.iter().enumerate().find_map(|(b, br)| {
+                    br.model
+                        .joints
+                        .iter()
+                        .position(|j| j.name == at)
+                        .map(|a| (b, a))
+                })
+            })
+            .ok_or_else(|| {
+                format!(
+                "term `{name}`: its mass names no joint of the tree (`at` = {:?}; a tree takes \
+                 no payload terms)",
+                t.at
+            )
+            })?;
+    Ok((joint, mass))
+}
+
+/// Adds term `t`'s κ, named `name`, to the tree registry (segment chain), its value checked.
+fn add_term(t: &ComplianceTerm, name: String, registry: &mut Registry) -> Result<usize, Error> {
+    let unit = t.unit();
+    if !unit.holds(t.value) {
+        return Err(Error::Model(format!(
+            "compliance: term `{name}` = {:e} {} is outside {}",
+            t.value * unit.display_factor(),
+            unit.display_name(),
+            unit.range_text()
+        )));
+    }
+    registry.add(name, unit, t.value, Segment::Chain)
 }
 
 /// Per evaluation, the deflection of a tree's compliant joints ([`TreeData`]).
@@ -174,6 +205,8 @@ pub(crate) struct DeflectionData<T: RealField + Copy> {
     pub(crate) deflected: Vec<T>,
     /// Per term, κ at the last evaluation.
     pub(crate) kappa: Vec<f64>,
+    /// The bending terms' rotations and each branch's bend.
+    pub(crate) bending: BendingData<T>,
 }
 
 impl<T: RealField + Copy> DeflectionData<T> {
@@ -181,8 +214,13 @@ impl<T: RealField + Copy> DeflectionData<T> {
     pub(crate) fn new(tree: &Tree) -> Option<Self> {
         let c = tree.compliance.as_ref()?;
         let mut needed = vec![false; tree.branches.len()];
-        for t in &c.terms {
-            needed[t.mass.0] = true;
+        for mass in c
+            .terms
+            .iter()
+            .map(|t| t.mass)
+            .chain(c.bending.iter().map(|t| t.mass))
+        {
+            needed[mass.0] = true;
         }
         Some(DeflectionData {
             levers: tree
@@ -205,6 +243,7 @@ impl<T: RealField + Copy> DeflectionData<T> {
             lever_rate: vec![T::zero(); c.terms.len() * tree.dof()],
             deflected: vec![T::zero(); tree.dof()],
             kappa: vec![0.0; c.terms.len()],
+            bending: BendingData::new(tree, c),
         })
     }
 
@@ -263,6 +302,8 @@ impl<T: RealField + Copy> DeflectionData<T> {
             self.kappa[t] = params[term.param];
             self.deflected[term.joint] += convert::<f64, T>(self.kappa[t]) * lever;
         }
+        self.bending
+            .evaluate_terms(tree, c, &self.levers, params, &g);
     }
 }
 
@@ -287,41 +328,49 @@ pub(crate) fn map_joints<T: RealField + Copy>(branch: &Branch, q: &[T], qb: &mut
     }
 }
 
-/// The lumped compliance of the tree joints `joints` of `tree` (which has no compliance
-/// yet) with gravity `gravity` (root frame, any length): per branch the elbow and wrist
-/// masses, and for each joint the terms the tests over the tree's joint space keep (module
-/// notes). The error names the joint and what to do.
-pub fn lumped_tree_compliance(
+/// A lumped point mass of a tree: its label in a term's name (`elbow_r3`), its branch, the
+/// branch joint on whose axis it sits and that joint's name.
+pub(crate) struct LumpedMass {
+    pub(crate) label: String,
+    pub(crate) branch: usize,
+    pub(crate) axis: usize,
+    pub(crate) joint: String,
+}
+
+/// The tree joints named `joints` (revolute, each with a variable of its own), sorted; the
+/// error names the joint (`what`: "compliance is", "bending is").
+pub(crate) fn compliant_joints(
     tree: &Tree,
     joints: &[String],
-    gravity: [f64; 3],
-) -> Result<ComplianceSpec, String> {
-    let g = gravity_direction(gravity)?;
-    let index =
-        crate::model::joint_correction::revolute_joints(&tree.joints, joints, "compliance is")
-            .map_err(|e| {
-                if tree
-                    .coupled
-                    .iter()
-                    .any(|c| e.contains(&format!("`{}`", c.joint)))
-                {
-                    format!("{e}; a coupled joint deflects with the joints it follows: name those")
-                } else {
-                    e
-                }
-            })?;
+    what: &str,
+) -> Result<Vec<usize>, String> {
+    let index = crate::model::joint_correction::revolute_joints(&tree.joints, joints, what)
+        .map_err(|e| {
+            if tree
+                .coupled
+                .iter()
+                .any(|c| e.contains(&format!("`{}`", c.joint)))
+            {
+                format!("{e}; a coupled joint deflects with the joints it follows: name those")
+            } else {
+                e
+            }
+        })?;
     if index.is_empty() {
         return Err("give at least one joint, e.g. [\"t1\", \"r2\"]".into());
     }
-    // the masses: per branch, elbow and wrist of its compliant joints; one per joint axis
-    // (label, branch, branch joint, joint name)
-    let mut masses: Vec<(String, usize, usize, String)> = Vec::new();
+    Ok(index)
+}
+
+/// The lumped masses of the tree joints `index` (module notes): per branch an elbow on the
+/// axis after its first such joint of its own (past the fork; else the first it shares)
+/// and a wrist on the second-to-last axis; one mass per joint axis.
+pub(crate) fn lumped_masses(tree: &Tree, index: &[usize]) -> Vec<LumpedMass> {
+    let mut masses: Vec<LumpedMass> = Vec::new();
     for (b, branch) in tree.branches.iter().enumerate() {
         let on: Vec<usize> = (0..branch.model.dof())
             .filter(|&i| index.iter().any(|&k| coefficient(branch, i, k) != 0.0))
             .collect();
-        // the elbow follows the branch's first compliant joint of its own (past the fork),
-        // else the first it shares (the torso's)
         let shared = |i: usize| {
             let name = &branch.model.joints[i].name;
             tree.branches
@@ -335,8 +384,13 @@ pub fn lumped_tree_compliance(
         let dof = branch.model.dof();
         let mut add = |role: &str, a: usize| {
             let name = &branch.model.joints[a].name;
-            if !masses.iter().any(|m| m.3 == *name) {
-                masses.push((format!("{role}_{name}"), b, a, name.clone()));
+            if !masses.iter().any(|m| m.joint == *name) {
+                masses.push(LumpedMass {
+                    label: format!("{role}_{name}"),
+                    branch: b,
+                    axis: a,
+                    joint: name.clone(),
+                });
             }
         };
         if first + 1 < dof {
@@ -346,6 +400,40 @@ pub fn lumped_tree_compliance(
             add("wrist", dof - 2);
         }
     }
+    masses
+}
+
+/// The samples of a lever `l` (over random configurations) that are a function of their own:
+/// `l` less its projection on the orthonormal `basis` (a constant and the kept levers) is
+/// appended, normalised, and `true` returned; `false` for no lever at all (below 1e-9 mm
+/// per sample) or one within [`LEVER_DEPENDENCE`] of the span.
+pub(crate) fn independent(basis: &mut Vec<Vec<f64>>, mut l: Vec<f64>) -> bool {
+    let norm = l.iter().map(|x| x * x).sum::<f64>().sqrt();
+    for v in basis.iter() {
+        let d: f64 = v.iter().zip(&l).map(|(x, y)| x * y).sum();
+        l.iter_mut().zip(v).for_each(|(y, x)| *y -= d * x);
+    }
+    let rest = l.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if norm < 1e-9 * l.len() as f64 || rest < LEVER_DEPENDENCE * norm {
+        return false;
+    }
+    l.iter_mut().for_each(|x| *x /= rest);
+    basis.push(l);
+    true
+}
+
+/// The lumped compliance of the tree joints `joints` of `tree` (which has no compliance
+/// yet) with gravity `gravity` (root frame, any length): per branch the elbow and wrist
+/// masses, and for each joint the terms the tests over the tree's joint space keep (module
+/// notes). The error names the joint and what to do.
+pub fn lumped_tree_compliance(
+    tree: &Tree,
+    joints: &[String],
+    gravity: [f64; 3],
+) -> Result<ComplianceSpec, String> {
+    let g = gravity_direction(gravity)?;
+    let index = compliant_joints(tree, joints, "compliance is")?;
+    let masses = lumped_masses(tree, &index);
     let qs = crate::model::sampling::random_joint_values(&tree.joints, LEVER_SAMPLES, 14);
     let levers = tree.nominal();
     let mut data = TreeData::<f64>::new(tree);
@@ -357,14 +445,14 @@ pub fn lumped_tree_compliance(
         }
         let per_mass: Vec<Vec<f64>> = masses
             .iter()
-            .map(|(_, b, a, _)| {
-                let d = &data.branches[*b];
-                let x = d.joint_points[*a];
+            .map(|m| {
+                let d = &data.branches[m.branch];
+                let x = d.joint_points[m.axis];
                 (0..tree.dof())
                     .map(|k| {
-                        (0..*a)
+                        (0..m.axis)
                             .map(|i| {
-                                coefficient(&tree.branches[*b], i, k)
+                                coefficient(&tree.branches[m.branch], i, k)
                                     * g.dot(&d.joint_twists[i].point_velocity(&x))
                             })
                             .sum()
@@ -378,26 +466,16 @@ pub fn lumped_tree_compliance(
     for &k in &index {
         let n = samples.len() as f64;
         let mut basis: Vec<Vec<f64>> = vec![vec![1.0 / n.sqrt(); samples.len()]];
-        for (m, (label, _, _, at)) in masses.iter().enumerate() {
-            let mut l: Vec<f64> = samples.iter().map(|s| s[m][k]).collect();
-            let norm = l.iter().map(|x| x * x).sum::<f64>().sqrt();
-            for v in &basis {
-                let d: f64 = v.iter().zip(&l).map(|(x, y)| x * y).sum();
-                l.iter_mut().zip(v).for_each(|(y, x)| *y -= d * x);
+        for (m, mass) in masses.iter().enumerate() {
+            let l: Vec<f64> = samples.iter().map(|s| s[m][k]).collect();
+            if independent(&mut basis, l) {
+                terms.push(ComplianceTerm {
+                    joint: tree.joints[k].name.clone(),
+                    mass: mass.label.clone(),
+                    at: Some(mass.joint.clone()),
+                    value: 0.0,
+                });
             }
-            let rest = l.iter().map(|x| x * x).sum::<f64>().sqrt();
-            // 1e-9 mm: no torque at all
-            if norm < 1e-9 * n || rest < LEVER_DEPENDENCE * norm {
-                continue;
-            }
-            l.iter_mut().for_each(|x| *x /= rest);
-            basis.push(l);
-            terms.push(ComplianceTerm {
-                joint: tree.joints[k].name.clone(),
-                mass: label.clone(),
-                at: Some(at.clone()),
-                value: 0.0,
-            });
         }
         if basis.len() == 1 {
             return Err(format!(
@@ -412,5 +490,6 @@ pub fn lumped_tree_compliance(
         gravity: [g.x, g.y, g.z],
         levers,
         terms,
+        bending: Vec::new(),
     })
 }

@@ -9,22 +9,25 @@
 //!
 //! With joint compliance ([`crate::model::tree::compliance`]) the branch runs at the
 //! deflected tree joints `q + Δq(q)`: the compliance's κ columns and the chain rule through
-//! `Δq` are added here.
+//! `Δq` are added here. With bending ([`crate::model::tree::bending`]) the branch's targets
+//! are then moved by its bend `D_b = (Exp(δ_b), t_b)`: the chain's columns are mapped by
+//! `Exp(δ_b)` at the rigid target, the instrument's taken at the bent one, and the κ⊥
+//! columns and the chain rule through `δ_b(q)`, `t_b(q)` added (equations in that module).
 
-use crate::model::jacobian::{
-    identification_jacobian, joint_jacobian, observed_world, Observed, Rows,
-};
+use crate::model::jacobian::{identification_jacobian, influence, Observed, Rows};
 use crate::model::kinematics::{forward_kinematics, Data};
 use crate::model::pose::Twist;
+use crate::model::tree::bending::BranchBend;
 use crate::model::tree::compliance::{coefficient, map_joints, DeflectionData};
 use crate::model::tree::Tree;
-use nalgebra::{DMatrix, RealField};
+use nalgebra::{DMatrix, RealField, Vector3};
 
 /// Reusable buffers for evaluating a [`Tree`]: one serial [`Data`] per branch, the branch's
 /// joints and parameters, and a scratch Jacobian of the branch's columns.
 #[derive(Clone, Debug)]
 pub struct TreeData<T: RealField + Copy> {
-    /// Per branch, the serial model's evaluation (frames, targets, twists).
+    /// Per branch, the serial model's evaluation (frames, targets, twists); with bending,
+    /// its targets are bent by the branch's bend (the frames and twists stay rigid).
     pub branches: Vec<Data<T>>,
     q: Vec<Vec<T>>,
     params: Vec<Vec<f64>>,
@@ -34,6 +37,8 @@ pub struct TreeData<T: RealField + Copy> {
     local: Vec<Vec<Option<usize>>>,
     /// The compliance's term of each tree parameter that is a κ.
     kappa: Vec<Option<usize>>,
+    /// The bending term of each tree parameter that is a κ⊥.
+    bending: Vec<Option<usize>>,
     /// The joint compliance's levers and deflected joints; `None` without compliance.
     pub(crate) deflection: Option<Box<DeflectionData<T>>>,
 }
@@ -79,6 +84,13 @@ impl<T: RealField + Copy> TreeData<T> {
                         .and_then(|c| c.terms.iter().position(|t| t.param == i))
                 })
                 .collect(),
+            bending: (0..tree.param_count())
+                .map(|i| {
+                    tree.compliance
+                        .as_ref()
+                        .and_then(|c| c.bending.iter().position(|t| t.param == i))
+                })
+                .collect(),
             deflection: DeflectionData::new(tree).map(Box::new),
         }
     }
@@ -90,8 +102,8 @@ impl<T: RealField + Copy> TreeData<T> {
 }
 
 /// Evaluates branch `b` of `tree` at tree parameters `params` and tree joints `q` into
-/// `data.branches[b]` (with compliance, at the deflected joints `q + Δq(q)`). Allocates
-/// nothing.
+/// `data.branches[b]` (with compliance, at the deflected joints `q + Δq(q)`; with bending,
+/// its targets then bent by `D_b`, the frames and twists left rigid). Allocates nothing.
 pub fn branch_kinematics<T: RealField + Copy>(
     tree: &Tree,
     data: &mut TreeData<T>,
@@ -116,12 +128,43 @@ pub fn branch_kinematics<T: RealField + Copy>(
         &data.params[b],
         &data.q[b],
     );
+    if let (Some(d), Some(c)) = (data.deflection.as_mut(), &tree.compliance) {
+        d.bending.bend(c, b, &mut data.branches[b]);
+    }
+}
+
+/// The bend of branch `b` in `data`, if its targets bend.
+fn bend_of<T: RealField + Copy>(data: &TreeData<T>, b: usize) -> Option<&BranchBend<T>> {
+    data.deflection
+        .as_ref()
+        .map(|d| &d.bending.branches[b])
+        .filter(|bend| bend.active)
+}
+
+/// The world motion (velocity of the point, angular velocity) of target `local` of a branch
+/// evaluated in `data` under a world twist `tw` of the structure before the bend `bend`:
+/// `(Exp(δ) (ω × p + v), Exp(δ) ω)` at the rigid target `p`; without a bend, `tw` at the
+/// target.
+fn downstream<T: RealField + Copy>(
+    data: &Data<T>,
+    bend: Option<&BranchBend<T>>,
+    local: usize,
+    tw: &Twist<T>,
+) -> (Vector3<T>, Vector3<T>) {
+    match bend {
+        Some(bend) => (
+            bend.rot * tw.point_velocity(&bend.rigid[local].trans),
+            bend.rot * tw.w,
+        ),
+        None => (tw.point_velocity(&data.targets[local].trans), tw.w),
+    }
 }
 
 /// The identification Jacobian of tree target `target` (its branch evaluated by
 /// [`branch_kinematics`]) for the tree parameters `columns`, into `out` at rows
 /// `row..row + rows.count()`: the branch's columns scattered, zero for a parameter not on
-/// the branch.
+/// the branch; a κ's and a κ⊥'s column from the deflection, the chain's mapped by the bend
+/// (module notes).
 #[allow(clippy::too_many_arguments)]
 pub fn tree_identification_jacobian<T: RealField + Copy>(
     tree: &Tree,
@@ -134,62 +177,72 @@ pub fn tree_identification_jacobian<T: RealField + Copy>(
 ) {
     let (_, b, k) = tree.targets[target];
     let model = &tree.branches[b].model;
-    let scratch = &mut data.scratch[b];
+    // the serial columns at the (bent) target: the instrument's as they are
     identification_jacobian(
         model,
         &data.branches[b],
         Observed::Target(k),
         rows,
         &data.all_columns[b],
-        scratch,
+        &mut data.scratch[b],
         0,
     );
+    let bend = bend_of(data, b);
+    let branch = &data.branches[b];
+    let rt = branch.instrument.rot.transpose();
     for (c, &t) in columns.iter().enumerate() {
-        match (data.local[b][t], data.kappa[t], &data.deflection) {
-            (Some(i), _, _) => {
-                for r in 0..rows.count() {
-                    out[(row + r, c)] = scratch[(r, i)];
+        let motion = match (
+            data.local[b][t],
+            data.kappa[t],
+            data.bending[t],
+            &data.deflection,
+        ) {
+            (Some(i), _, _, _) => {
+                let bent_chain = bend.is_some()
+                    && influence(model.registry.get(i).segment, Observed::Target(k)) > 0.0;
+                if !bent_chain {
+                    for r in 0..rows.count() {
+                        out[(row + r, c)] = data.scratch[b][(r, i)];
+                    }
+                    continue;
                 }
+                downstream(branch, bend, k, &branch.param_twists[i])
             }
-            (None, Some(term), Some(d)) => {
-                let k = tree.compliance.as_ref().expect("a κ").terms[term].joint;
-                kappa_column(
-                    tree,
-                    &data.branches[b],
-                    b,
-                    k,
-                    d.lever[term],
-                    target,
-                    rows,
-                    out,
-                    (row, c),
-                );
+            (None, Some(term), _, Some(d)) => {
+                let joint = tree.compliance.as_ref().expect("a κ").terms[term].joint;
+                let tw = kappa_twist(tree, branch, b, joint, d.lever[term]);
+                downstream(branch, bend, k, &tw)
             }
-            _ => {
-                for r in 0..rows.count() {
-                    out[(row + r, c)] = T::zero();
+            (None, None, Some(term), Some(d)) => match bend {
+                Some(bend) if tree.compliance.as_ref().expect("a κ⊥").bending[term].branches[b] =>
+                {
+                    let dw = bend.left * d.bending.w[term];
+                    let p = branch.targets[k].trans - bend.trans;
+                    (dw.cross(&p) + d.bending.u[term], dw)
                 }
+                _ => (Vector3::zeros(), Vector3::zeros()),
+            },
+            _ => (Vector3::zeros(), Vector3::zeros()),
+        };
+        let (dp, dw) = (rt * motion.0, rt * motion.1);
+        for r in 0..3 {
+            out[(row + r, c)] = dp[r];
+            if rows == Rows::Pose {
+                out[(row + 3 + r, c)] = dw[r];
             }
         }
     }
 }
 
-/// The column of a compliance κ of tree joint `k` with lever `lever` for tree target
-/// `target` of branch `b` (evaluated in `data`) at `out[at]`: the observed frame's motion
-/// under the twist `ℓ Σ_i C_b[i, k] ξ_i`, in the instrument frame (as
-/// [`identification_jacobian`] writes a chain parameter's).
-#[allow(clippy::too_many_arguments)]
-fn kappa_column<T: RealField + Copy>(
+/// The world twist a unit κ of tree joint `k` with lever `lever` gives branch `b`
+/// (evaluated in `data`): `ℓ Σ_i C_b[i, k] ξ_i`.
+fn kappa_twist<T: RealField + Copy>(
     tree: &Tree,
     data: &Data<T>,
     b: usize,
     k: usize,
     lever: T,
-    target: usize,
-    rows: Rows,
-    out: &mut DMatrix<T>,
-    (row, c): (usize, usize),
-) {
+) -> Twist<T> {
     let mut tw = Twist::zero();
     for (i, joint) in data.joint_twists.iter().enumerate() {
         let ci = coefficient(&tree.branches[b], i, k);
@@ -199,34 +252,28 @@ fn kappa_column<T: RealField + Copy>(
             tw.v += joint.v * s;
         }
     }
-    let (_, _, local) = tree.targets[target];
-    let p = observed_world(data, Observed::Target(local)).trans;
-    let rt = data.instrument.rot.transpose();
-    let dp = rt * tw.point_velocity(&p);
-    let dw = rt * tw.w;
-    for r in 0..3 {
-        out[(row + r, c)] = dp[r];
-        if rows == Rows::Pose {
-            out[(row + 3 + r, c)] = dw[r];
-        }
-    }
+    tw
 }
 
 /// Geometric joint Jacobian (world frame, 6 × tree joints) of tree target `target`, its
-/// branch evaluated by [`branch_kinematics`]: the branch's `J_b` times `∂q_b/∂q = C_b`.
+/// branch evaluated by [`branch_kinematics`]: the branch's `J_b` times `∂q_b/∂q = C_b`,
+/// with compliance through `q + Δq(q)`, with bending mapped by the bend and through
+/// `δ_b(q)`, `t_b(q)` ([`crate::model::tree::bending`]).
 pub fn tree_joint_jacobian<T: RealField + Copy>(
     tree: &Tree,
     data: &TreeData<T>,
     target: usize,
 ) -> DMatrix<T> {
     let (_, b, k) = tree.targets[target];
-    let jb = joint_jacobian(&data.branches[b], Observed::Target(k));
+    let (branch, bend) = (&data.branches[b], bend_of(data, b));
     let mut j = DMatrix::zeros(6, tree.dof());
     for (i, map) in tree.branches[b].joints.iter().enumerate() {
+        let (dp, dw) = downstream(branch, bend, k, &branch.joint_twists[i]);
         for &(t, c) in &map.terms {
             let c: T = nalgebra::convert(c);
-            for r in 0..6 {
-                j[(r, t)] += jb[(r, i)] * c;
+            for r in 0..3 {
+                j[(r, t)] += dp[r] * c;
+                j[(r + 3, t)] += dw[r] * c;
             }
         }
     }
@@ -241,6 +288,18 @@ pub fn tree_joint_jacobian<T: RealField + Copy>(
                 for r in 0..6 {
                     j[(r, m)] += deflected[(r, term.joint)] * a;
                 }
+            }
+        }
+    }
+    if let Some(bend) = bend {
+        // the bend's own motion: (J_l ∂δ/∂q) × (p' − t) + ∂t/∂q, J_l ∂δ/∂q
+        let p = branch.targets[k].trans - bend.trans;
+        for m in 0..tree.dof() {
+            let dw = bend.left * bend.rot_rate[m];
+            let dp = dw.cross(&p) + bend.trans_rate[m];
+            for r in 0..3 {
+                j[(r, m)] += dp[r];
+                j[(r + 3, m)] += dw[r];
             }
         }
     }

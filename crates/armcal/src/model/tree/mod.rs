@@ -48,6 +48,7 @@ use crate::Error;
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 
+pub mod bending;
 pub mod compliance;
 pub mod identifiability;
 pub mod kinematics;
@@ -97,9 +98,9 @@ pub struct TreeSpec {
     pub links: Vec<TreeLinkSpec>,
     /// The targets, each naming its link.
     pub targets: Vec<TreeTargetSpec>,
-    /// Joint compliance over the tree ([`compliance`]): gravity, the lever geometry (the
-    /// tree's nominal parameters) and the lumped terms, each naming its tree joint and the
-    /// joint on whose axis its mass sits.
+    /// Joint and lateral compliance over the tree ([`compliance`], [`bending`]): gravity,
+    /// the lever geometry (the tree's nominal parameters) and the lumped joint and bending
+    /// terms, each naming its tree joint and the joint on whose axis its mass sits.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub compliance: Option<crate::model::compliance::ComplianceSpec>,
 }
@@ -390,6 +391,9 @@ impl Tree {
         }
         if let (Some(c), Some(given)) = (&self.compliance, spec.compliance.as_mut()) {
             for (term, t) in c.terms.iter().zip(&mut given.terms) {
+                t.value = params[term.param];
+            }
+            for (term, t) in c.bending.iter().zip(&mut given.bending) {
                 t.value = params[term.param];
             }
         }

@@ -7,6 +7,7 @@
 
 use crate::common::*;
 use armcal::model::identifiability::{IdentifiabilitySettings, Measurement};
+use armcal::model::tree::bending::lumped_tree_bending;
 use armcal::model::tree::compliance::lumped_tree_compliance;
 use armcal::model::tree::identifiability::{analyze_tree, expected_tree_count};
 use armcal::model::tree::kinematics::*;
@@ -163,6 +164,49 @@ fn compliant(spec: TreeSpec) -> TreeSpec {
     }
 }
 
+/// `spec` (with or without joint compliance) with lateral (bending) compliance on the torso
+/// joint, the second joint of the right arm (it drives the coupled joint) and the third of
+/// the left, every
+/// κ⊥ at a value that bends by milliradians, or by centiradians for `seed` 0 (the
+/// rotation's closed form rather than its series).
+fn bent(spec: TreeSpec, seed: u64) -> TreeSpec {
+    let tree = Tree::from_spec(&TreeSpec {
+        compliance: None,
+        ..spec.clone()
+    })
+    .unwrap();
+    let joints = ["q_t1", "q_a0j2", "q_a1j3"].map(String::from);
+    let gravity = [0.3, -0.2, -1.0];
+    let mut bending = lumped_tree_bending(&tree, &joints, gravity).unwrap();
+    assert!(
+        bending
+            .iter()
+            .any(|t| t.joint == "q_t1" && t.at.as_deref().unwrap().starts_with("q_a0"))
+            && bending
+                .iter()
+                .any(|t| t.joint == "q_t1" && t.at.as_deref().unwrap().starts_with("q_a1")),
+        "the torso bends under both arms: {bending:?}"
+    );
+    let scale = if seed == 0 { 2e-5 } else { 2e-6 };
+    for (i, t) in bending.iter_mut().enumerate() {
+        t.value = scale * (1.0 + 0.3 * i as f64);
+    }
+    let mut c =
+        spec.compliance
+            .clone()
+            .unwrap_or_else(|| armcal::model::compliance::ComplianceSpec {
+                gravity,
+                levers: tree.nominal(),
+                terms: Vec::new(),
+                bending: Vec::new(),
+            });
+    c.bending = bending;
+    TreeSpec {
+        compliance: Some(c),
+        ..spec
+    }
+}
+
 #[test]
 fn tree_identification_jacobian_matches_finite_differences() {
     identification_jacobian_matches_finite_differences(coupled_dual_arm);
@@ -174,6 +218,15 @@ fn tree_identification_jacobian_matches_finite_differences() {
 #[test]
 fn compliant_tree_identification_jacobian_matches_finite_differences() {
     identification_jacobian_matches_finite_differences(|s| compliant(coupled_dual_arm(s)));
+}
+
+/// With lateral compliance alone and with joint compliance: the κ⊥ columns (a torso bent by
+/// both arms' masses moves both arms' targets), the chain's columns mapped by the bend and
+/// the instrument's at the bent targets.
+#[test]
+fn bent_tree_identification_jacobian_matches_finite_differences() {
+    identification_jacobian_matches_finite_differences(|s| bent(coupled_dual_arm(s), s));
+    identification_jacobian_matches_finite_differences(|s| bent(compliant(coupled_dual_arm(s)), s));
 }
 
 fn identification_jacobian_matches_finite_differences(spec: fn(u64) -> TreeSpec) {
@@ -205,7 +258,7 @@ fn identification_jacobian_matches_finite_differences(spec: fn(u64) -> TreeSpec)
                 for j in 0..n {
                     let name = &tree.registry.get(j).name;
                     // a κ of 1e-6 rad/mm turns a joint by a milliradian: a step of its own
-                    let h = if name.contains(".compliance.") {
+                    let h = if name.contains(".compliance.") || name.contains(".bending.") {
                         1e-7
                     } else {
                         1e-6
@@ -245,6 +298,16 @@ fn tree_joint_jacobian_matches_finite_differences_and_dual_numbers() {
 #[test]
 fn compliant_tree_joint_jacobian_matches_finite_differences_and_dual_numbers() {
     joint_jacobian_matches_finite_differences_and_dual_numbers(|s| compliant(coupled_dual_arm(s)));
+}
+
+/// With lateral compliance alone and with joint compliance: the chain rule through the
+/// bend `δ_b(q)`, `t_b(q)`, whose levers, pivots and axes turn with the joints before them.
+#[test]
+fn bent_tree_joint_jacobian_matches_finite_differences_and_dual_numbers() {
+    joint_jacobian_matches_finite_differences_and_dual_numbers(|s| bent(coupled_dual_arm(s), s));
+    joint_jacobian_matches_finite_differences_and_dual_numbers(|s| {
+        bent(compliant(coupled_dual_arm(s)), s)
+    });
 }
 
 fn joint_jacobian_matches_finite_differences_and_dual_numbers(spec: fn(u64) -> TreeSpec) {
