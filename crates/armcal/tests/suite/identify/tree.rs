@@ -318,7 +318,7 @@ fn a_compliant_tree_exports_rigid_and_says_what_that_costs() {
 /// estimate records both candidates' scores with the fit of the one chosen.
 #[test]
 fn auto_on_a_tree_keeps_the_compliance_only_where_the_data_need_it() {
-    let cell = compliant_dual_arm("");
+    let cell = compliant_dual_arm("", false);
     let opts = IdentifySettings {
         nongeometric: NonGeometric::Auto { folds: 5 },
         ..IdentifySettings::default()
