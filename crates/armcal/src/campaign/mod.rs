@@ -48,8 +48,8 @@ pub fn fewest_poses(cell: &Cell) -> Result<usize, Error> {
 ///
 /// ```
 /// use armcal::{campaign_start, campaign_step, CampaignDecision as Decision, CampaignSettings};
-/// use armcal::progress::Silent;
-/// use armcal::sim::{perturbed_truth, Perturbation};
+/// use armcal::Silent;
+/// use armcal::{perturbed_truth, Perturbation};
 ///
 /// # fn main() -> armcal::Result<()> {
 /// let cell = armcal::cell::builtin::paper_cell()?;

@@ -401,7 +401,7 @@ pub fn simulate_poses(
 /// "prediction".
 ///
 /// ```
-/// use armcal::model::identifiability::Measurement;
+/// use armcal::Measurement;
 /// use armcal::model::random_configurations;
 /// use armcal::{predict, simulate};
 ///

@@ -37,13 +37,14 @@
 //! URDF links are the joint frames, not armcal's link-end frames; the end of the chain and the
 //! targets are exact.
 
-pub mod calibration;
+pub(crate) mod calibration;
 pub mod depth;
 pub(crate) mod export;
 pub(crate) mod import;
 pub mod joint_corrections;
 pub(crate) mod tree;
 
+pub use calibration::{conservative, Dropped};
 pub use export::to_urdf;
 pub use import::{
     from_urdf_robot, from_urdf_str, from_urdf_str_with_collisions, read_urdf,

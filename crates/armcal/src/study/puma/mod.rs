@@ -15,10 +15,12 @@
 
 pub(crate) mod book;
 pub(crate) mod poses;
-pub mod record;
+pub(crate) mod record;
+pub(crate) mod settings;
 
 pub use book::*;
 pub use poses::*;
+pub(crate) use settings::PumaSettings;
 
 use crate::identify::{solve, IdentifySettings, Problem};
 use crate::measure::{Dataset, NoiseModel};
@@ -30,24 +32,6 @@ use crate::robots::puma560::{book_dh_spec, book_zrp_spec, MM_PER_IN};
 use crate::sim::simulate;
 use crate::Error;
 use serde::{Deserialize, Serialize};
-
-/// Settings of [`run`].
-#[derive(Clone, Debug)]
-pub struct PumaSettings {
-    /// Seed of the measurement noise (identification data; the held-out data use seed + 1).
-    pub seed: u64,
-    /// Seed of the pose grid's orientations and of the held-out poses.
-    pub pose_seed: u64,
-}
-
-impl Default for PumaSettings {
-    fn default() -> Self {
-        PumaSettings {
-            seed: 1,
-            pose_seed: 6,
-        }
-    }
-}
 
 /// One identification.
 #[derive(Clone, Debug, Serialize, Deserialize)]

@@ -6,9 +6,7 @@
 //! `cargo test --release -p armcal --test suite real_data::motoman_tree -- --nocapture`.
 
 use super::motoman_calibration::motoman;
-use armcal::identify::{identify, IdentifySettings};
-use armcal::progress::Silent;
-use armcal::{identify_tree, TreeCell};
+use armcal::{identify, identify_tree, IdentifySettings, Silent, TreeCell};
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {
