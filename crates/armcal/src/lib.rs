@@ -10,7 +10,7 @@
 //! A cell ([`Cell`]: robot, instrument, targets, working poses, obstacles) gives the
 //! [`Model`]; [`plan`] chooses measurement poses and [`assess`] predicts what any design
 //! gives; [`simulate`] measures a virtual robot (or a [`Dataset`] is read from a file with
-//! [`measure::csv::read`]); [`identify`] fits the parameters with their uncertainty into an
+//! [`measure::csv::read`]); [`identify()`] fits the parameters with their uncertainty into an
 //! [`Estimate`]; [`calibrated_ik`] and [`compensate()`] use it; [`performance`] proves
 //! it (ISO 9283 accuracy and repeatability). Every solver reports a [`Status`] and its
 //! progress to an [`Observer`]; every file armcal writes is a typed record of the module

@@ -177,7 +177,7 @@ pub fn half_space_unit_normal(
 /// about 0.4 in a cell whose tracker stands 2 m or more away), so 20 mm covers 50 mm of
 /// tracker error there; an obstacle near the tracker needs more. `armcal evaluate
 /// --tracker-shift-mm D` checks a design exactly against a tracker `D` mm off in any
-/// direction ([`crate::design::cell_constraints::tracker_shift`]).
+/// direction (`crate::design::cell_constraints::tracker_shift`).
 ///
 /// The paper's cells set all four to 0: the paper's constraints (eq. 4, eq. 24b) have no
 /// margin, and its Tables 6–8 are reproduced with none.

@@ -86,7 +86,7 @@ use split::Split;
 /// unknown and written as `[0, 0, 0]` lies on the last joint axis there, where two
 /// parameters of that joint have no effect), and the reason for every parameter left out.
 /// A parameter the same analysis at the nominal leaves out is freed there only if the
-/// data determine it ([`weak_gain`]: variance inflation at most [`DETERMINED_VIF`]), so
+/// data determine it (`weak_gain`: variance inflation at most [`DETERMINED_VIF`]), so
 /// `plan`'s prediction at the nominal and the fit agree on a target on the last axis.
 /// With `free = "auto"` the free set is the minimal identifiable set *at the data's
 /// configurations*; parameters these data cannot identify although the cell could (e.g. a

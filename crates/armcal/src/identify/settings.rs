@@ -58,7 +58,7 @@ pub struct IdentifySettings {
     /// Settings of Levenberg–Marquardt (also inside a robust fit); Gauss–Newton stops by
     /// its tolerances.
     pub lm: LmSettings,
-    /// A frames refit ([`refit`](super::refit)): keep the robot of this estimate and fit only the
+    /// A frames refit (`refit`): keep the robot of this estimate and fit only the
     /// instrument, base, tool and target frames. `None`: a full calibration.
     pub refit: Option<FramesRefit>,
     /// Warm start: every parameter of the cell's model (internal units), e.g. a previous
@@ -67,12 +67,12 @@ pub struct IdentifySettings {
     /// free set is decided there. `None`: the frames-first start.
     pub start: Option<Vec<f64>>,
     /// Which of the cell's non-geometric terms (compliance, periodic errors) the fit keeps,
-    /// or a choice by cross-validation ([`nongeometric_choice`](super::nongeometric_choice)).
+    /// or a choice by cross-validation (`nongeometric_choice`).
     pub nongeometric: NonGeometric,
-    /// Run the joint sign and zero diagnosis ([`sign_diagnosis`](super::sign_diagnosis)) even without a gross
+    /// Run the joint sign and zero diagnosis (`sign_diagnosis`) even without a gross
     /// misfit (it always runs on an unexplained one).
     pub diagnose_signs: bool,
-    /// How the caller accepts a fit the checks refuse ([`fit_checks`](super::fit_checks): a gross misfit or a
+    /// How the caller accepts a fit the checks refuse (`fit_checks`: a gross misfit or a
     /// unit mistake), in its own words (the CLI: its flag); recorded in the estimate, whose
     /// every later use then says so. `None`: not accepted.
     pub accept_misfit: Option<String>,

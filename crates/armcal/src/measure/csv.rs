@@ -14,7 +14,7 @@
 //!   and `sigma_roll` … for pose rows (σ of the residual's rotation rows);
 //! * `temperature_c` — air temperature at the measurement, °C (a covariate);
 //! * `station` — the instrument station the row was measured from
-//!   ([`crate::model::station`]); with it, a configuration is a (station, `pose_id`) pair;
+//!   (`crate::model::station`); with it, a configuration is a (station, `pose_id`) pair;
 //! * `payload` — the payload the robot carried (a cell's `[[payload]]` name; empty or
 //!   `none`: no payload; [`crate::model::compliance`]); with it, a configuration is a
 //!   (station, payload, `pose_id`) triple, so one pose list measured with two payloads

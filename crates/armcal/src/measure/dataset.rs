@@ -17,7 +17,7 @@ pub struct Dataset {
     pub source: String,
     /// The instrument stations the data name (a `station` column, or
     /// [`Dataset::at_station`]), in order of first appearance; empty: one station, the
-    /// cell's instrument pose ([`crate::model::station`]).
+    /// cell's instrument pose (`crate::model::station`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub stations: Vec<String>,
     /// The station of each configuration, an index into `stations`; empty when `stations`
@@ -87,7 +87,7 @@ impl Dataset {
     }
 
     /// Each configuration's payload as an index into `model`'s payloads
-    /// ([`Model::payload_index`]); an error names a payload the model does not have.
+    /// ([`Model::payload_index`](crate::Model::payload_index)); an error names a payload the model does not have.
     pub fn model_payloads(
         &self,
         model: &crate::model::Model,
@@ -130,7 +130,7 @@ impl Dataset {
 
     /// Every configuration of this data set at station `name` (the data of one set-up,
     /// before they are appended to another's, [`Dataset::append`]). The name is checked
-    /// ([`crate::model::station::check_name`]); data that name their own stations already
+    /// (`crate::model::station::check_name`); data that name their own stations already
     /// are an error.
     pub fn at_station(mut self, name: &str) -> Result<Dataset, crate::Error> {
         crate::model::station::check_name(name)

@@ -90,8 +90,8 @@ impl MeasurementKind {
 
     /// The identification Jacobian rows of the kind's residual at a zero residual: a
     /// position's 3 rows, a pose's 6 (position, then rotation: `J_l⁻¹(φ)` of
-    /// [`residual::residual_rows`] is the identity at φ = 0); `None` for the one-row kinds,
-    /// whose rows are projections ([`residual::residual_rows`]).
+    /// `residual::residual_rows` is the identity at φ = 0); `None` for the one-row kinds,
+    /// whose rows are projections (`residual::residual_rows`).
     pub fn jacobian_rows(&self) -> Option<Rows> {
         match self {
             MeasurementKind::Position { .. } => Some(Rows::Position),

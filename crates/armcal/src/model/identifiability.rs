@@ -123,7 +123,7 @@ pub struct Completeness {
     /// `4R + 2P + 6` (book eq. 2.49): parameters of a complete, minimal model of the
     /// pose of the tool relative to the world.
     pub complete_pose_model: usize,
-    /// What the measurement type identifies in generic geometry (see [`expected_count`]).
+    /// What the measurement type identifies in generic geometry (see `expected_count`).
     pub expected_for_measurement: Option<usize>,
 }
 
@@ -162,7 +162,7 @@ pub struct Identifiability {
 }
 
 /// An identifiable set counted the one way `model` and `identify` state it: the geometric
-/// parameters, which the generic count ([`expected_count`]) covers, and the non-geometric
+/// parameters, which the generic count (`expected_count`) covers, and the non-geometric
 /// terms (joint compliance, periodic gear errors) apart.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct IdentifiableCount {

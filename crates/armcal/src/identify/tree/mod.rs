@@ -107,7 +107,7 @@ pub struct TreeEstimate {
 }
 
 impl TreeEstimate {
-    /// The record as JSON (keys in alphabetical order, [`crate::json`]).
+    /// The record as JSON (keys in alphabetical order, `crate::json`).
     pub fn to_json(&self) -> Result<String, Error> {
         crate::json::sorted_pretty(self)
     }
@@ -280,7 +280,7 @@ fn data_measurement(data: &Dataset) -> Measurement {
 /// at random, seeded, or `opts.test`). A fit that did not converge says so in its status.
 ///
 /// With the cell's joint compliance (`--nongeometric` as the cell, or `compliance`) the κ
-/// are fitted with the geometry and gated ([`crate::identify::nongeometric_gate`]): while a
+/// are fitted with the geometry and gated (`crate::identify::nongeometric_gate`): while a
 /// term is not separable, the least separable is dropped (its reason kept) and the tree
 /// fitted again; `--nongeometric none` fits the rigid tree.
 ///

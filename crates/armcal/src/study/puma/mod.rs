@@ -5,7 +5,7 @@
 //!
 //! * Truth: the identified robot of Table 6.5; the CMM measures the full end-effector pose
 //!   with the σ of Table 6.4 (seeded noise).
-//! * Poses (§6.2, Figs. 6.9–6.10, [`poses`]): [`book_poses`], 50 on a 3 × 2 × 2 grid in the four arm
+//! * Poses (§6.2, Figs. 6.9–6.10, `poses`): [`book_poses`], 50 on a 3 × 2 × 2 grid in the four arm
 //!   configurations with random orientations, plus 10 held-out poses in the grid box.
 //! * Errors (eqs. 6.41–6.42): [`pose_errors`], δr = |translation of Pm⁻¹Pp|,
 //!   δθ = rotation angle of Pm⁻¹Pp.
