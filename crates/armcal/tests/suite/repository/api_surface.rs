@@ -702,16 +702,16 @@ fn api_surface_is_the_committed_one() {
     );
 }
 
-/// `mod f { … } pub use f::{f, S};` re-exports the function and the struct only: the private
-/// module of the same name adds no path (it once gave `TrackerShift` a second one, through
-/// `design::cell_constraints::tracker_shift`).
+/// `mod f { use super::*; … } pub use f::{f, S};` re-exports the function and the struct
+/// only: the private module of the same name, which the glob brings into `f`, adds no path (it
+/// once gave `TrackerShift` a second one, through `design::cell_constraints::tracker_shift`).
 #[test]
 fn a_private_module_named_like_its_re_export_adds_no_path() {
     let dir = std::env::temp_dir().join(format!("armcal-api-surface-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(
         dir.join("lib.rs"),
-        "mod f { pub fn f() {} pub struct S; } pub use f::{f, S};",
+        "mod f { use super::*; pub fn f() {} pub struct S; } pub use f::{f, S};",
     )
     .unwrap();
     let krate = Crate::read(&dir);
