@@ -126,8 +126,7 @@ pub use sim::{
 // Identification, its checks, the prediction σ of any configuration, joint axes by circle
 // point analysis.
 pub use identify::circle_point::record::{axes_record, AxesRecord};
-pub use identify::estimate::{Acceptance, Estimate};
-pub use identify::estimate::{ParameterEstimate, SolverReport};
+pub use identify::estimate::{Acceptance, Estimate, ParameterEstimate, SolverReport};
 pub use identify::fit_checks::FitChecks;
 pub use identify::lm::LmSettings;
 pub use identify::nongeometric_choice::{Candidate, NonGeometric};
