@@ -5,18 +5,14 @@
 //! unbounded allocation is a finding. The round trips (`export` → read, `write` → read) assert
 //! armcal's own promise that every file it writes, it can read (issue 12).
 
-use armcal::cell::export::{export_model, ExportFormat};
-use armcal::design::assess::evaluate_design;
-use armcal::design::cell_constraints::unmeasurable_poses;
-use armcal::design::user_pool::{plan_from_pool, PoolSettings};
-use armcal::identify::IdentifySettings;
+use armcal::design::plan_from_pool;
 use armcal::measure::csv;
-use armcal::model::complete::LinkForm;
-use armcal::model::identifiability::IdentifiabilitySettings;
 use armcal::model::{random_configurations, tool_pose};
-use armcal::progress::Silent;
 use armcal::report::{page, Document, Input, ReportContent};
-use armcal::{analyze_model, Cell, Model};
+use armcal::{
+    analyze_model, evaluate_design, export_model, unmeasurable_poses, Cell, ExportFormat,
+    IdentifiabilitySettings, IdentifySettings, LinkForm, Model, PoolSettings, Silent,
+};
 use std::path::Path;
 use std::sync::OnceLock;
 
@@ -169,7 +165,9 @@ pub fn urdf(text: &str) {
     for shape in &shapes {
         if let Some(c) = armcal::robots::bounding::bounding_capsule(shape) {
             assert!(
-                c.radius >= 0.0 && c.radius.is_finite() && c.a.iter().chain(&c.b).all(|v| v.is_finite()),
+                c.radius >= 0.0
+                    && c.radius.is_finite()
+                    && c.a.iter().chain(&c.b).all(|v| v.is_finite()),
                 "a collision shape of link `{}` was bounded by {c:?}",
                 shape.link
             );
@@ -234,8 +232,12 @@ pub fn ur_kinematics(text: &str) {
     let Ok(file) = to_ur_kinematics(&spec, "fuzz") else {
         return;
     };
-    let again = from_ur_kinematics_str(&file.text)
-        .unwrap_or_else(|e| panic!("armcal cannot read the UR file it wrote: {e}\n{}", file.text));
+    let again = from_ur_kinematics_str(&file.text).unwrap_or_else(|e| {
+        panic!(
+            "armcal cannot read the UR file it wrote: {e}\n{}",
+            file.text
+        )
+    });
     same_tool_poses(&spec, &again, &file.text);
 }
 
@@ -259,8 +261,12 @@ pub fn joint_corrections(text: &str) {
     let Ok(file) = to_joint_corrections(&spec, &chain, "fuzz") else {
         return;
     };
-    let again = apply_joint_corrections(&file.text, &chain)
-        .unwrap_or_else(|e| panic!("armcal cannot read the corrections it wrote: {e}\n{}", file.text));
+    let again = apply_joint_corrections(&file.text, &chain).unwrap_or_else(|e| {
+        panic!(
+            "armcal cannot read the corrections it wrote: {e}\n{}",
+            file.text
+        )
+    });
     same_tool_poses(&spec, &again, &file.text);
 }
 
@@ -272,7 +278,7 @@ pub fn records(text: &str) {
     };
     match &document {
         Document::Estimate(e) => {
-            let _ = e.check_usable(&armcal::identify::Acceptance {
+            let _ = e.check_usable(&armcal::Acceptance {
                 accepted: false,
                 accept: "accept",
                 raise_iterations: "raise",
@@ -291,12 +297,8 @@ pub fn records(text: &str) {
                     let _ = e.outside_fitted_ranges(&model, &poses);
                     for payload in std::iter::once(None).chain((0..model.payloads.len()).map(Some))
                     {
-                        for measured in [
-                            armcal::model::identifiability::Measurement::Position,
-                            armcal::model::identifiability::Measurement::Pose,
-                        ] {
-                            let _ =
-                                armcal::sim::predict(&model, &params, &poses, payload, measured);
+                        for measured in [armcal::Measurement::Position, armcal::Measurement::Pose] {
+                            let _ = armcal::predict(&model, &params, &poses, payload, measured);
                         }
                     }
                 }
@@ -333,21 +335,19 @@ pub fn records(text: &str) {
 
 /// An estimate of the paper cell → a drift check on three simulated poses of its robot, and
 /// the prior of a campaign after it (the first group released).
-fn drift_check(e: &armcal::identify::Estimate) {
+fn drift_check(e: &armcal::Estimate) {
     let cell = &data_cells()[0];
     let Ok(params) = e.params_for(&cell.model) else {
         return;
     };
     let qs = random_configurations(&cell.model, 3, 2);
-    let Ok(data) = armcal::sim::simulate(&cell.model, &params, &qs, None, 0) else {
+    let Ok(data) = armcal::simulate(&cell.model, &params, &qs, None, 0) else {
         return;
     };
     let settings = armcal::CheckSettings::default();
     if let Ok(c) = armcal::check(cell, e, &data, &settings) {
         let released = c.moved_groups().into_iter().take(1).collect::<Vec<_>>();
-        if let Ok(p) =
-            armcal::CampaignPrior::from_estimate(cell, e, "fuzz.json", &released)
-        {
+        if let Ok(p) = armcal::CampaignPrior::from_estimate(cell, e, "fuzz.json", &released) {
             let _ = p.apply(cell);
         }
     }
@@ -391,7 +391,14 @@ pub fn controller_program(text: &str, language: armcal::ProgramLanguage) {
         ik: armcal::IkSettings::default(),
     };
     let run = |t: &str| {
-        armcal::filter_controller_program(&cell.model, calibrated, &cell.controller, t, "fuzz", &settings)
+        armcal::filter_controller_program(
+            &cell.model,
+            calibrated,
+            &cell.controller,
+            t,
+            "fuzz",
+            &settings,
+        )
     };
     let Ok(first) = run(text) else {
         return;
@@ -403,6 +410,9 @@ pub fn controller_program(text: &str, language: armcal::ProgramLanguage) {
             "the filtered program has another number of targets:\n{}",
             first.text
         ),
-        Err(e) => panic!("armcal cannot read the program it wrote: {e}\n{}", first.text),
+        Err(e) => panic!(
+            "armcal cannot read the program it wrote: {e}\n{}",
+            first.text
+        ),
     }
 }

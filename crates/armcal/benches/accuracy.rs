@@ -2,11 +2,11 @@
 //! 20 000 commanded poses each approached 4 times (encoder jitter well below the grouping
 //! tolerance), grouped into ISO 9283 poses and compared with the model.
 
-use armcal::accuracy::report::{accuracy_report, Orientation};
-use armcal::accuracy::same_pose::{commanded_poses, SamePose};
-use armcal::cell::Cell;
 use armcal::model::random_configurations;
-use armcal::sim::{perturbed_truth, simulate, Perturbation};
+use armcal::{
+    accuracy_report, commanded_poses, perturbed_truth, simulate, AccuracyOrientation, Cell,
+    Perturbation, SamePose,
+};
 use criterion::{criterion_group, criterion_main, Criterion};
 
 use armcal::cell::builtin::PAPER_CELL as CELL;
@@ -46,8 +46,14 @@ fn accuracy(c: &mut Criterion) {
                 &data.config_ids,
                 &SamePose::default(),
             );
-            let report = accuracy_report(model, &nominal, &data, &poses, Orientation::IfMeasured)
-                .expect("position data");
+            let report = accuracy_report(
+                model,
+                &nominal,
+                &data,
+                &poses,
+                AccuracyOrientation::IfMeasured,
+            )
+            .expect("position data");
             assert_eq!(report.poses.len(), 20_000);
             report
         })

@@ -6,11 +6,10 @@
 //! * a program path of nearby targets (≈ 1° per joint between rows), each seeded from the
 //!   previous row's solution, as in program filtering.
 
-use armcal::cell::Cell;
-use armcal::compensate::{CalibratedIk, IkSettings, IkTarget};
+use armcal::compensate::CalibratedIk;
 use armcal::model::random_configurations;
 use armcal::model::{forward_kinematics, Data};
-use armcal::sim::{perturbed_truth, Perturbation};
+use armcal::{perturbed_truth, Cell, IkSettings, IkTarget, Perturbation};
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 
 use armcal::cell::builtin::PAPER_CELL as CELL;

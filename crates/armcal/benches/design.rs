@@ -9,16 +9,12 @@
 //! The 90-manipulator study is timed by the CLI:
 //! `time ./target/release/armcal study paper --collisions on --out DIR`.
 
-use armcal::cell::Cell;
 use armcal::design::baselines::random_feasible;
 use armcal::design::exchange::{exchange, ExchangeSettings};
-use armcal::design::information::DesignModel;
-use armcal::design::objective::DesignObjective;
-use armcal::design::plan::{
-    constraint_set, plan, CellConstraints, PlanSettings, EXCHANGE_TOLERANCE_BEFORE_REFINEMENT,
-};
-use armcal::design::Criterion as KpiCriterion;
-use armcal::progress::Silent;
+use armcal::design::DesignModel;
+use armcal::design::DesignObjective;
+use armcal::design::{constraint_set, CellConstraints, EXCHANGE_TOLERANCE_BEFORE_REFINEMENT};
+use armcal::{plan, Cell, Criterion as KpiCriterion, PlanSettings, Silent};
 use criterion::{criterion_group, criterion_main, Criterion};
 
 use armcal::cell::builtin::PAPER_CELL as CELL;

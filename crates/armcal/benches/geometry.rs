@@ -2,9 +2,9 @@
 //! every capsule constraint, paper eq. 20–23), and the full constraint set of the paper cell
 //! with obstacles (FK + 67 values + 67 × 6 Jacobian).
 
-use armcal::cell::Cell;
 use armcal::design::{ConstraintSet, ConstraintSettings};
 use armcal::geometry::segment_distance;
+use armcal::Cell;
 use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::Vector3;
 use std::hint::black_box;

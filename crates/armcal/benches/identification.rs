@@ -4,11 +4,9 @@
 //! the call the CLI and the Python package make (the Python figure is compared with this
 //! one, docs/src/reference/benchmarks.md).
 
-use armcal::cell::Cell;
-use armcal::identify::{levenberg_marquardt, LmSettings, Problem};
+use armcal::identify::{levenberg_marquardt, Problem};
 use armcal::model::random_configurations;
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, simulate, Perturbation};
+use armcal::{perturbed_truth, simulate, Cell, LmSettings, Perturbation, Silent};
 use criterion::{criterion_group, criterion_main, Criterion};
 
 use armcal::cell::builtin::PAPER_CELL as CELL;

@@ -2,8 +2,8 @@
 //! 27 free parameters), the mixed derivative ∂J/∂q, and its weighted sum ∂/∂q ⟨Ω, J⟩ (what
 //! a design gradient needs per pose).
 
-use armcal::cell::Cell;
 use armcal::model::*;
+use armcal::Cell;
 use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::DMatrix;
 use std::hint::black_box;

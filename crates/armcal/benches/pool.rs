@@ -7,13 +7,12 @@
 //! of the low-rank selection relative to the reference, `exp((log det M − log det M_ref)/n)`,
 //! are printed once before timing.
 
-use armcal::cell::Cell;
 use armcal::design::baselines::{greedy_then_exchange, random_feasible};
 use armcal::design::exchange::pool_jacobians;
-use armcal::design::plan::{constraint_set, CellConstraints};
 use armcal::design::selection::{select_d, SelectionSettings};
-use armcal::design::{Criterion as DesignCriterion, DesignModel};
-use armcal::progress::Silent;
+use armcal::design::DesignModel;
+use armcal::design::{constraint_set, CellConstraints};
+use armcal::{Cell, Criterion as DesignCriterion, Silent};
 use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::DMatrix;
 

@@ -8,10 +8,9 @@
 //! Run: `cargo run --release -p armcal --example accuracy_iso9283`
 //! (the same figures as `armcal accuracy`; guide: "Accuracy (ISO 9283)").
 
-use armcal::accuracy::iso9283::{position_accuracy, position_repeatability};
 use armcal::model::{random_configurations, tool_pose};
 use armcal::nalgebra::Vector3;
-use armcal::sim::{perturbed_truth, Perturbation};
+use armcal::{perturbed_truth, position_accuracy, position_repeatability, Perturbation};
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 

@@ -10,13 +10,11 @@
 //! Run: `cargo run --release -p armcal --example adaptive_campaign`
 //! (the same as `armcal campaign start` / `campaign step`; guide: "Campaigns and drift checks").
 
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, Perturbation};
 use armcal::{
     campaign_largest_sigma, campaign_start, campaign_step, CampaignDecision as Decision,
     CampaignSettings, CampaignState,
 };
-use armcal::{simulate, Dataset};
+use armcal::{perturbed_truth, simulate, Dataset, Perturbation, Silent};
 
 fn main() -> armcal::Result<()> {
     let cell = armcal::cell::builtin::paper_cell()?;

@@ -11,11 +11,12 @@
 
 use std::collections::BTreeMap;
 
-use armcal::compensate::program::filter_joint_program;
+use armcal::compensate::filter_joint_program;
 use armcal::model::{random_configurations, tool_pose};
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, Perturbation};
-use armcal::{identify, simulate, IdentifySettings, IkSettings, IkStatus};
+use armcal::{
+    identify, perturbed_truth, simulate, IdentifySettings, IkSettings, IkStatus, Perturbation,
+    Silent,
+};
 
 fn main() -> armcal::Result<()> {
     let cell = armcal::cell::builtin::paper_cell()?;

@@ -9,9 +9,10 @@
 //! (the same steps as `armcal plan`, `armcal simulate`, `armcal identify`; guide: "Plan the
 //! measurement poses" and "Identify").
 
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, Perturbation};
-use armcal::{assess, identify, plan, simulate, IdentifySettings, PlanSettings};
+use armcal::{
+    assess, identify, perturbed_truth, plan, simulate, IdentifySettings, Perturbation,
+    PlanSettings, Silent,
+};
 
 fn main() -> armcal::Result<()> {
     let cell = armcal::cell::builtin::paper_cell()?;

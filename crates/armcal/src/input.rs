@@ -83,7 +83,7 @@ pub fn cap(default: u64) -> u64 {
     }
 }
 
-/// The text of `path`, read up to [`cap`]`(default)` bytes; a longer file is an
+/// The text of `path`, read up to `cap``(default)` bytes; a longer file is an
 /// [`std::io::ErrorKind::InvalidData`] error that says the cap and how to raise it, and
 /// stops the read there.
 pub fn read_capped(path: &Path, default: u64) -> std::io::Result<String> {

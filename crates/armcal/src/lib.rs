@@ -10,11 +10,11 @@
 //! A cell ([`Cell`]: robot, instrument, targets, working poses, obstacles) gives the
 //! [`Model`]; [`plan`] chooses measurement poses and [`assess`] predicts what any design
 //! gives; [`simulate`] measures a virtual robot (or a [`Dataset`] is read from a file with
-//! [`measure::csv::read`]); [`identify`] fits the parameters with their uncertainty into an
-//! [`Estimate`]; [`calibrated_ik`] and [`compensate::program`] use it; [`accuracy`] proves
-//! it. Every solver reports a [`Status`] and its progress to an [`Observer`]; every file
-//! armcal writes is a typed record of the module that produces it ([`Estimate`],
-//! [`DesignRecord`], …), read by [`report`].
+//! [`measure::csv::read`]); [`identify()`] fits the parameters with their uncertainty into an
+//! [`Estimate`]; [`calibrated_ik`] and [`compensate()`] use it; [`performance`] proves
+//! it (ISO 9283 accuracy and repeatability). Every solver reports a [`Status`] and its
+//! progress to an [`Observer`]; every file armcal writes is a typed record of the module
+//! that produces it ([`Estimate`], [`DesignRecord`], …), read by [`report`].
 //!
 //! # Where to read on
 //!
@@ -34,11 +34,11 @@
 //! # Example
 //!
 //! ```
-//! use armcal::{calibrated_ik, identify, simulate, Cell, IdentifySettings, IkSettings, IkTarget};
-//! use armcal::compensate::ik::IkWorkspace;
 //! use armcal::model::{random_configurations, tool_pose};
-//! use armcal::progress::Silent;
-//! use armcal::sim::{perturbed_truth, Perturbation};
+//! use armcal::{
+//!     calibrated_ik, identify, perturbed_truth, simulate, Cell, IdentifySettings, IkSettings,
+//!     IkTarget, IkWorkspace, Perturbation, Silent,
+//! };
 //!
 //! # fn main() -> armcal::Result<()> {
 //! let cell = armcal::cell::builtin::paper_cell()?;
@@ -62,7 +62,7 @@
 
 #![warn(missing_docs)]
 
-pub mod accuracy;
+pub(crate) mod accuracy;
 pub(crate) mod campaign;
 pub mod cell;
 pub mod compensate;
@@ -76,10 +76,10 @@ pub(crate) mod linalg;
 pub mod measure;
 pub mod model;
 pub(crate) mod performance;
-pub mod progress;
+pub(crate) mod progress;
 pub mod report;
 pub mod robots;
-pub mod sim;
+pub(crate) mod sim;
 pub(crate) mod solve;
 pub mod study;
 pub(crate) mod table;
@@ -92,16 +92,21 @@ pub use error::{Error, Result};
 // inputs (numbers in internal units: mm, rad; names; records) and typed, serde records out.
 // They stay in the module of the concept they compute (one concept per module, the layering
 // test's order) and are named here once; docs/src/reference/library.md lists them.
+// One path per item (tests/suite/repository/api_surface.rs): the file that defines a
+// front-door item is a crate-private module, so the item's only path is the root; an internal
+// part keeps its module path (its parent module re-exports it) and is not named here.
 
 // A cell and its model; the model's parameters, completeness and identifiability.
+pub use cell::loaded::Cell;
 pub use cell::model_analysis::{analyze_model, ModelAnalysis, ModelRecord, ParameterRecord};
-pub use cell::Cell;
-pub use model::complete::LinkForm;
-pub use model::identifiability::{Identifiability, IdentifiabilitySettings, Measurement};
+pub use model::chain::Model;
+pub use model::complete::{FormChange, LinkForm};
+pub use model::identifiability::{
+    Completeness, Exclusion, Identifiability, IdentifiabilitySettings, Measurement,
+};
 pub use model::link::{Joint, JointKind};
 pub use model::registry::{ParameterStatus, Registry, Unit};
 pub use model::urdf::calibration::DEFAULT_K_SIGMA;
-pub use model::Model;
 // Kinematic trees and coupled joints: analysis, simulation and identification.
 pub use cell::tree::{analyze_tree_file, describes_tree, TreeAnalysis, TreeCell};
 pub use identify::tree::{export_tree_estimate, identify_tree, TreeEstimate, TreeTargetFit};
@@ -111,45 +116,73 @@ pub use model::frames::{frames, FramesRecord, PoseRecord};
 pub use model::kinematics::fk;
 // Measurements: from arrays, from several stations, simulated, predicted.
 pub use measure::arrays::{DataArrays, RowKind};
-pub use measure::csv::{next_pose_ids, ReadReport};
-pub use measure::Dataset;
-pub use sim::simulate_poses;
-pub use sim::{perturbed_truth, predict, simulate, Perturbation};
+pub use measure::dataset::Dataset;
+pub use measure::pose_ids::next_pose_ids;
+pub use measure::read_report::ReadReport;
+pub use sim::{
+    perturbed_truth, predict, simulate, simulate_carrying, simulate_measuring, simulate_poses,
+    Perturbation, Simulation, TrueParameter, TruthRecord,
+};
 // Identification, its checks, the prediction σ of any configuration, joint axes by circle
 // point analysis.
 pub use identify::circle_point::record::{axes_record, AxesRecord};
-pub use identify::estimate::{ParameterEstimate, SolverReport};
+pub use identify::estimate::{Acceptance, Estimate, ParameterEstimate, SolverReport};
 pub use identify::fit_checks::FitChecks;
-pub use identify::nongeometric_choice::NonGeometricChoice;
+pub use identify::lm::LmSettings;
+pub use identify::nongeometric_choice::{Candidate, NonGeometric, NonGeometricChoice};
 pub use identify::nongeometric_gate::TermVerdict;
-pub use identify::pivot::{pivot_calibration, PivotSettings};
+pub use identify::pivot::{pivot_calibration, PivotCalibration, PivotSettings};
 pub use identify::prediction_sigma::{csv_with_sigmas, prediction_sigmas, RowSigma};
+pub use identify::refit::FramesRefit;
+pub use identify::robust::Loss;
+pub use identify::run::identify;
+pub use identify::settings::{IdentifySettings, Method};
+pub use identify::solver::ToleranceSettings;
 pub use identify::uncertainty::TcpCovariance;
-pub use identify::{
-    identify, Acceptance, Candidate, Estimate, FramesRefit, IdentifySettings, LmSettings, Loss,
-    Method, NonGeometric, ToleranceSettings,
-};
 // Optimal design: plan, plan from the user's pose pool, assess any design.
-pub use design::assess::{assess, evaluate_design, DesignAssessment, PathPrecision};
-pub use design::cell_constraints::{unmeasurable_poses, unplaced_instrument, TrackerShift};
-pub use design::plan::{plan, PlanResult, PlanSettings};
-pub use design::record::KindMargin;
-pub use design::user_pool::{plan_pool, PoolPlan, PoolReport, PoolSettings};
-pub use design::{Criterion, DesignRecord};
+pub use design::assess::{
+    assess, evaluate_design, DesignAssessment, DesignEvaluation, PathPrecision,
+};
+pub use design::cell_constraints::{
+    unmeasurable_poses, unplaced_instrument, TrackerShift, Unmeasurable, Violation,
+};
+pub use design::criteria::Criterion;
+pub use design::plan::{plan, DesignMargin, PlanResult, PlanSettings};
+pub use design::record::{DesignRecord, JointRange, KindMargin};
+pub use design::user_pool::{
+    plan_pool, InfeasibleRow, PoolPlan, PoolReport, PoolRow, PoolSettings,
+};
 // Compensation: calibrated inverse kinematics, programs from values.
-pub use compensate::ik::{calibrated_ik, IkResult, IkSettings, IkStatus, IkTarget};
-pub use compensate::joint_change::JointChangeLimit;
-pub use compensate::nonparametric::{CorrectionInputs, ResidualCorrection};
+pub use compensate::ik::{
+    calibrated_ik, IkResult, IkSettings, IkStatus, IkTarget, IkWorkspace, LimitViolation,
+};
+pub use compensate::joint_change::{ChangeViolation, JointChangeLimit};
+pub use compensate::nonparametric::{
+    CorrectionInputs, PolynomialBasis, PolynomialCorrection, ResidualCorrection,
+};
 pub use compensate::program::{
-    compensate, compensate_program, CompensatedRow, Program, ProgramFile,
+    compensate, compensate_program, CompensatedProgram, CompensatedRow, Program, ProgramFile,
+    ProgramRecord, ProgramRecordRow,
 };
 // Robot programs in the controllers' languages (KRL, RAPID, UR script).
 pub use compensate::controller_program::{
     filter_controller_program, FilteredControllerProgram, Language as ProgramLanguage,
     ProgramSettings, TargetOutcome,
 };
-// Accuracy (ISO 9283 before and after calibration).
-pub use accuracy::ErrorStats;
+// Accuracy (ISO 9283 before and after calibration): the whole comparison, one model's
+// report, the commanded poses found in the data, the standard's figures of one pose.
+pub use accuracy::iso9283::{
+    position_accuracy, position_repeatability, Accuracy, OrientationAccuracy,
+    OrientationRepeatability, Repeatability, ISO_CYCLES,
+};
+pub use accuracy::report::{
+    accuracy_report, AccuracyReport, Iso9283Summary, Orientation as AccuracyOrientation,
+    OrientationFigures, PoseFigures,
+};
+pub use accuracy::same_pose::{
+    commanded_poses, ClosePoses, CommandedPoses, GroupingSummary, SamePose,
+};
+pub use accuracy::stats::ErrorStats;
 pub use performance::{
     performance, Calibrated, ModelPerformance, PerformanceRecord, PerformanceSettings,
 };
@@ -178,6 +211,16 @@ pub use campaign::study::{
     poses_summary as campaign_poses_summary, run as campaign_study, CampaignStudyRecord,
     RunOutcome as CampaignRunOutcome, StudySettings as CampaignStudySettings,
 };
+// The sources' experiments reproduced: the paper's Tables 6–8 (`armcal study paper`) and
+// the book's PUMA 560 case (`armcal study puma`; its tables and helpers stay in
+// `study::puma`).
+pub use study::paper::{
+    notional_robots, run_study as paper_study, NotionalSummary, PaperStudy, RobotSelection,
+    Spread as StudySpread, StudyRecord as PaperStudyRecord, StudyRow as PaperStudyRow,
+    StudySettings as PaperStudySettings, PAPER_SUMMARY, PAPER_TABLE6,
+};
+pub use study::puma::record::{run_record as puma_study, PumaRecord};
+pub use study::puma::settings::PumaSettings;
 // Export and report.
 pub use cell::export::{export_model, ExportFormat, Exported};
 pub use identify::export::export_estimate;

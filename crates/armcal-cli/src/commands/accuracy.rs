@@ -6,11 +6,10 @@ use super::output::{
     load_cell, load_data, load_estimate, with_note, AcceptUnconverged, NoteStyle, Outputs,
 };
 use super::progress::Progress;
-use armcal::accuracy::iso9283::ISO_CYCLES;
-use armcal::accuracy::report::{AccuracyReport, Orientation, PoseFigures};
-use armcal::accuracy::same_pose::{GroupingSummary, SamePose};
-use armcal::Table;
-use armcal::{performance, Calibrated, PerformanceRecord, PerformanceSettings};
+use armcal::{
+    performance, AccuracyOrientation, AccuracyReport, Calibrated, GroupingSummary,
+    PerformanceRecord, PerformanceSettings, PoseFigures, SamePose, Table, ISO_CYCLES,
+};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -74,9 +73,9 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let settings = PerformanceSettings {
         same_pose,
         orientation: if a.orientation {
-            Orientation::Required
+            AccuracyOrientation::Required
         } else {
-            Orientation::IfMeasured
+            AccuracyOrientation::IfMeasured
         },
     };
     let calibrated = estimate.as_ref().map(|(name, params, _)| Calibrated {

@@ -3,10 +3,10 @@
 
 use super::output::Outputs;
 use super::progress::Progress;
-use armcal::study::paper::{
-    self, RobotSelection, StudyRecord, StudySettings, PAPER_SUMMARY, PAPER_TABLE6,
+use armcal::{
+    paper_study, puma_study, PaperStudyRecord, PaperStudySettings, PumaSettings, RobotSelection,
+    PAPER_SUMMARY, PAPER_TABLE6,
 };
-use armcal::study::puma;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -45,19 +45,19 @@ pub fn run_study(a: &Args) -> anyhow::Result<()> {
         .clone()
         .unwrap_or_else(|| PathBuf::from("out/study-paper"));
     let collisions = a.collisions == "on";
-    let stem = StudyRecord::stem(collisions);
+    let stem = PaperStudyRecord::stem(collisions);
     let csv_path = out.join(format!("{stem}.csv"));
     let json_path = out.join(format!("{stem}.json"));
     let outputs = Outputs::plan(a.force, &[], &[&csv_path, &json_path])?;
     let robots = RobotSelection::from_name(&a.robots)
         .expect("clap checked")
         .robots();
-    let settings = StudySettings {
+    let settings = PaperStudySettings {
         collisions,
         seed: a.seed,
-        ..StudySettings::default()
+        ..PaperStudySettings::default()
     };
-    let study = paper::run_study(&robots, &settings, &mut Progress::new(a.quiet));
+    let study = paper_study(&robots, &settings, &mut Progress::new(a.quiet));
     let record = &study.record;
     outputs.commit(&[
         (&csv_path, &record.to_csv()),
@@ -144,8 +144,8 @@ fn run_puma(a: &Args) -> anyhow::Result<()> {
     let conv_path = out.join("puma-conversion.csv");
     let acc_path = out.join("puma-accuracy.csv");
     let outputs = Outputs::plan(a.force, &[], &[&json_path, &conv_path, &acc_path])?;
-    let record = puma::record::run_record(
-        &puma::PumaSettings {
+    let record = puma_study(
+        &PumaSettings {
             seed: a.seed,
             ..Default::default()
         },

@@ -4,7 +4,7 @@
 //! export writes as a link, so without an entry its parameters would read back as exact).
 
 use crate::common::{armcal, scratch, simulate_and_identify_variant};
-use armcal::cell::Cell;
+use armcal::Cell;
 
 #[test]
 fn an_exported_cell_reads_back_with_the_same_fixed_priors() {

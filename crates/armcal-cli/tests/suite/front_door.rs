@@ -1,12 +1,8 @@
 //! The CLI uses only the library's front door (issue 34): a command file names root items
-//! (`armcal::identify`, `armcal::Dataset`, …), never `armcal::<module>::…`. The commands
-//! still name module paths where the front door has no call yet; [`MODULE_PATH_BUDGET`]
-//! bounds them and may only go down, to 0.
+//! (`armcal::identify`, `armcal::Dataset`, …), never `armcal::<module>::…` (the budget of
+//! such paths, once 81, is 0).
 
 use std::path::Path;
-
-/// `armcal::<module>::` mentions left in the command files.
-const MODULE_PATH_BUDGET: usize = 5;
 
 /// Every `armcal::<module>::` in `text` (the re-exported `nalgebra` crate is a root item).
 fn module_paths(text: &str) -> Vec<String> {
@@ -66,9 +62,9 @@ fn commands_name_only_root_items() {
     all.sort();
     println!("{} module paths in the command files", all.len());
     assert!(
-        all.len() <= MODULE_PATH_BUDGET,
-        "the command files name {} `armcal::<module>::` paths (at most {MODULE_PATH_BUDGET}): \
-         call the front door (a root item of crates/armcal/src/lib.rs) instead:\n{}",
+        all.is_empty(),
+        "the command files name {} `armcal::<module>::` paths: call the front door (a root \
+         item of crates/armcal/src/lib.rs) instead:\n{}",
         all.len(),
         all.join("\n")
     );

@@ -4,9 +4,8 @@
 //! TCP error at the nominal rate where C_s alone does not.
 
 use crate::common::{armcal, scratch};
-use armcal::cell::Cell;
-use armcal::identify::Estimate;
-use armcal::model::{forward_kinematics, observed_position, Data, Model, Observed};
+use armcal::model::{forward_kinematics, observed_position, Data, Observed};
+use armcal::{Cell, Estimate, Model};
 use nalgebra::{Matrix3, Vector3};
 use std::collections::HashMap;
 

@@ -4,8 +4,8 @@
 //! refused with what to do.
 
 use crate::common::{armcal, scratch};
-use armcal::cell::Cell;
 use armcal::model::{forward_kinematics, Data};
+use armcal::Cell;
 use nalgebra::{Matrix3, Vector3};
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};

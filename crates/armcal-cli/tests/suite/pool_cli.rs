@@ -5,9 +5,9 @@
 //! degrees); bad pools and flags give clear errors.
 
 use crate::common::{armcal, scratch};
-use armcal::cell::Cell;
 use armcal::measure::csv::write_configurations;
 use armcal::model::random_configurations;
+use armcal::Cell;
 use std::collections::BTreeSet;
 use std::path::Path;
 

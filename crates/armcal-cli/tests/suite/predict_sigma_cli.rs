@@ -5,9 +5,8 @@
 //! `identify/model_floor.rs`).
 
 use crate::common::{armcal, scratch, simulate_and_identify_variant};
-use armcal::cell::Cell;
-use armcal::identify::Estimate;
-use armcal::model::{forward_kinematics, observed_position, Data, Model, Observed};
+use armcal::model::{forward_kinematics, observed_position, Data, Observed};
+use armcal::{Cell, Estimate, Model};
 use nalgebra::{DVector, Matrix3, Vector3};
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};

@@ -70,7 +70,7 @@ pub struct Accuracy {
 /// ISO 9283 AP. `None` without positions.
 ///
 /// ```
-/// use armcal::accuracy::iso9283::{position_accuracy, position_repeatability};
+/// use armcal::{position_accuracy, position_repeatability};
 /// use armcal::nalgebra::Vector3;
 ///
 /// let commanded = Vector3::new(1000.0, 0.0, 500.0);

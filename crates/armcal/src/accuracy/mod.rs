@@ -1,9 +1,9 @@
 //! Proof of accuracy: statistics of position errors and the ISO 9283 pose characteristics
 //! (book ch. 7).
 
-pub mod iso9283;
-pub mod report;
-pub mod same_pose;
-pub mod stats;
+pub(crate) mod iso9283;
+pub(crate) mod report;
+pub(crate) mod same_pose;
+pub(crate) mod stats;
 
-pub use stats::ErrorStats;
+pub(crate) use stats::ErrorStats;

@@ -60,7 +60,7 @@ pub struct Iso9283Summary {
     pub poses: usize,
     /// Of those, approached at least twice (with RP).
     pub repeated: usize,
-    /// Of those, approached at least [`ISO_CYCLES`](crate::accuracy::iso9283::ISO_CYCLES)
+    /// Of those, approached at least [`ISO_CYCLES`](crate::ISO_CYCLES)
     /// times, as ISO 9283 asks.
     pub iso_cycles: usize,
     /// AP_P over the poses (mm).
@@ -135,7 +135,7 @@ fn observed_name(model: &Model, o: Observed) -> String {
 
 /// Compares the model with parameters `params` with every position and pose measurement of
 /// `data` and gives the ISO 9283 figures of each of the commanded `poses` (found by
-/// [`commanded_poses`](crate::accuracy::same_pose::commanded_poses)). Fails on data with no
+/// [`commanded_poses`](crate::commanded_poses)). Fails on data with no
 /// position or pose measurement, and on data without pose measurements if orientation is
 /// [`Orientation::Required`].
 pub fn accuracy_report(

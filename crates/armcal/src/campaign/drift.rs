@@ -109,7 +109,7 @@ pub struct DriftCheck {
     /// The same χ² with the prediction covariance left out (`S = I`): how much of the
     /// tolerance is the calibration's own uncertainty.
     pub chi2_without_prediction: f64,
-    /// How `C_p` enters `S` ([`COVARIANCE_RULE`]).
+    /// How `C_p` enters `S` (`COVARIANCE_RULE`).
     pub covariance_rule: String,
     /// The calibration's variance factor σ̂₀² (`None` without redundancy).
     pub calibration_variance_factor: Option<f64>,
@@ -123,7 +123,7 @@ impl DriftCheck {
     /// rejective multiple test procedure": the k-th smallest of the G tested groups' p-values,
     /// k = 0, 1, …, rejects at α/(G − k) while every smaller one has), and at least the first
     /// when the check says "drifted" (the groups a campaign after the check releases from the
-    /// old estimate's prior, [`crate::campaign::prior`]). Empty for a consistent check without
+    /// old estimate's prior, `crate::campaign::prior`). Empty for a consistent check without
     /// such a group. Testing each of a robot's 8 or so groups at α on its own would name a
     /// group on an unmoved robot far more often than α; Holm's procedure keeps the chance of
     /// naming any group of an unmoved robot at most α.
@@ -142,7 +142,7 @@ impl DriftCheck {
         moved
     }
 
-    /// The record as JSON (keys in alphabetical order, see [`crate::json`]).
+    /// The record as JSON (keys in alphabetical order, see `crate::json`).
     pub fn to_json(&self) -> Result<String, Error> {
         crate::json::sorted_pretty(self)
     }

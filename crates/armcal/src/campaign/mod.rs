@@ -48,8 +48,8 @@ pub fn fewest_poses(cell: &Cell) -> Result<usize, Error> {
 ///
 /// ```
 /// use armcal::{campaign_start, campaign_step, CampaignDecision as Decision, CampaignSettings};
-/// use armcal::progress::Silent;
-/// use armcal::sim::{perturbed_truth, Perturbation};
+/// use armcal::Silent;
+/// use armcal::{perturbed_truth, Perturbation};
 ///
 /// # fn main() -> armcal::Result<()> {
 /// let cell = armcal::cell::builtin::paper_cell()?;
@@ -282,7 +282,7 @@ pub struct StepResult {
 
 /// Takes the measured batch `batch` (the poses of `state.next`): identifies the free
 /// parameters on everything measured (warm start from the last converged fit), computes
-/// the TCP precision at every working pose ([`precision`]), and decides: stop when every
+/// the TCP precision at every working pose (`precision`), and decides: stop when every
 /// working pose's σ is at or below the target and the fit converged (an unconverged fit
 /// never stops the campaign), stop when the budget is spent, or plan the next batch given
 /// everything measured. `state` itself is not changed: a step that fails leaves it as it

@@ -32,7 +32,7 @@ pub fn chi2_quantile() -> f64 {
 pub struct WorkingSigma {
     /// The working pose's name.
     pub name: String,
-    /// σ = √((1/3) tr C_s) (mm, [`SIGMA_DEFINITION`]).
+    /// σ = √((1/3) tr C_s) (mm, `SIGMA_DEFINITION`).
     pub sigma_mm: f64,
     /// σ of each instrument axis, √diag C_s (mm).
     pub axes_mm: [f64; 3],

@@ -52,7 +52,7 @@ pub fn simulate(
 
 /// Measures the poses `state` asks for on the robot `truth` with the cell's instrument
 /// noise (batch `k` with noise seed `seed · 1000 + k`) and steps until the campaign stops.
-/// A pose the virtual instrument cannot measure there ([`unmeasurable_poses_at`] at the true
+/// A pose the virtual instrument cannot measure there (`unmeasurable_poses_at` at the true
 /// robot and instrument) only for its incidence or line of sight is left out and declared
 /// unmeasurable ([`StepSettings::unmeasurable`]), as an operator whose tracker loses the
 /// beam goes on without it; a pose in collision at the true robot, or a batch with no

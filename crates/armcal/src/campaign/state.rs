@@ -36,7 +36,7 @@ pub struct CampaignSettings {
     /// How batches are chosen.
     pub planner: Planner,
     /// The earlier calibration the campaign starts from, as a prior (a campaign after a
-    /// drift check, [`crate::campaign::prior`]); `None`: from the cell's nominal model.
+    /// drift check, `crate::campaign::prior`); `None`: from the cell's nominal model.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub prior: Option<CampaignPrior>,
 }
@@ -127,7 +127,7 @@ pub struct FitSummary {
     pub dof: usize,
     /// The χ² test's p-value P(χ² ≥ rᵀr) (`None` without redundancy).
     pub p_value: Option<f64>,
-    /// The factor C_s was scaled by ([`crate::campaign::precision::scale`]).
+    /// The factor C_s was scaled by (`crate::campaign::precision::scale`).
     pub covariance_scale: f64,
     /// Every parameter of the model at the fit (internal units), the next step's warm start.
     pub params: Vec<f64>,
@@ -160,7 +160,7 @@ pub struct CampaignStep {
     /// The decision's reason in words (the σ's against the target, or the budget).
     pub reason: String,
     /// Predicted σ at every working pose once `next` is measured too (mm, scaled as the fit's
-    /// C_s; [`crate::campaign::precision::predicted_sigmas`]); empty when stopped. `next`
+    /// C_s; `crate::campaign::precision::predicted_sigmas`); empty when stopped. `next`
     /// was planned, and this predicted, with the instrument and target frames at the latest
     /// converged fit (this step's `fit.params`, else an earlier step's; the nominal before
     /// any) and the links nominal.
@@ -237,7 +237,7 @@ impl CampaignState {
             .map(|f| f.params.as_slice())
     }
 
-    /// The state as JSON (keys in alphabetical order, see [`crate::json`]).
+    /// The state as JSON (keys in alphabetical order, see `crate::json`).
     pub fn to_json(&self) -> Result<String, Error> {
         crate::json::sorted_pretty(self)
     }

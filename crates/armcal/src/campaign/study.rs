@@ -162,7 +162,7 @@ pub struct CampaignStudyRecord {
 }
 
 impl CampaignStudyRecord {
-    /// The record as JSON (keys in alphabetical order, see [`crate::json`]).
+    /// The record as JSON (keys in alphabetical order, see `crate::json`).
     pub fn to_json(&self) -> Result<String, Error> {
         crate::json::sorted_pretty(self)
     }

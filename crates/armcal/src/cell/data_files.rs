@@ -4,7 +4,8 @@
 //! can be loaded from ([`Cell::robots`]).
 
 use super::Cell;
-use crate::measure::csv::{self, Import, ReadReport};
+use crate::measure::csv::{self, Import};
+use crate::measure::read_report::ReadReport;
 use crate::measure::Dataset;
 use crate::Error;
 use std::path::Path;

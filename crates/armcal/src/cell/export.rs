@@ -229,7 +229,7 @@ pub enum ExportFormat {
     /// URDF (the model's links as joints and fixed frames).
     Urdf,
     /// URDF with the joint offsets against the nominal model as `<calibration rising>`
-    /// ([`urdf::calibration`]); `Some(k)`: the conservative variant, keeping only the
+    /// (`urdf::calibration`); `Some(k)`: the conservative variant, keeping only the
     /// corrections beyond `k σ`.
     UrdfCalibration(Option<f64>),
     /// Universal Robots kinematics YAML ([`crate::model::ur_kinematics`]).

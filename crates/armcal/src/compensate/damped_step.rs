@@ -9,7 +9,7 @@ use nalgebra::{Cholesky, SMatrix, SVector, Vector6};
 /// Columns of the weighted task Jacobian `Q^{1/2} J` of the tool frame, one per commanded
 /// joint, from evaluated kinematics: joint j's world twist (ω, v) moves the tool origin p
 /// with `ω × p + v` (rows 0–2) and turns it with ω, scaled by L (rows 3–5). With joint
-/// corrections (compliance, periodic errors; [`crate::model::joint_correction`]) the twists
+/// corrections (compliance, periodic errors; `crate::model::joint_correction`) the twists
 /// are those of the corrected joints `q̃ = q + Δq(q)` and the columns w.r.t. the commanded
 /// joints follow by the chain rule, `J = J̃ ∂q̃/∂q`; `corrected` (one column per joint) then
 /// holds `J̃` and is otherwise untouched.

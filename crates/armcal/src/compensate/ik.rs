@@ -743,9 +743,9 @@ impl<'a> CalibratedIk<'a> {
 
     /// Damped least squares on the calibrated model within the joint box `[lower, upper]`
     /// (each bound within the joint limits), from `seed`, with position priority: the
-    /// orientation rows are weighted by [`PRIORITY_LENGTH`] instead of L (and ε, γ_max
+    /// orientation rows are weighted by `PRIORITY_LENGTH` instead of L (and ε, γ_max
     /// scaled alike), so that a position error δ costs as much as an orientation error
-    /// δ/[`PRIORITY_LENGTH`] rad — where the box leaves an orientation error ϑ, the position
+    /// δ/`PRIORITY_LENGTH` rad — where the box leaves an orientation error ϑ, the position
     /// gives way by about `PRIORITY_LENGTH² ϑ / r` only (r ≈ the arm's reach, 10⁻⁵ mm for
     /// ϑ = 0.3°, r = 1 m). A joint at a bound that the error pushes outward is held there
     /// (active set). Converged if both tolerances are met; otherwise

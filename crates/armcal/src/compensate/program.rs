@@ -147,7 +147,7 @@ impl<'a> RowCompensator<'a> {
 /// form is needed.
 ///
 /// ```
-/// use armcal::compensate::program::filter_joint_program;
+/// use armcal::compensate::filter_joint_program;
 /// use armcal::model::random_configurations;
 /// use armcal::{IkSettings, IkStatus};
 ///

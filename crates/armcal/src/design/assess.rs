@@ -36,7 +36,7 @@ pub struct DesignAssessment {
     pub observability: Observability,
     /// Every criterion's value (see [`Criterion`]).
     pub criteria: Vec<(Criterion, f64)>,
-    /// The model floor beside C_s at the working poses ([`design_floor`]); `None` without
+    /// The model floor beside C_s at the working poses (`design_floor`); `None` without
     /// working poses, for distance measurements, or in files of an older armcal.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub model_floor: Option<ModelFloor>,
@@ -218,13 +218,13 @@ pub struct DesignEvaluation {
     /// clearance and joint margin ([`kind_margins`]).
     pub margins: Vec<KindMargin>,
     /// The poses that stay measurable with the instrument displaced (`evaluate
-    /// --tracker-shift-mm D`, [`tracker_shift`]); absent unless asked for.
+    /// --tracker-shift-mm D`, `tracker_shift`); absent unless asked for.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tracker_shift: Option<TrackerShift>,
 }
 
 impl DesignEvaluation {
-    /// The record as JSON (keys in alphabetical order, see [`crate::json`]).
+    /// The record as JSON (keys in alphabetical order, see `crate::json`).
     pub fn to_json(&self) -> Result<String, Error> {
         crate::json::sorted_pretty(self)
     }
@@ -233,7 +233,7 @@ impl DesignEvaluation {
 /// The assessment of `design` (internal units) for `cell`, its infeasible poses, its
 /// smallest margin and the margins per constraint kind, with or without the collision and
 /// line-of-sight constraints; with `tracker_shift_mm`, which poses stay measurable with the
-/// instrument that far off in any direction ([`tracker_shift`]).
+/// instrument that far off in any direction (`tracker_shift`).
 pub fn evaluate_design(
     cell: &Cell,
     design: &[Vec<f64>],

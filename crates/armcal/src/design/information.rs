@@ -53,7 +53,7 @@ pub struct DesignModel {
     /// Weight of each KPI configuration in the mean KPI.
     pub kpi_weights: Vec<f64>,
     /// The cell's prior information over the free columns, as whitened rows
-    /// ([`crate::model::prior::prior_rows`]): part of every design's information.
+    /// (`crate::model::prior::prior_rows`): part of every design's information.
     pub prior_rows: DMatrix<f64>,
 }
 

@@ -2,24 +2,30 @@
 //! calibrated robot most precise where it works (the KPI method), or that optimise a classic
 //! criterion of the parameter covariance.
 
-pub mod assess;
+pub(crate) mod assess;
 pub mod baselines;
 pub mod bound;
-pub mod cell_constraints;
-pub mod criteria;
+pub(crate) mod cell_constraints;
+pub(crate) mod criteria;
 pub mod exchange;
-pub mod information;
-pub mod objective;
+pub(crate) mod information;
+pub(crate) mod objective;
 pub(crate) mod order;
-pub mod plan;
-pub mod record;
+pub(crate) mod plan;
+pub(crate) mod record;
 pub mod refine;
 pub mod selection;
 pub(crate) mod small_cholesky;
-pub mod user_pool;
+pub(crate) mod user_pool;
 
+// The planner's parts, one path each (the calls and records are root items: `armcal::plan`,
+// `armcal::PlanSettings`, `armcal::DesignRecord`, …).
 pub use cell_constraints::{ConstraintKind, ConstraintSet, ConstraintSettings};
-pub use criteria::Criterion;
+pub(crate) use criteria::Criterion;
+pub use criteria::SMOOTH_MAX_P;
 pub use information::{DesignModel, InformationWorkspace};
 pub use objective::DesignObjective;
-pub use record::DesignRecord;
+pub use plan::{constraint_set, CellConstraints, EXCHANGE_TOLERANCE_BEFORE_REFINEMENT};
+pub use record::kind_margins;
+pub(crate) use record::DesignRecord;
+pub use user_pool::plan_from_pool;

@@ -397,7 +397,7 @@ pub fn constraint_set(cell: &Cell, collisions: bool) -> Result<ConstraintSet, Er
 ///
 /// ```
 /// use armcal::{assess, plan, Cell, PlanSettings};
-/// use armcal::progress::Silent;
+/// use armcal::Silent;
 ///
 /// # fn main() -> armcal::Result<()> {
 /// let cell = armcal::cell::builtin::paper_cell()?;

@@ -176,7 +176,7 @@ impl AxisErrors {
 pub struct Estimate {
     /// Name of the cell.
     pub cell: String,
-    /// Where the fitted data came from ([`Dataset::source`]).
+    /// Where the fitted data came from ([`Dataset::source`](crate::Dataset::source)).
     pub data: String,
     /// The identified model (internal units: mm, rad), for predict / compensate / export.
     pub model: ModelSpec,
@@ -188,11 +188,11 @@ pub struct Estimate {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub payloads_measured: Vec<String>,
     /// The identifiability gate of the free non-geometric terms (compliance, periodic
-    /// errors; [`crate::identify::nongeometric_gate`]); empty for a kinematic model.
+    /// errors; `crate::identify::nongeometric_gate`); empty for a kinematic model.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub nongeometric: Vec<crate::identify::nongeometric_gate::TermVerdict>,
     /// The cross-validated choice of the non-geometric terms (`identify --nongeometric
-    /// auto`, [`crate::identify::nongeometric_choice`]): every candidate's held-out score.
+    /// auto`, `crate::identify::nongeometric_choice`): every candidate's held-out score.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub nongeometric_choice: Option<crate::identify::NonGeometricChoice>,
     /// Why each parameter not estimated was left out (identifiability analysis).
@@ -489,7 +489,7 @@ impl Estimate {
 
     /// The full parameter vector of `model` from this estimate (by parameter name), after
     /// [`Estimate::check_model`]. An estimate over several instrument stations gives a model
-    /// without stations its first station's instrument pose ([`Estimate::by_model_name`]).
+    /// without stations its first station's instrument pose (`Estimate::by_model_name`).
     pub fn params_for(&self, model: &Model) -> Result<Vec<f64>, Error> {
         self.check_model(model)?;
         let by_name = self.by_model_name(model);

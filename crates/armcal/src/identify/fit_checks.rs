@@ -154,10 +154,10 @@ fn far_from_drawing(angles: Vec<FarAngle>, diagnosis: Option<&SignDiagnosis>) ->
 /// the right units.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct FitChecks {
-    /// The arm's length at the nominal (mm, [`arm_length`]).
+    /// The arm's length at the nominal (mm, `arm_length`).
     #[serde(default)]
     pub arm_mm: f64,
-    /// The plausible model error (mm, [`plausible_model_error`]).
+    /// The plausible model error (mm, `plausible_model_error`).
     #[serde(default)]
     pub plausible_mm: f64,
     /// Units the data or the model likely hold where others are meant.

@@ -18,24 +18,27 @@ pub(crate) mod lm;
 pub mod model_floor;
 pub(crate) mod nongeometric_choice;
 pub(crate) mod nongeometric_gate;
-pub mod pivot;
+pub(crate) mod pivot;
 pub(crate) mod prediction_sigma;
 pub(crate) mod problem;
 pub(crate) mod refit;
 pub mod residuals;
 pub(crate) mod robust;
+pub(crate) mod run;
+pub(crate) mod settings;
 pub(crate) mod sign_diagnosis;
 pub(crate) mod solver;
 mod split;
 pub(crate) mod tree;
-pub mod uncertainty;
+pub(crate) mod uncertainty;
 pub(crate) mod unit_check;
 pub(crate) mod verdicts;
 mod weak_gain;
 
+pub(crate) use estimate::{Acceptance, Estimate};
 pub use estimate::{
-    Acceptance, AxisErrors, Estimate, HeldOutAxes, HeldOutOrientation, MeasurementResidual,
-    ResidualReport, Usability, Validation,
+    AxisErrors, HeldOutAxes, HeldOutOrientation, MeasurementResidual, ResidualReport, Usability,
+    Validation,
 };
 pub(crate) use estimate::{ParameterEstimate, SolverReport};
 pub use fingerprint::ModelFingerprint;
@@ -46,13 +49,22 @@ pub use frames_first::{
 };
 pub use gauss_newton::gauss_newton;
 pub use kalman::{kalman_filter, KalmanSettings};
-pub use lm::{levenberg_marquardt, LmSettings};
+pub use lm::levenberg_marquardt;
+pub(crate) use lm::LmSettings;
+pub use pivot::pivot_from_flange_poses;
 pub use problem::Problem;
-pub use refit::{FramesRefit, RefitRecord};
-pub use robust::{robust_fit, Loss, Outlier};
-pub use solver::{SolverResult, ToleranceSettings};
-pub(crate) use uncertainty::Observability;
-pub use uncertainty::{Chi2Outcome, ParameterUncertainty, TcpCovariance};
+pub(crate) use refit::FramesRefit;
+pub use refit::RefitRecord;
+pub(crate) use robust::Loss;
+pub use robust::{robust_fit, Outlier};
+pub(crate) use run::identify;
+pub(crate) use settings::{IdentifySettings, Method};
+pub use solver::SolverResult;
+pub(crate) use solver::ToleranceSettings;
+pub use uncertainty::{
+    observability, parameter_uncertainty, tcp_covariance, tcp_covariance_constrained, tcp_jacobian,
+    Chi2Outcome, Observability, ParameterUncertainty,
+};
 pub use verdicts::{Chi2Verdict, IdentifiabilityVerdict, Verdicts};
 
 use crate::cell::Cell;
@@ -62,110 +74,18 @@ use crate::model::{Model, ParameterStatus};
 use crate::progress::Observer;
 use crate::Error;
 use free_set::{fit_free_set, FreeSetFit};
-pub(crate) use nongeometric_choice::NonGeometricChoice;
-pub use nongeometric_choice::{Candidate, NonGeometric};
+pub(crate) use nongeometric_choice::{Candidate, NonGeometric, NonGeometricChoice};
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use serde::{Deserialize, Serialize};
 use split::Split;
-
-/// Which solver.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Method {
-    /// Levenberg–Marquardt ([`levenberg_marquardt`], book §4.3).
-    Lm,
-    /// Damped Gauss–Newton ([`gauss_newton()`], book eqs. 4.22–4.27).
-    GaussNewton,
-    /// Iterated Kalman filter ([`kalman_filter`], book §4.3.3, §4.5.4).
-    Kalman,
-}
-
-impl Method {
-    /// The method in words, for output: `Levenberg–Marquardt`, `Gauss–Newton`, `recursive
-    /// (Kalman filter)`.
-    pub fn words(self) -> &'static str {
-        match self {
-            Method::Lm => "Levenberg–Marquardt",
-            Method::GaussNewton => "Gauss–Newton",
-            Method::Kalman => "recursive (Kalman filter)",
-        }
-    }
-
-    /// The method named `lm`, `gn` / `gauss-newton` or `kalman`; `None` for another name.
-    pub fn from_name(s: &str) -> Option<Method> {
-        match s {
-            "lm" => Some(Method::Lm),
-            "gn" | "gauss-newton" => Some(Method::GaussNewton),
-            "kalman" => Some(Method::Kalman),
-            _ => None,
-        }
-    }
-}
-
-/// Settings of [`identify`].
-#[derive(Clone, Debug)]
-pub struct IdentifySettings {
-    /// Solver of the fit.
-    pub method: Method,
-    /// Robust loss for an IRLS fit ([`robust_fit`], always with Levenberg–Marquardt);
-    /// `None`: plain least squares.
-    pub robust: Option<Loss>,
-    /// Fraction of configurations held out for validation, in [0, 1) (0: none).
-    pub holdout: f64,
-    /// Validation data of the same cell (the user's own held-out file): the whole `data`
-    /// is fitted and validated on these configurations. Excludes `holdout`.
-    pub test: Option<Dataset>,
-    /// Seed of the random choice of held-out configurations.
-    pub seed: u64,
-    /// Settings of Levenberg–Marquardt (also inside a robust fit); Gauss–Newton stops by
-    /// its tolerances.
-    pub lm: LmSettings,
-    /// A frames refit ([`refit`]): keep the robot of this estimate and fit only the
-    /// instrument, base, tool and target frames. `None`: a full calibration.
-    pub refit: Option<FramesRefit>,
-    /// Warm start: every parameter of the cell's model (internal units), e.g. a previous
-    /// estimate of the same cell on part of these data ([`Estimate::params_for`]); the fit
-    /// starts there instead of at the frames-first start ([`frames_first_start`]), and the
-    /// free set is decided there. `None`: the frames-first start.
-    pub start: Option<Vec<f64>>,
-    /// Which of the cell's non-geometric terms (compliance, periodic errors) the fit keeps,
-    /// or a choice by cross-validation ([`nongeometric_choice`]).
-    pub nongeometric: NonGeometric,
-    /// Run the joint sign and zero diagnosis ([`sign_diagnosis`]) even without a gross
-    /// misfit (it always runs on an unexplained one).
-    pub diagnose_signs: bool,
-    /// How the caller accepts a fit the checks refuse ([`fit_checks`]: a gross misfit or a
-    /// unit mistake), in its own words (the CLI: its flag); recorded in the estimate, whose
-    /// every later use then says so. `None`: not accepted.
-    pub accept_misfit: Option<String>,
-}
-
-impl Default for IdentifySettings {
-    fn default() -> Self {
-        IdentifySettings {
-            method: Method::Lm,
-            robust: None,
-            holdout: 0.0,
-            test: None,
-            seed: 1,
-            lm: LmSettings::default(),
-            refit: None,
-            start: None,
-            nongeometric: NonGeometric::AsCell,
-            diagnose_signs: false,
-            accept_misfit: None,
-        }
-    }
-}
 
 /// The cell's model with its free set for `data`, decided at the parameters `at` (the
 /// frames-first estimate or a fit, not the nominal: a target whose nominal offset is
 /// unknown and written as `[0, 0, 0]` lies on the last joint axis there, where two
 /// parameters of that joint have no effect), and the reason for every parameter left out.
 /// A parameter the same analysis at the nominal leaves out is freed there only if the
-/// data determine it ([`weak_gain`]: variance inflation at most [`DETERMINED_VIF`]), so
+/// data determine it (`weak_gain`: variance inflation at most [`DETERMINED_VIF`]), so
 /// `plan`'s prediction at the nominal and the fit agree on a target on the last axis.
 /// With `free = "auto"` the free set is the minimal identifiable set *at the data's
 /// configurations*; parameters these data cannot identify although the cell could (e.g. a
@@ -285,93 +205,6 @@ pub fn holdout_split(n: usize, fraction: f64, seed: u64) -> (Vec<usize>, Vec<usi
     train.sort();
     test.sort();
     (train, test)
-}
-
-/// Identifies the cell's free parameters from a dataset: fit (optionally on a training
-/// split), covariance, TCP covariance at the working configurations, diagnostics, and
-/// held-out validation against the nominal and frames-only models.
-///
-/// The fit is Levenberg–Marquardt (book §5.3) on the σ-weighted residuals; its covariance
-/// `C_p = σ̂² (JᵀJ)⁻¹` (book eq. 5.23) and `C_s = G C_p Gᵀ` at each working pose (paper
-/// eq. 19) say how well the robot is known. A fit that did not converge says so in its
-/// status and is not a calibration.
-///
-/// ```
-/// use armcal::{identify, simulate, Cell, IdentifySettings};
-/// use armcal::model::random_configurations;
-/// use armcal::progress::Silent;
-/// use armcal::sim::{perturbed_truth, Perturbation};
-///
-/// # fn main() -> armcal::Result<()> {
-/// let cell = armcal::cell::builtin::paper_cell()?;
-/// let model = &cell.model;
-/// let truth = perturbed_truth(model, &Perturbation::default(), 5);
-/// let data = simulate(model, &truth, &random_configurations(model, 50, 2), Some(&cell.noise()), 3)?;
-/// let estimate = identify(&cell, &data, &IdentifySettings::default(), &mut Silent)?;
-/// assert!(estimate.solver.status.is_converged());
-/// // Every free parameter lies within 4 stated σ of the truth.
-/// let fitted = estimate.params_for(model)?;
-/// for p in estimate.parameters.iter().filter(|p| p.free) {
-///     let k = model.registry.index_of(&p.name).expect("a parameter of the model");
-///     assert!((fitted[k] - truth[k]).abs() < 4.0 * p.sigma.unwrap(), "{}", p.name);
-/// }
-/// # Ok(())
-/// # }
-/// ```
-pub fn identify(
-    cell: &Cell,
-    data: &Dataset,
-    opts: &IdentifySettings,
-    observer: &mut dyn Observer,
-) -> Result<Estimate, Error> {
-    let noise = cell.noise();
-    let split = Split::of(data, opts)?;
-    let train: &Dataset = &split.train;
-    crate::measure::stations::check_stations(data)?;
-    let stationed = cell.with_stations(&data.stations)?;
-    let (mut left_out, choice) = match opts.nongeometric {
-        NonGeometric::AsCell => (Vec::new(), None),
-        NonGeometric::Only(c) => (c.left_out(&stationed.model)?, None),
-        NonGeometric::Auto { folds } => {
-            let choice =
-                nongeometric_choice::choose(&stationed, train, &noise, opts, folds, observer)?;
-            (choice.chosen.left_out(&stationed.model)?, Some(choice))
-        }
-    };
-    if !train.carries_payloads() {
-        let new: Vec<(usize, String)> = payload_terms(&stationed.model)
-            .filter(|(i, _)| !left_out.iter().any(|(j, _)| j == i))
-            .collect();
-        left_out.extend(new);
-    }
-    let fit = match &opts.refit {
-        Some(refit) => refit::fit_frames(&stationed, cell, train, &noise, opts, refit, observer)?,
-        None => fit_free_set(&stationed, train, &noise, opts, &left_out, observer)?,
-    };
-    observer.start("uncertainty, observability and residuals", None);
-    let estimate = estimate_of_fit(&stationed, data, opts, &split, fit, &noise, observer);
-    observer.finish();
-    let mut estimate = estimate?;
-    let checks = phase(observer, "units, misfit, joint signs and zeros", || {
-        fit_checks::check(
-            &stationed.model,
-            train,
-            &noise,
-            &estimate,
-            opts.diagnose_signs,
-            opts.accept_misfit.as_deref(),
-        )
-    })?;
-    if let Some(v) = estimate.verdicts.as_mut() {
-        v.chi2.name_worst_rows(&checks.worst_rows);
-        v.fit = checks;
-    }
-    // an estimate belongs to the cell as its file describes it, whatever stations its data name
-    Ok(Estimate {
-        fingerprint: Some(ModelFingerprint::of(&cell.model)),
-        nongeometric_choice: choice,
-        ..estimate
-    })
 }
 
 /// The payload terms of `model` (`<joint>.compliance.payload`, [`crate::model::compliance`])

@@ -1,5 +1,5 @@
 //! The model floor of the TCP covariance: what the parameters a fit holds fixed add to the
-//! TCP error, given their stated prior uncertainty ([`FixedPrior`]).
+//! TCP error, given their stated prior uncertainty (`FixedPrior`).
 //!
 //! C_s (paper eq. 19) treats a fixed parameter as exact. A real one is off by `Δp_f` (a link
 //! length along the flange axis, a tool frame from CAD), and the fit absorbs what of it the
@@ -79,7 +79,7 @@ pub struct ModelFloor {
 /// `A = C_p Fᵀ F_f` (module notes), the free parameters' response to the fixed ones'
 /// errors, with the fixed parameters of non-zero prior σ it maps: the floor of any point the
 /// model predicts at any configuration is `K Σ_f Kᵀ` with `K = G_f − G A`, `G`, `G_f` that
-/// point's Jacobians ([`crate::identify::prediction_sigma`]).
+/// point's Jacobians (`crate::identify::prediction_sigma`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Absorbed {
     /// The fixed parameters with a non-zero prior σ, the columns of `map`.

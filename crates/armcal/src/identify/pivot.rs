@@ -68,7 +68,7 @@ pub struct PivotCalibration {
 }
 
 impl PivotCalibration {
-    /// The record as JSON (keys in alphabetical order, see [`crate::json`]).
+    /// The record as JSON (keys in alphabetical order, see `crate::json`).
     pub fn to_json(&self) -> Result<String, Error> {
         crate::json::sorted_pretty(self)
     }

@@ -21,7 +21,7 @@ pub struct Problem<'a> {
     /// Parameter index of each estimated column.
     pub free: Vec<usize>,
     /// Prior rows `W` over the free columns, appended after the data rows: the prior adds
-    /// `W p_free − prior_offset` to the residual ([`crate::model::prior`]).
+    /// `W p_free − prior_offset` to the residual (`crate::model::prior`).
     pub prior_rows: DMatrix<f64>,
     /// `W μ` of the prior rows.
     pub prior_offset: DVector<f64>,

@@ -174,15 +174,15 @@ pub struct TcpCovariance {
     /// (1/3) tr(C_s) (mm²): the paper's KPI criterion φ_A(C_s).
     pub kpi: f64,
     /// The covariance of the TCP position in the robot base (world) frame, `G_w C_p G_wᵀ`
-    /// ([`tcp_jacobian_world`]): where the robot's TCP is, without the uncertainty of the
+    /// (`tcp_jacobian_world`): where the robot's TCP is, without the uncertainty of the
     /// instrument's own pose that the instrument-frame C_s includes; `None` in files of an
     /// older armcal.
     #[serde(default)]
     pub covariance_base: Option<Matrix3<f64>>,
     /// (1/3) tr of the covariance of the TCP orientation (the tool frame's small rotation
-    /// vector in the instrument frame, `G_ω C_p G_ωᵀ` with [`tcp_orientation_jacobian`]),
+    /// vector in the instrument frame, `G_ω C_p G_ωᵀ` with `tcp_orientation_jacobian`),
     /// deg²: the orientation's KPI beside the position's, for a design whose instrument
-    /// measures orientations ([`with_orientation`]); `None` otherwise (a position-only
+    /// measures orientations (`with_orientation`); `None` otherwise (a position-only
     /// design holds the tool's orientation parameters fixed, so it would state them exact).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub orientation_kpi_deg2: Option<f64>,
@@ -354,7 +354,7 @@ pub struct Observability {
 
 /// The observability indices of the whitened identification Jacobian `j` ([`Observability`]).
 /// Singular values and column norms are those of `j`'s triangular factor
-/// ([`crate::linalg`]), so a Jacobian of many rows is neither copied nor decomposed whole.
+/// (`crate::linalg`), so a Jacobian of many rows is neither copied nor decomposed whole.
 pub fn observability(j: DMatrixView<f64>) -> Observability {
     let m = j.nrows() as f64;
     let r = crate::linalg::r_factor(j);

@@ -20,7 +20,7 @@ pub struct Verdicts {
     pub chi2: Chi2Verdict,
     /// How many parameters were identified of the generic count.
     pub identifiability: IdentifiabilityVerdict,
-    /// Units, blunders, gross misfit, joint signs and zeros ([`super::fit_checks`]); empty
+    /// Units, blunders, gross misfit, joint signs and zeros (`super::fit_checks`); empty
     /// in files of an older armcal.
     #[serde(default)]
     pub fit: super::FitChecks,
@@ -102,7 +102,7 @@ impl Chi2Verdict {
 }
 
 /// How many parameters were identified, against the count the measurement type identifies
-/// in generic geometry ([`expected_count`]).
+/// in generic geometry (`expected_count`).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct IdentifiabilityVerdict {
     /// The cell's measurement type (position, pose, distance).

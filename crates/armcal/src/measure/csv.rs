@@ -14,7 +14,7 @@
 //!   and `sigma_roll` … for pose rows (σ of the residual's rotation rows);
 //! * `temperature_c` — air temperature at the measurement, °C (a covariate);
 //! * `station` — the instrument station the row was measured from
-//!   ([`crate::model::station`]); with it, a configuration is a (station, `pose_id`) pair;
+//!   (`crate::model::station`); with it, a configuration is a (station, `pose_id`) pair;
 //! * `payload` — the payload the robot carried (a cell's `[[payload]]` name; empty or
 //!   `none`: no payload; [`crate::model::compliance`]); with it, a configuration is a
 //!   (station, payload, `pose_id`) triple, so one pose list measured with two payloads
@@ -24,11 +24,12 @@
 //! ([`crate::measure::format`]: delimiter, decimal comma, column names, units, orientation
 //! convention), read by [`read_with`] and converted to this format by [`import`].
 //!
-//! Other columns are ignored and listed in [`ReadReport::ignored`]; a known column with an
+//! Other columns are ignored and listed in [`ReadReport::ignored`](crate::ReadReport::ignored); a known column with an
 //! unknown unit suffix is an error.
 
 use crate::measure::columns::{controller_base, explain_header, Column, JointColumns, SigmaOf};
 use crate::measure::format::{clean, number, DataFormat, Decimal};
+use crate::measure::read_report::ReadReport;
 use crate::measure::{Covariates, Dataset, Measurement, MeasurementKind};
 use crate::model::controller::ControllerConvention;
 use crate::model::{Joint, JointKind, Model, Observed, Pose};
@@ -37,16 +38,6 @@ use crate::Error;
 use nalgebra::Vector3;
 use std::collections::HashMap;
 use std::path::Path;
-
-/// What the reader found besides the data.
-#[derive(Clone, Debug, Default)]
-pub struct ReadReport {
-    /// Header names of the columns the reader did not use.
-    pub ignored: Vec<String>,
-    /// Rows read with a remark, each a sentence naming file, line and field: joint values a
-    /// little past the model's limits ([`crate::model::MEASURED_LIMIT_TOLERANCE`]).
-    pub warnings: Vec<String>,
-}
 
 fn err(file: &str, msg: String) -> Error {
     Error::File {
@@ -958,23 +949,6 @@ pub fn write_configurations(model: &Model, qs: &[Vec<f64>]) -> String {
         .map(|(i, q)| ((i + 1).to_string(), q.as_slice()))
         .collect();
     write_poses(model, &numbered)
-}
-
-/// `n` new pose ids that continue `taken` (the ids of the poses already measured): on from
-/// the largest whole-number id (`61`, `62`, … after `1` … `60`), or from `taken.len()` when
-/// that is larger (ids that are not numbers), never an id already taken.
-pub fn next_pose_ids(taken: &[String], n: usize) -> Vec<String> {
-    let largest = taken
-        .iter()
-        .filter_map(|id| id.parse::<u64>().ok())
-        .max()
-        .unwrap_or(0)
-        .max(taken.len() as u64);
-    (largest + 1..)
-        .map(|k| k.to_string())
-        .filter(|id| !taken.contains(id))
-        .take(n)
-        .collect()
 }
 
 /// Writes joint configurations with their own `pose_id`s, in the format of

@@ -1,4 +1,4 @@
-//! Whether the instrument stations a data set names ([`crate::model::station`]) can be
+//! Whether the instrument stations a data set names (`crate::model::station`) can be
 //! located from their own rows, and how many one fit takes: a bad `station` column must not
 //! grow the identification without bound (a fuzzing finding, issue 15).
 

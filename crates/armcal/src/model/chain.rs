@@ -149,7 +149,7 @@ pub struct Model {
     /// station's.
     pub instrument: Option<Link>,
     /// The instrument's frame at each station the data name, in station order (frames
-    /// `<instrument>@<station>`, [`crate::model::station`]); empty: one instrument pose.
+    /// `<instrument>@<station>`, `crate::model::station`); empty: one instrument pose.
     pub stations: Vec<Link>,
     /// Base frame, links, tool frame, in chain order.
     pub links: Vec<Link>,
@@ -465,7 +465,7 @@ impl Model {
         }
     }
 
-    /// The joint-space correction terms ([`crate::model::joint_correction`]) in registry
+    /// The joint-space correction terms (`crate::model::joint_correction`) in registry
     /// order, each as (registry index, index of the joint it turns): the compliance terms,
     /// then the periodic terms.
     pub fn joint_corrections(&self) -> impl Iterator<Item = (usize, usize)> + '_ {

@@ -45,7 +45,7 @@ const EXACTLY_PARALLEL: f64 = 1e-12;
 #[serde(rename_all = "kebab-case")]
 pub enum LinkForm {
     /// The links as given, with the Hayati / β form wherever consecutive axes are nearly
-    /// parallel ([`complete_minimal`]): complete and minimal. The default.
+    /// parallel (`complete_minimal`): complete and minimal. The default.
     Auto,
     /// The links exactly as the robot library or the cell file gives them.
     AsGiven,
@@ -85,7 +85,7 @@ impl LinkForm {
     }
 }
 
-/// One link whose form [`complete_minimal`] changed, and why.
+/// One link whose form `complete_minimal` changed, and why.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FormChange {
     /// Name of the changed link.

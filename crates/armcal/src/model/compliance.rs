@@ -226,7 +226,7 @@ impl Compliance {
     }
 }
 
-/// The compliance's lever pass ([`crate::model::joint_correction::CorrectionData`]).
+/// The compliance's lever pass (`crate::model::joint_correction::CorrectionData`).
 #[derive(Clone, Debug)]
 pub struct ComplianceData<T: RealField + Copy> {
     /// The model at the lever parameters and the commanded `q`.

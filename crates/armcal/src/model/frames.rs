@@ -72,7 +72,7 @@ pub struct FramesRecord {
 }
 
 impl FramesRecord {
-    /// The record as JSON (keys in alphabetical order, see [`crate::json`]).
+    /// The record as JSON (keys in alphabetical order, see `crate::json`).
     pub fn to_json(&self) -> Result<String, Error> {
         crate::json::sorted_pretty(self)
     }

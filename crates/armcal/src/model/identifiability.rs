@@ -123,7 +123,7 @@ pub struct Completeness {
     /// `4R + 2P + 6` (book eq. 2.49): parameters of a complete, minimal model of the
     /// pose of the tool relative to the world.
     pub complete_pose_model: usize,
-    /// What the measurement type identifies in generic geometry (see [`expected_count`]).
+    /// What the measurement type identifies in generic geometry (see `expected_count`).
     pub expected_for_measurement: Option<usize>,
 }
 
@@ -162,7 +162,7 @@ pub struct Identifiability {
 }
 
 /// An identifiable set counted the one way `model` and `identify` state it: the geometric
-/// parameters, which the generic count ([`expected_count`]) covers, and the non-geometric
+/// parameters, which the generic count (`expected_count`) covers, and the non-geometric
 /// terms (joint compliance, periodic gear errors) apart.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct IdentifiableCount {
@@ -297,18 +297,7 @@ fn observations(model: &Model, m: Measurement) -> Vec<(Observed, Rows)> {
 }
 
 /// Stacked identification Jacobian for a measurement type over configurations `qs`, one
-/// column per entry of `columns`.
-pub fn stacked_jacobian(
-    model: &Model,
-    params: &[f64],
-    qs: &[Vec<f64>],
-    m: Measurement,
-    columns: &[usize],
-) -> DMatrix<f64> {
-    stacked_jacobian_at(model, params, qs, &|_| (0, None), m, columns)
-}
-
-/// As [`stacked_jacobian`], configuration `i` measured from station `at(i).0` carrying
+/// column per entry of `columns`, configuration `i` measured from station `at(i).0` carrying
 /// payload `at(i).1`.
 fn stacked_jacobian_at(
     model: &Model,
@@ -372,7 +361,7 @@ fn stacked_jacobian_at(
 /// Configurations stacked per block of [`stacked_factor`].
 const FACTOR_BLOCK: usize = 256;
 
-/// The triangular factor of [`stacked_jacobian`] (`linalg`) and its number of rows, built
+/// The triangular factor of [`stacked_jacobian_at`] (`linalg`) and its number of rows, built
 /// a block of configurations at a time (a distance block overlaps the next by one
 /// configuration, so every successive pair is stacked once).
 fn stacked_factor(

@@ -237,7 +237,7 @@ impl MixedWorkspace {
 /// `J^ω_j = s R_Iᵀ ω_j` (the orientation column). Orientation rows: `(R_Iᵀω_k) × J^ω_j`
 /// after joint k, the screw's `s R_Iᵀ ω̇_j`, zero before.
 ///
-/// With joint corrections ([`crate::model::joint_correction`]: compliance, periodic errors)
+/// With joint corrections (`crate::model::joint_correction`: compliance, periodic errors)
 /// the chain runs at `q̃ = q + Δq(q)`, so
 /// `∂J/∂q_k = Σ_l ∂J/∂q̃_l (δ_lk + Σ_{t: joint l} θ_t ∂f_t/∂q_k)`, and the column of θ_t,
 /// `f_t J̃_i` (joint i's column scaled by the basis), gains `(∂f_t/∂q_k) J̃_i`. Allocates

@@ -41,7 +41,7 @@ pub struct Data<T: RealField + Copy> {
     /// [`crate::model::compliance`] puts its point masses.
     pub joint_points: Vec<Vector3<T>>,
     /// The joint-space corrections (compliance, periodic errors;
-    /// [`crate::model::joint_correction`]) and the corrected joints; `None` without them.
+    /// `crate::model::joint_correction`) and the corrected joints; `None` without them.
     /// `joint_twists` are then the twists of the corrected joints `q + Δq`.
     pub corrections: Option<Box<CorrectionData<T>>>,
     /// Per parameter of a constant elementary rotation (no joint): the parameter value (its
@@ -84,7 +84,7 @@ impl<T: RealField + Copy> Data<T> {
 
 /// Evaluates the model at parameters `params` (internal units) and joints `q`, filling
 /// `data` with every frame pose and every parameter and joint twist. A model with joint
-/// corrections ([`crate::model::joint_correction`]: compliance, periodic errors) first
+/// corrections (`crate::model::joint_correction`: compliance, periodic errors) first
 /// computes them at `q`, then evaluates the chain at the corrected joints `q + Δq`.
 /// Allocates nothing.
 pub fn forward_kinematics<T: RealField + Copy>(

@@ -8,7 +8,7 @@
 //! `Δq_i = Σ_k a_ik sin(k q_i) + b_ik cos(k q_i)`
 //!
 //! for the chosen harmonics `k ≥ 1` (`q_i` the commanded angle), and forward kinematics runs
-//! at `q + Δq` with the joint compliance's deflection ([`crate::model::joint_correction`]).
+//! at `q + Δq` with the joint compliance's deflection (`crate::model::joint_correction`).
 //! The constant term (`k = 0`) is the joint offset, already a parameter of every link form,
 //! so it is never a periodic term. The model is linear in the amplitudes: a unit change of
 //! `a_ik` turns joint `i` by `sin(k q_i)`, so its identification column is `sin(k q_i)` times
@@ -18,7 +18,7 @@
 //! A periodic term can be the same function as another over the measured poses: the first
 //! harmonic of a shoulder joint and the compliance of that joint under an elbow mass (whose
 //! lever is `a cos(q_i + φ)`), or any harmonic of a joint that moves over a small range. The
-//! identification's gate ([`crate::identify::nongeometric_gate`]) reports such a term as
+//! identification's gate (`crate::identify::nongeometric_gate`) reports such a term as
 //! not separable and the fit drops it.
 //!
 //! # Names and units

@@ -274,13 +274,13 @@ impl Registry {
         self.params[i].nominal = value;
     }
 
-    /// The correlated prior, if any ([`crate::model::prior`]).
+    /// The correlated prior, if any (`crate::model::prior`).
     pub fn correlated_prior(&self) -> Option<&CorrelatedPrior> {
         self.correlated.as_ref()
     }
 
     /// Sets (or with `None` removes) the correlated prior, after checking it
-    /// ([`CorrelatedPrior::check`]); its parameters keep their statuses (a fit estimates the
+    /// (`CorrelatedPrior::check`); its parameters keep their statuses (a fit estimates the
     /// free ones with it).
     pub fn set_correlated_prior(
         &mut self,

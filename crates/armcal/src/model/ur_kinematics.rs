@@ -25,7 +25,7 @@
 //! identity `tool`; joint values are the controller's.
 //!
 //! **Writing** a calibrated chain: every link is split at its joint, `T_i(q) = A_i J(q) B_i`
-//! ([`super::urdf::export`]), with `R_i` turning z onto the joint axis; the origin of joint
+//! (`super::urdf::export`), with `R_i` turning z onto the joint axis; the origin of joint
 //! `i` is `P_i A_i R_i Tz(d_i)`, where `P_i = Tz(−d_{i−1}) R_{i−1}ᵀ B_{i−1}` (the base frame
 //! for joint 1) and `d_i` is the z component of `R_iᵀ B_i`'s shift, which commutes with the
 //! joint's rotation. For the built-in UR10's DH parameters this gives exactly Universal

@@ -1,11 +1,11 @@
 //! Self-contained HTML reports: figures as inline SVG (plotters, embedded font) and a 3D
 //! view of the cell drawn in the browser from inline data. One file, no network fetches.
 //!
-//! [`documents`] recognises armcal's JSON results; the page opens with the [`verdict`]
-//! panels, then one module per kind builds its section ([`estimate`] with
-//! [`parameter_view`] and [`held_out`], [`design`], [`study`], [`tcp`] for the Figure 7
-//! comparison, [`demo_summary`] and [`compensation`], [`tree`] for a tree's estimate); [`figures`] and
-//! [`parameter_charts`] draw plain data to SVG; [`html`] assembles the page. A design (and
+//! `documents` recognises armcal's JSON results; the page opens with the [`verdict`]
+//! panels, then one module per kind builds its section (`estimate` with
+//! [`parameter_view`] and `held_out`, `design`, `study`, `tcp` for the Figure 7
+//! comparison, `demo_summary` and [`compensation`], `tree` for a tree's estimate);
+//! [`figures`] and [`parameter_charts`] draw plain data to SVG; [`html`] assembles the page. A design (and
 //! the estimate made from it) keeps one colour in every figure ([`design_key`]).
 
 pub(crate) mod campaign;

@@ -75,7 +75,7 @@ fn held_out_baseline(e: &Estimate) -> Option<(&'static str, &ErrorStats)> {
 }
 
 /// The held-out improvement `1 − after/before` of the RMS error over
-/// [`held_out_baseline`] (`None` without a validation or with a zero baseline error).
+/// `held_out_baseline` (`None` without a validation or with a zero baseline error).
 pub fn held_out_gain(e: &Estimate) -> Option<f64> {
     let v = e.validation.as_ref()?;
     let (_, before) = held_out_baseline(e)?;

@@ -1,5 +1,5 @@
 //! A capsule that bounds each URDF `<collision>` shape
-//! ([`CollisionShape`](crate::model::urdf::CollisionShape)), in the shape's chain frame:
+//! ([`CollisionShape`]), in the shape's chain frame:
 //!
 //! | shape | bounding capsule |
 //! |---|---|

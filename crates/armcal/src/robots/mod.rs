@@ -48,7 +48,7 @@ pub struct Robot {
     pub capsules: Vec<Capsule>,
     /// Where the capsules come from, in words (`plan` and `model` print it): hand-made, the
     /// cell's `[[robot.capsules]]`, the URDF's `<collision>` shapes or the skeleton
-    /// ([`skeleton`]) with its radius.
+    /// (`skeleton`) with its radius.
     #[serde(default)]
     pub collision: String,
 }

@@ -52,7 +52,7 @@ pub struct Perturbation {
     /// truth then lies in the identifiable set and identification can recover it exactly).
     pub all: bool,
     /// Perturb the parameters the model holds fixed by their stated prior instead
-    /// (`nominal + σ z`, σ of the cell's [`FixedPrior`], 0 for an exact one; overrides
+    /// (`nominal + σ z`, σ of the cell's `FixedPrior`, 0 for an exact one; overrides
     /// `all` for them): the robot a fit's model floor ([`crate::identify::model_floor`])
     /// describes. `None` (the default): as `all` says.
     #[serde(default)]
@@ -195,7 +195,7 @@ pub fn simulate_carrying(
 /// model without targets: the tool frame's full pose for [`Measured::Pose`] (a full-pose
 /// cell, paper eq. 3 with the orientation), else the tool origin's position. Point targets
 /// are measured in position; frame targets in pose, unless `measured` is
-/// [`Measured::Position`] (a position-measuring cell: [`measurement_at`]).
+/// [`Measured::Position`] (a position-measuring cell: `measurement_at`).
 pub fn simulate_measuring(
     model: &Model,
     truth: &[f64],
@@ -348,7 +348,7 @@ impl TruthRecord {
         }
     }
 
-    /// The record as JSON (keys in alphabetical order, see [`crate::json`]).
+    /// The record as JSON (keys in alphabetical order, see `crate::json`).
     pub fn to_json(&self) -> Result<String, Error> {
         crate::json::sorted_pretty(self)
     }
@@ -401,7 +401,7 @@ pub fn simulate_poses(
 /// "prediction".
 ///
 /// ```
-/// use armcal::model::identifiability::Measurement;
+/// use armcal::Measurement;
 /// use armcal::model::random_configurations;
 /// use armcal::{predict, simulate};
 ///

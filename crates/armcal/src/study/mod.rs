@@ -1,5 +1,5 @@
 //! Reproductions of the sources' experiments.
 
 pub(crate) mod demo;
-pub mod paper;
+pub(crate) mod paper;
 pub mod puma;

@@ -353,7 +353,7 @@ impl StudyRecord {
         }
     }
 
-    /// The record as JSON (keys in alphabetical order, see [`crate::json`]).
+    /// The record as JSON (keys in alphabetical order, see `crate::json`).
     pub fn to_json(&self) -> Result<String, Error> {
         crate::json::sorted_pretty(self)
     }
@@ -398,7 +398,7 @@ pub struct PaperStudy {
     pub failed: Vec<StudyRow>,
 }
 
-/// The study over `robots` ([`run`]), timed, as its record; `observer` sees one step per
+/// The study over `robots` (`run`), timed, as its record; `observer` sees one step per
 /// robot.
 pub fn run_study(robots: &[String], s: &StudySettings, observer: &mut dyn Observer) -> PaperStudy {
     let t0 = Instant::now();

@@ -1,9 +1,8 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
-use armcal::cell::Cell;
 use armcal::model::*;
-use armcal::ParameterStatus;
+use armcal::{Cell, Joint, JointKind, Model, ParameterStatus, Unit};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::Path;
@@ -257,8 +256,7 @@ pub fn paper_cell_with_default_margins() -> Cell {
 /// tracker and the reflector (an explicit free list).
 pub fn unplaced_tracker_paper_cell(frames_only: bool, seed: u64) -> (Cell, Vec<f64>) {
     let placed = example_cell("paper-cell.toml");
-    let truth =
-        armcal::sim::perturbed_truth(&placed.model, &armcal::sim::Perturbation::default(), seed);
+    let truth = armcal::perturbed_truth(&placed.model, &armcal::Perturbation::default(), seed);
     let text = armcal::cell::builtin::PAPER_CELL
         .replace("xyz_mm = [2730.88, 4554.68, 1397.67]", "xyz_mm = [0, 0, 0]")
         .replace("rpy_deg = [-95.63, -95.63, 0.23]", "rpy_deg = [0, 0, 0]");
@@ -310,15 +308,15 @@ pub fn monte_carlo_tcp_poses(
     runs: u64,
     seed: u64,
 ) -> Vec<Vec<Pose<f64>>> {
-    use armcal::identify::{solve, IdentifySettings, Problem};
-    use armcal::progress::Silent;
+    use armcal::identify::{solve, Problem};
+    use armcal::{IdentifySettings, Silent};
     use rayon::prelude::*;
     let model = &cell.model;
     let noise = cell.noise();
     (seed..seed + runs)
         .into_par_iter()
         .map(|s| {
-            let data = armcal::sim::simulate_measuring(
+            let data = armcal::simulate_measuring(
                 model,
                 truth,
                 design,
@@ -362,7 +360,7 @@ pub fn sample_covariance(
 
 /// Every parameter of the estimate `e` of `model` within 1e-6 (display units) of `truth`
 /// (internal units, registry order).
-pub fn assert_estimate_is(model: &Model, e: &armcal::identify::Estimate, truth: &[f64]) {
+pub fn assert_estimate_is(model: &Model, e: &armcal::Estimate, truth: &[f64]) {
     for p in &e.parameters {
         let i = model.registry.require(&p.name).unwrap();
         let f = model.registry.get(i).unit.display_factor();
@@ -417,9 +415,6 @@ pub fn ur10_pose_cell() -> Cell {
          noise = { model = \"constant\", sigma_mm = 0.05, sigma_angle_deg = 0.005 }",
     ) + "\n[[working]]\nname = \"w\"\njoints_deg = [30, -60, 90, -120, -90, 0]\n";
     let cell = cell_from_text(&text, "ur10-pose").unwrap();
-    assert_eq!(
-        cell.measurement,
-        armcal::model::identifiability::Measurement::Pose
-    );
+    assert_eq!(cell.measurement, armcal::Measurement::Pose);
     cell
 }

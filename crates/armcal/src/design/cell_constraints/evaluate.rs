@@ -218,7 +218,7 @@ impl ConstraintSet {
     }
 
     /// Whether `q` lies within the joint bounds (inclusive; the limits shrunk by the joint
-    /// margin, see [`ConstraintSet::joint_bounds`], less [`JOINT_MARGIN_TOLERANCE`]).
+    /// margin, see [`ConstraintSet::joint_bounds`], less `JOINT_MARGIN_TOLERANCE`).
     pub fn within_limits(&self, q: &[f64]) -> bool {
         let tol = self.joint_tolerance;
         q.iter()

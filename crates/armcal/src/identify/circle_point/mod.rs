@@ -8,7 +8,7 @@
 //! ([`axes_to_s_model`], book §4.6.5.1).
 //!
 //! The plane, circle and line fits and the covariance of a fitted axis are geometry:
-//! [`crate::geometry::fit`].
+//! `crate::geometry::fit`.
 
 pub(crate) mod record;
 
@@ -21,7 +21,7 @@ use crate::Error;
 use nalgebra::{Matrix3, Vector3};
 
 /// The shortest sweep (rad, at most a full turn) of `n` evenly spread points at radius `r`
-/// and noise σ whose planned σ's ([`planned_circle_covariance`]) are within
+/// and noise σ whose planned σ's (`planned_circle_covariance`) are within
 /// [`MAX_SIGMA_DIRECTION_DEG`] and [`MAX_SIGMA_POINT_MM`]; `None` if not even a full turn
 /// reaches them. Bisection to 0.1°, the σ's falling with the span.
 pub fn span_for_limits(r: f64, n: usize, sigma: f64) -> Option<f64> {
@@ -268,7 +268,7 @@ pub fn trust_warning(a: &JointAxis) -> Option<String> {
 /// at 0; sweeps made in the book's sequential way (joints j+1… at arbitrary values) still
 /// give correct axes here, but only those with the others at 0 build a zero-reference model.
 ///
-/// Each axis carries the linearised covariance of its fit ([`AxisCovariance`]) and, if it
+/// Each axis carries the linearised covariance of its fit (`AxisCovariance`) and, if it
 /// is not to be trusted, a warning ([`trust_warning`]).
 ///
 /// Errors: a joint not swept or swept twice, mismatched lengths, a joint vector of the

@@ -62,7 +62,7 @@ pub struct AxesRecord {
 }
 
 impl AxesRecord {
-    /// The axes as a JSON array (keys in alphabetical order, see [`crate::json`]).
+    /// The axes as a JSON array (keys in alphabetical order, see `crate::json`).
     pub fn to_json(&self) -> Result<String, Error> {
         crate::json::sorted_pretty(&self.axes)
     }
@@ -105,7 +105,7 @@ pub fn sweeps(model: &Model, data: &Dataset) -> Result<Vec<JointSweep>, Error> {
     Ok(sweeps)
 }
 
-/// The axes identified from the sweeps in `data` ([`sweeps`], [`identify_axes`]), each
+/// The axes identified from the sweeps in `data` (`sweeps`, [`identify_axes`]), each
 /// compared with the nominal axis at q = 0 in the instrument frame.
 pub fn axes_record(model: &Model, data: &Dataset) -> Result<AxesRecord, Error> {
     let axes = identify_axes(model, &sweeps(model, data)?)?;

@@ -133,7 +133,7 @@ impl TreeEstimate {
         )))
     }
 
-    /// The record as JSON (keys in alphabetical order, [`crate::json`]).
+    /// The record as JSON (keys in alphabetical order, `crate::json`).
     pub fn to_json(&self) -> Result<String, Error> {
         crate::json::sorted_pretty(self)
     }
@@ -308,7 +308,7 @@ fn data_measurement(data: &Dataset) -> Measurement {
 ///
 /// With the cell's joint compliance and bending (`--nongeometric` as the cell, or
 /// `compliance`: both kinds) the κ and κ⊥ are fitted with the geometry and gated
-/// ([`crate::identify::nongeometric_gate`]): while a term is not separable, the least
+/// (`crate::identify::nongeometric_gate`): while a term is not separable, the least
 /// separable is dropped (its reason kept) and the tree fitted again; `--nongeometric none`
 /// fits the rigid tree.
 ///

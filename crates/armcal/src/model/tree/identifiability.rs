@@ -1,7 +1,7 @@
 //! Identifiability of a [`Tree`]: the identification Jacobians of every target over the same
 //! random configurations of the tree's joints, stacked (one registry, so a shared link is one
 //! column fed by every branch), analysed as a serial model's
-//! ([`crate::model::identifiability`]: rank, greedy minimal set, reasons, variance inflation).
+//! (`crate::model::identifiability`: rank, greedy minimal set, reasons, variance inflation).
 //!
 //! # The generic count of a tree ([`expected_tree_count`])
 //!

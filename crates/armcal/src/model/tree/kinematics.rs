@@ -1,5 +1,5 @@
 //! Forward kinematics and exact Jacobians of a [`Tree`]: a measurement of a target is its
-//! branch's serial measurement ([`crate::model::kinematics`]) at the branch's joints
+//! branch's serial measurement (`crate::model::kinematics`) at the branch's joints
 //! `q_b = offset + C_b q` ([`crate::model::tree::JointMap`]) and parameters gathered from
 //! the tree's vector. Hence, exactly:
 //! * identification Jacobian: the branch's columns scattered into the tree's

@@ -15,7 +15,7 @@
 //! The corrected origin is `O · T(dx, dy, dz) Rz(dyaw) Ry(dpitch) Rx(droll)` — the nominal
 //! origin `O` composed on the right with the correction, in the joint's origin frame, as
 //! robot_calibration's `update_urdf` composes its frame corrections — and the joint moves by
-//! `q + offset` (the `<calibration rising>` of [`super::calibration`]). No public
+//! `q + offset` (the `<calibration rising>` of `super::calibration`). No public
 //! specification of such a file exists: the layout is a ROS 2 parameter file
 //! (`<node>: ros__parameters:`), the names the `dx … dyaw` of the issue, and the file says
 //! how to apply it in its header. A joint the file does not name keeps its nominal origin.

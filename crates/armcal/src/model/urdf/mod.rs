@@ -1,4 +1,4 @@
-//! URDF import ([`import`]) and export ([`export`]) (urdf-rs 0.10).
+//! URDF import (`import`) and export (`export`) (urdf-rs 0.10).
 //!
 //! **Import** ([`read_urdf`], [`from_urdf_str`], [`from_urdf_robot`]) takes the serial chain
 //! from the root link (the one link that is no joint's child) to a tip link (by default the
@@ -22,7 +22,7 @@
 //! capsules (`robots/bounding.rs`). Inertia, visual geometry and links off the chain are
 //! ignored; a `<mimic>` joint on the chain is refused (a serial chain has no coupled
 //! joints): a URDF that branches or has mimic joints loads as a kinematic tree
-//! ([`read_urdf_tree`], module [`tree`]).
+//! ([`read_urdf_tree`], module `tree`).
 //!
 //! **Export** ([`to_urdf`]) writes any chain, in any convention, as a URDF serial chain. Every
 //! link transform is split at its joint motion, `T_i(q) = A_i · J(q) · B_i`, with `A_i` the
@@ -37,13 +37,14 @@
 //! URDF links are the joint frames, not armcal's link-end frames; the end of the chain and the
 //! targets are exact.
 
-pub mod calibration;
+pub(crate) mod calibration;
 pub mod depth;
 pub(crate) mod export;
 pub(crate) mod import;
 pub mod joint_corrections;
 pub(crate) mod tree;
 
+pub use calibration::{conservative, Dropped};
 pub use export::to_urdf;
 pub use import::{
     from_urdf_robot, from_urdf_str, from_urdf_str_with_collisions, read_urdf,

@@ -5,7 +5,7 @@
 //!
 //! * Truth: the identified robot of Table 6.5; the CMM measures the full end-effector pose
 //!   with the σ of Table 6.4 (seeded noise).
-//! * Poses (§6.2, Figs. 6.9–6.10, [`poses`]): [`book_poses`], 50 on a 3 × 2 × 2 grid in the four arm
+//! * Poses (§6.2, Figs. 6.9–6.10, `poses`): [`book_poses`], 50 on a 3 × 2 × 2 grid in the four arm
 //!   configurations with random orientations, plus 10 held-out poses in the grid box.
 //! * Errors (eqs. 6.41–6.42): [`pose_errors`], δr = |translation of Pm⁻¹Pp|,
 //!   δθ = rotation angle of Pm⁻¹Pp.
@@ -15,10 +15,12 @@
 
 pub(crate) mod book;
 pub(crate) mod poses;
-pub mod record;
+pub(crate) mod record;
+pub(crate) mod settings;
 
 pub use book::*;
 pub use poses::*;
+pub(crate) use settings::PumaSettings;
 
 use crate::identify::{solve, IdentifySettings, Problem};
 use crate::measure::{Dataset, NoiseModel};
@@ -30,24 +32,6 @@ use crate::robots::puma560::{book_dh_spec, book_zrp_spec, MM_PER_IN};
 use crate::sim::simulate;
 use crate::Error;
 use serde::{Deserialize, Serialize};
-
-/// Settings of [`run`].
-#[derive(Clone, Debug)]
-pub struct PumaSettings {
-    /// Seed of the measurement noise (identification data; the held-out data use seed + 1).
-    pub seed: u64,
-    /// Seed of the pose grid's orientations and of the held-out poses.
-    pub pose_seed: u64,
-}
-
-impl Default for PumaSettings {
-    fn default() -> Self {
-        PumaSettings {
-            seed: 1,
-            pose_seed: 6,
-        }
-    }
-}
 
 /// One identification.
 #[derive(Clone, Debug, Serialize, Deserialize)]

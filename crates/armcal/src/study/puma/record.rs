@@ -21,7 +21,7 @@ pub struct PumaRecord {
 }
 
 impl PumaRecord {
-    /// The record as JSON (keys in alphabetical order, see [`crate::json`]).
+    /// The record as JSON (keys in alphabetical order, see `crate::json`).
     pub fn to_json(&self) -> Result<String, Error> {
         crate::json::sorted_pretty(self)
     }

@@ -3,12 +3,12 @@
 //! attained world poses this test made), the grouping of repeated approaches (rows
 //! shuffled, no pose ids, near-duplicate poses of different corners), and bad input.
 
-use armcal::accuracy::report::{accuracy_report, Orientation};
-use armcal::accuracy::same_pose::{commanded_poses, SamePose};
-use armcal::cell::Cell;
-use armcal::measure::{Covariates, Dataset, Measurement, MeasurementKind};
-use armcal::model::pose::{rot_axis, rotation_log};
-use armcal::model::{tool_pose, Model, Observed, Pose};
+use armcal::measure::{Covariates, Measurement, MeasurementKind};
+use armcal::model::{rot_axis, rotation_log};
+use armcal::model::{tool_pose, Observed, Pose};
+use armcal::{
+    accuracy_report, commanded_poses, AccuracyOrientation, Cell, Dataset, Model, SamePose,
+};
 use nalgebra::{Matrix3, Vector3};
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
@@ -175,7 +175,7 @@ fn cube_figures_are_iso_9283_of_the_attained_poses() {
     );
     assert_eq!(found.summary.poses, 9);
     assert_eq!(found.summary.approaches, vec![[30, 9]]);
-    let rep = accuracy_report(model, &p, &data, &found, Orientation::Required).unwrap();
+    let rep = accuracy_report(model, &p, &data, &found, AccuracyOrientation::Required).unwrap();
     assert_eq!(rep.summary.iso_cycles, 9);
     let nominal = model.nominal();
     for fig in &rep.poses {
@@ -338,7 +338,7 @@ fn a_pose_approached_once_has_no_rp_and_positions_give_no_orientation() {
         &data.config_ids,
         &SamePose::default(),
     );
-    let rep = accuracy_report(model, &p, &data, &found, Orientation::IfMeasured).unwrap();
+    let rep = accuracy_report(model, &p, &data, &found, AccuracyOrientation::IfMeasured).unwrap();
     assert_eq!(rep.summary.repeated, 0);
     assert!(rep.summary.rp.is_none() && rep.summary.rp_abc_max_deg.is_none());
     assert!(rep.poses.iter().all(|f| f.repeatability.is_none()
@@ -347,9 +347,16 @@ fn a_pose_approached_once_has_no_rp_and_positions_give_no_orientation() {
             .is_some_and(|o| o.repeatability.is_none())));
     // Positions only: orientation figures are absent, and refused when required.
     let positions = dataset(model, &p, &refs, false);
-    let rep = accuracy_report(model, &p, &positions, &found, Orientation::IfMeasured).unwrap();
+    let rep = accuracy_report(
+        model,
+        &p,
+        &positions,
+        &found,
+        AccuracyOrientation::IfMeasured,
+    )
+    .unwrap();
     assert!(rep.poses.iter().all(|f| f.orientation.is_none()) && rep.orientation_errors.is_none());
-    let err = accuracy_report(model, &p, &positions, &found, Orientation::Required)
+    let err = accuracy_report(model, &p, &positions, &found, AccuracyOrientation::Required)
         .unwrap_err()
         .to_string();
     assert!(

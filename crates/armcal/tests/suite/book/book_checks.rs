@@ -5,8 +5,8 @@
 use crate::common;
 use armcal::model::convert::zrp_to_dh;
 use armcal::model::*;
-use armcal::robots;
 use armcal::robots::puma560::{book_dh_spec, book_zrp_spec, MM_PER_IN};
+use armcal::{robots, Model};
 use common::rng;
 use nalgebra::Vector3;
 use rand::Rng;

@@ -3,16 +3,14 @@
 
 use crate::common;
 use armcal::compensate::cmac::{book_memory_words, Cmac, CmacSettings};
-use armcal::compensate::ik::{damped_step, task_jacobian_columns};
 use armcal::compensate::lqr::{
     operation_count, optimal_compensation, pose_error_map, reduced_order_weight, relative_weights,
     OperationCount,
 };
-use armcal::compensate::nonparametric::PolynomialCorrection;
+use armcal::compensate::{damped_step, task_jacobian_columns};
 use armcal::model::random_configurations;
-use armcal::model::{forward_kinematics, joint_jacobian, tool_pose, Data, Model, Observed, Pose};
-use armcal::robots;
-use armcal::sim::{perturbed_truth, Perturbation};
+use armcal::model::{forward_kinematics, joint_jacobian, tool_pose, Data, Observed, Pose};
+use armcal::{perturbed_truth, robots, Model, Perturbation, PolynomialCorrection};
 use common::rng;
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix4, Rotation3, Vector3};
 use rand::Rng;

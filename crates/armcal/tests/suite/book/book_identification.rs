@@ -16,20 +16,19 @@
 //! **Units.** armcal works in mm and rad; the book's Chapter 6 in inches and degrees
 //! (Table 6.4 in mm and rad). Printed numbers are given in both.
 
-use armcal::cell::Cell;
-use armcal::identify::{solve, IdentifySettings, Method, Problem};
-use armcal::measure::{Dataset, MeasurementKind, NoiseModel};
-use armcal::model::identifiability::{analyze, IdentifiabilitySettings, Measurement};
+use armcal::identify::{solve, Problem};
+use armcal::measure::{MeasurementKind, NoiseModel};
+use armcal::model::analyze;
 use armcal::model::*;
-use armcal::progress::Silent;
-use armcal::robots;
 use armcal::robots::puma560::MM_PER_IN;
-use armcal::sim::simulate;
 use armcal::study::puma::{
     self, arm_configuration, book_poses, pose_errors, table_6_4_noise, Configurations,
     CONFIGURATIONS, GRID_X, GRID_Y, GRID_Z,
 };
-use armcal::ParameterStatus;
+use armcal::{
+    robots, simulate, Cell, Dataset, IdentifiabilitySettings, IdentifySettings, Measurement,
+    Method, Model, ParameterStatus, Silent, Unit,
+};
 use nalgebra::Vector3;
 use std::path::Path;
 use std::sync::OnceLock;
@@ -52,10 +51,7 @@ fn puma_30(spec: &ModelSpec) -> Model {
     m
 }
 
-fn analysis(
-    m: &Model,
-    measurement: Measurement,
-) -> armcal::model::identifiability::Identifiability {
+fn analysis(m: &Model, measurement: Measurement) -> armcal::Identifiability {
     let opts = IdentifiabilitySettings {
         measurement,
         poses: 60,
@@ -65,7 +61,7 @@ fn analysis(
     analyze(m, &m.nominal(), &opts).unwrap()
 }
 
-fn reason<'a>(r: &'a armcal::model::identifiability::Identifiability, name: &str) -> &'a str {
+fn reason<'a>(r: &'a armcal::Identifiability, name: &str) -> &'a str {
     &r.excluded
         .iter()
         .find(|e| e.name == name)
@@ -412,12 +408,8 @@ fn check6_table_6_4_noise_calibrated_held_out_errors() {
         .iter()
         .map(|&i| m.registry.get(i).name.clone())
         .collect();
-    let unc = armcal::identify::uncertainty::parameter_uncertainty(
-        &lm_sol.jacobian,
-        &lm_sol.residual,
-        &names,
-    )
-    .unwrap();
+    let unc = armcal::identify::parameter_uncertainty(&lm_sol.jacobian, &lm_sol.residual, &names)
+        .unwrap();
     // Gauss–Newton = LM to a tiny fraction of each parameter's σ (the book's "identical").
     let mut worst_gn = 0.0f64;
     for (c, &i) in problem.free.iter().enumerate() {

@@ -15,8 +15,8 @@
 //! 0.003–0.005° from the Table 6.4 noise): the test asks 0.1 σ; and both lie within 5 σ of
 //! the truth (Table 6.5).
 
-use armcal::progress::Silent;
-use armcal::study::puma::{run, PumaSettings, PumaStudy};
+use armcal::study::puma::{run, PumaStudy};
+use armcal::{PumaSettings, Silent};
 use std::sync::OnceLock;
 
 fn study() -> &'static PumaStudy {

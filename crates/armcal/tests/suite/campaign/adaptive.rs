@@ -4,14 +4,12 @@
 //! a converged fit, its state resumes, and a batch that is not the planned one is refused
 //! without changing the state.
 
-use armcal::progress::Silent;
-use armcal::sim::Perturbation;
-use armcal::Cell;
 use armcal::{
     campaign_fewest_poses, campaign_largest_sigma, campaign_simulate, campaign_start,
     campaign_step, CampaignDecision as Decision, CampaignPose, CampaignSettings, CampaignState,
     CampaignStep,
 };
+use armcal::{Cell, Perturbation, Silent};
 
 /// The paper cell with the default `[design]` margins: with the paper's zero margins, the
 /// poses a campaign plans sit on the 30° limit and the virtual instrument cannot measure some
@@ -124,7 +122,7 @@ fn the_next_batch_is_planned_at_the_estimate_not_the_nominal() {
     // (incidence, line of sight, collisions, joint limits) — not where the cell puts them.
     let cell = paper_cell();
     let model = &cell.model;
-    let mut truth = armcal::sim::perturbed_truth(model, &Perturbation::default(), 5);
+    let mut truth = armcal::perturbed_truth(model, &Perturbation::default(), 5);
     for name in ["tracker.x", "tracker.y"] {
         truth[model.registry.require(name).unwrap()] += 300.0;
     }
@@ -145,14 +143,14 @@ fn the_next_batch_is_planned_at_the_estimate_not_the_nominal() {
         .map(|(i, q)| CampaignPose::of(model, (i + 1).to_string(), q))
         .collect();
     let noise = cell.noise();
-    let mut batch = armcal::sim::simulate(model, &truth, &qs2, Some(&noise), 7).unwrap();
+    let mut batch = armcal::simulate(model, &truth, &qs2, Some(&noise), 7).unwrap();
     batch.config_ids = state.next.iter().map(|p| p.id.clone()).collect();
     let r = campaign_step(&cell, &state, &batch, &mut Silent).unwrap();
     let step = r.state.steps.last().unwrap();
     let fit = step.fit.as_ref().unwrap();
     assert!(fit.status.is_converged(), "{:?}", fit.status);
     assert_eq!(r.state.decision, Decision::Measure);
-    let set = armcal::design::plan::constraint_set(&cell, true).unwrap();
+    let set = armcal::design::constraint_set(&cell, true).unwrap();
     let nominal = model.nominal();
     // The fit's frames on the nominal links.
     let frames_at_fit: Vec<f64> = model
@@ -164,8 +162,8 @@ fn the_next_batch_is_planned_at_the_estimate_not_the_nominal() {
             _ => f,
         })
         .collect();
-    let at_fit = armcal::design::plan::CellConstraints::new(&set, &frames_at_fit);
-    let at_nominal = armcal::design::plan::CellConstraints::new(&set, &nominal);
+    let at_fit = armcal::design::CellConstraints::new(&set, &frames_at_fit);
+    let at_nominal = armcal::design::CellConstraints::new(&set, &nominal);
     let next: Vec<Vec<f64>> = r.state.next.iter().map(|p| p.q(model)).collect();
     assert_eq!(next.len(), 5);
     assert!(next.iter().all(|q| at_fit.feasible(q)));

@@ -4,16 +4,13 @@
 //! fewer poses than a campaign from the nominal model, and with the moved parameter found.
 
 use armcal::cell::builtin::PAPER_CELL;
-use armcal::identify::{identify, IdentifySettings};
-use armcal::model::sampling::random_configurations;
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, Perturbation};
-use armcal::Cell;
+use armcal::model::random_configurations;
 use armcal::{
     campaign_measure_until_stopped as measure_until_stopped, campaign_simulate as simulate,
     campaign_start_after_check as start_after_check, check, CampaignDecision as Decision,
     CampaignPrior, CampaignSettings, CheckSettings, DriftVerdict,
 };
+use armcal::{identify, perturbed_truth, Cell, IdentifySettings, Perturbation, Silent};
 
 #[test]
 fn a_campaign_from_the_old_calibration_needs_only_what_moved() {
@@ -22,7 +19,7 @@ fn a_campaign_from_the_old_calibration_needs_only_what_moved() {
     let truth = perturbed_truth(model, &Perturbation::default(), 7);
     // The old calibration: 120 random poses (σ = 1 mm).
     let qs = random_configurations(model, 120, 70);
-    let data = armcal::sim::simulate(model, &truth, &qs, Some(&cell.noise()), 71).unwrap();
+    let data = armcal::simulate(model, &truth, &qs, Some(&cell.noise()), 71).unwrap();
     let old = identify(&cell, &data, &IdentifySettings::default(), &mut Silent).unwrap();
     // Later the second joint's offset has moved by 0.5°; 10 check poses find it.
     let j2 = model.registry.index_of("j2.theta").unwrap();
@@ -30,7 +27,7 @@ fn a_campaign_from_the_old_calibration_needs_only_what_moved() {
     moved[j2] += 0.5f64.to_radians();
     let check_qs = random_configurations(model, 10, 72);
     let mut check_data =
-        armcal::sim::simulate(model, &moved, &check_qs, Some(&cell.noise()), 73).unwrap();
+        armcal::simulate(model, &moved, &check_qs, Some(&cell.noise()), 73).unwrap();
     check_data.config_ids = (1..=10).map(|i| format!("c{i}")).collect();
     let c = check(&cell, &old, &check_data, &CheckSettings::default()).unwrap();
     assert_eq!(c.verdict, DriftVerdict::Drifted);
@@ -110,7 +107,7 @@ fn a_damaged_estimate_is_an_error_for_the_check_and_the_prior() {
     let model = &cell.model;
     let truth = perturbed_truth(model, &Perturbation::default(), 3);
     let qs = random_configurations(model, 30, 3);
-    let data = armcal::sim::simulate(model, &truth, &qs, Some(&cell.noise()), 3).unwrap();
+    let data = armcal::simulate(model, &truth, &qs, Some(&cell.noise()), 3).unwrap();
     let mut est = identify(&cell, &data, &IdentifySettings::default(), &mut Silent).unwrap();
     est.uncertainty.covariance = nalgebra::DMatrix::identity(2, 2);
     let e = check(&cell, &est, &data, &CheckSettings::default())

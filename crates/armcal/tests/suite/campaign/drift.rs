@@ -4,12 +4,11 @@
 //! tracker after the calibration is detected, with the moved group ranked first.
 
 use armcal::cell::builtin::PAPER_CELL;
-use armcal::identify::{identify, Estimate, IdentifySettings};
-use armcal::model::sampling::random_configurations;
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, simulate, Perturbation};
-use armcal::Cell;
-use armcal::{check, CheckSettings, DriftCheck, DriftVerdict};
+use armcal::model::random_configurations;
+use armcal::{
+    check, identify, perturbed_truth, simulate, Cell, CheckSettings, DriftCheck, DriftVerdict,
+    Estimate, IdentifySettings, Perturbation, Silent,
+};
 
 fn paper_cell() -> Cell {
     Cell::from_toml(PAPER_CELL, "paper-cell.toml", ".".as_ref()).unwrap()

@@ -2,17 +2,16 @@
 //! 10 000 random reachable poses, per-row statuses for bad targets, and the closed loop:
 //! identify a truth robot, filter a program, and execute it on the truth.
 
-use armcal::cell::Cell;
 use armcal::compensate::closed_form::SphericalWristIk;
-use armcal::compensate::program::{corrected_cartesian_targets, filter_joint_program};
-use armcal::compensate::{CalibratedIk, IkSettings, IkStatus, IkTarget};
-use armcal::identify::{identify, IdentifySettings};
-use armcal::model::pose::rotation_log;
+use armcal::compensate::CalibratedIk;
+use armcal::compensate::{corrected_cartesian_targets, filter_joint_program};
 use armcal::model::random_configurations;
-use armcal::model::{forward_kinematics, Data, Model, Pose};
-use armcal::progress::Silent;
-use armcal::robots;
-use armcal::sim::{perturbed_truth, simulate, Perturbation};
+use armcal::model::rotation_log;
+use armcal::model::{forward_kinematics, Data, Pose};
+use armcal::{
+    identify, perturbed_truth, robots, simulate, Cell, IdentifySettings, IkSettings, IkStatus,
+    IkTarget, Model, Perturbation, Silent,
+};
 use rand::{Rng, SeedableRng};
 use std::f64::consts::PI;
 use std::path::Path;
@@ -281,7 +280,7 @@ fn closed_loop_filtered_program_hits_targets_within_predicted_uncertainty() {
 fn damping_keeps_wrist_corrections_bounded_near_the_wrist_singularity() {
     // Book Table 5.7 (check 9): at θ5 = −1°, a small pose correction with γ → 0 asks for
     // large, opposite motions of joints 4 and 6; damping keeps them small.
-    use armcal::compensate::ik::{damped_step, task_jacobian_columns};
+    use armcal::compensate::{damped_step, task_jacobian_columns};
     use nalgebra::{Vector3, Vector6};
     let cell = paper_cell();
     let model = &cell.model;
@@ -327,8 +326,7 @@ fn damping_keeps_wrist_corrections_bounded_near_the_wrist_singularity() {
 /// converged solve is converged there, and every other outcome keeps its reason.
 #[test]
 fn ik_status_speaks_the_shared_solver_vocabulary() {
-    use armcal::compensate::IkStatus;
-    use armcal::Status;
+    use armcal::{IkStatus, Status};
     for s in [
         IkStatus::Converged,
         IkStatus::Singular,
@@ -433,7 +431,8 @@ fn a_filtered_program_compensates_the_sag_and_gear_errors_a_kinematic_calibratio
 /// program whips the wrist.
 #[test]
 fn the_joint_change_limit_holds_through_the_wrist_singularity_of_any_chain() {
-    use armcal::compensate::joint_change::{joint_change, JointChangeLimit};
+    use armcal::compensate::joint_change;
+    use armcal::JointChangeLimit;
     for name in ["kr15", "puma560", "ur10"] {
         let model = Model::from_spec(&robots::robot(name).unwrap().spec).unwrap();
         let nominal = model.nominal();

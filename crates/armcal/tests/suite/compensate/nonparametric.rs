@@ -2,18 +2,16 @@
 //! polynomial correction of the error a parametric calibration leaves behind, and that
 //! correction applied in program filtering.
 
-use armcal::cell::Cell;
-use armcal::compensate::nonparametric::{
-    chebyshev_nodes, CorrectionInputs, PolynomialBasis, PolynomialCorrection, ResidualCorrection,
-};
-use armcal::compensate::program::filter_joint_program_corrected;
-use armcal::compensate::{IkSettings, IkStatus};
-use armcal::identify::{identify, IdentifySettings};
-use armcal::measure::{Dataset, MeasurementKind, NoiseModel};
+use armcal::compensate::chebyshev_nodes;
+use armcal::compensate::filter_joint_program_corrected;
+use armcal::measure::{MeasurementKind, NoiseModel};
 use armcal::model::random_configurations;
 use armcal::model::{forward_kinematics, Data};
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, simulate, Perturbation};
+use armcal::{
+    identify, perturbed_truth, simulate, Cell, CorrectionInputs, Dataset, IdentifySettings,
+    IkSettings, IkStatus, Perturbation, PolynomialBasis, PolynomialCorrection, ResidualCorrection,
+    Silent,
+};
 use nalgebra::Vector3;
 use std::path::Path;
 

@@ -4,11 +4,10 @@
 //! projection for the half-spaces (issue 12, item 5).
 
 use crate::common::example_cell;
-use armcal::cell::{Cell, Obstacle};
-use armcal::design::plan::{plan, PlanSettings};
-use armcal::design::record::kind_margins;
+use armcal::cell::Obstacle;
+use armcal::design::kind_margins;
 use armcal::model::{forward_kinematics, Data};
-use armcal::progress::Silent;
+use armcal::{plan, Cell, PlanSettings, Silent};
 use nalgebra::Vector3;
 use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::query;
@@ -269,7 +268,7 @@ fn only_a_distance_no_pose_changes_is_exempt_from_the_clearance() {
             "line_of_sight_margin_mm = 10\n",
         );
     let cell = Cell::from_toml(&text, "wall-5mm.toml", Path::new(".")).unwrap();
-    let set = armcal::design::plan::constraint_set(&cell, true).unwrap();
+    let set = armcal::design::constraint_set(&cell, true).unwrap();
     let params = cell.model.nominal();
     let mut ws = set.workspace();
     let qs = armcal::model::random_configurations(&cell.model, 200, 5);

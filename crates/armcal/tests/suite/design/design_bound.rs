@@ -1,13 +1,12 @@
 //! The optimality bound lies below every design found, and the efficiency is reported.
 
-use armcal::cell::Cell;
 use armcal::design::baselines::{strategy, Strategy};
 use armcal::design::bound::optimality_bound;
 use armcal::design::exchange::{exchange, ExchangeSettings};
 use armcal::design::refine::{refine, RefineSettings};
-use armcal::design::{Criterion, DesignModel, DesignObjective};
+use armcal::design::{DesignModel, DesignObjective};
 use armcal::model::random_configurations;
-use armcal::progress::Silent;
+use armcal::{Cell, Criterion, Silent};
 use nalgebra::DMatrix;
 use std::path::Path;
 
@@ -84,7 +83,7 @@ fn book_strategy_one_is_much_worse_than_random() {
             d.jacobian(&mut ws, q);
             j.rows_mut(i * d.rows(), d.rows()).copy_from(&ws.jac);
         }
-        armcal::identify::uncertainty::observability(j.as_view()).condition_number
+        armcal::identify::observability(j.as_view()).condition_number
     };
     let k1 = obs(&strategy(&d.model, Strategy::S1, 60, 0));
     let k2 = obs(&strategy(&d.model, Strategy::S2, 60, 0));

@@ -1,11 +1,10 @@
 //! The exchange algorithm improves on random designs, and the KPI design beats the
 //! parameter-variance design on the KPI (paper Table 7's picture, without constraints).
 
-use armcal::cell::Cell;
 use armcal::design::exchange::{exchange, ExchangeSettings};
-use armcal::design::{Criterion, DesignModel, DesignObjective};
+use armcal::design::{DesignModel, DesignObjective};
 use armcal::model::random_configurations;
-use armcal::progress::Silent;
+use armcal::{Cell, Criterion, Silent};
 use nalgebra::DMatrix;
 use std::path::Path;
 

@@ -3,9 +3,9 @@
 //! and rotation rows).
 
 use crate::common::{example_cell, ur10_pose_cell};
-use armcal::cell::Cell;
-use armcal::design::{Criterion, DesignModel, DesignObjective};
+use armcal::design::{DesignModel, DesignObjective};
 use armcal::model::random_configurations;
+use armcal::{Cell, Criterion};
 
 #[test]
 fn criterion_gradients_match_finite_differences() {

@@ -3,12 +3,10 @@
 //! pose matches the predicted ratio within ±15 %.
 
 use crate::common::monte_carlo_tcp_covariances;
-use armcal::cell::Cell;
 use armcal::design::baselines::random_feasible;
-use armcal::design::plan::{constraint_set, plan, CellConstraints, PlanSettings};
-use armcal::design::{Criterion, DesignModel, DesignObjective};
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, Perturbation};
+use armcal::design::{constraint_set, CellConstraints};
+use armcal::design::{DesignModel, DesignObjective};
+use armcal::{perturbed_truth, plan, Cell, Criterion, Perturbation, PlanSettings, Silent};
 use std::path::Path;
 
 #[test]

@@ -1,11 +1,10 @@
 //! The planner end to end on the paper cell: feasible designs, the KPI design better than
 //! the heuristic and the C_p design, the bound below the design.
 
-use armcal::cell::Cell;
 use armcal::design::baselines::random_feasible;
-use armcal::design::plan::{constraint_set, plan, CellConstraints, PlanSettings};
-use armcal::design::{Criterion, DesignModel, DesignObjective};
-use armcal::progress::Silent;
+use armcal::design::{constraint_set, CellConstraints};
+use armcal::design::{DesignModel, DesignObjective};
+use armcal::{plan, Cell, Criterion, PlanSettings, Silent};
 use std::path::Path;
 
 fn cell(name: &str) -> Cell {

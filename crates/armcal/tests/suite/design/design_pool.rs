@@ -5,14 +5,13 @@
 //! `refine_radius` keeps every joint within the radius of its pool pose (checked against
 //! the pool file's degrees); every criterion runs; bad pools give clear errors.
 
-use armcal::cell::Cell;
 use armcal::design::baselines::{greedy_then_exchange, random_feasible};
-use armcal::design::plan::{constraint_set, CellConstraints};
-use armcal::design::user_pool::{plan_from_pool, PoolSettings};
-use armcal::design::{Criterion, DesignModel, DesignObjective, DesignRecord};
+use armcal::design::plan_from_pool;
+use armcal::design::{constraint_set, CellConstraints};
+use armcal::design::{DesignModel, DesignObjective};
 use armcal::measure::csv;
 use armcal::model::random_configurations;
-use armcal::progress::Silent;
+use armcal::{Cell, Criterion, DesignRecord, PoolSettings, Silent};
 use nalgebra::DMatrix;
 use std::collections::BTreeSet;
 use std::path::Path;

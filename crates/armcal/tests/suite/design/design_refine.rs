@@ -1,12 +1,11 @@
 //! Continuous refinement of a design with OpEn improves on the exchange result and keeps
 //! every pose within the joint limits.
 
-use armcal::cell::Cell;
 use armcal::design::exchange::{exchange, ExchangeResult, ExchangeSettings};
 use armcal::design::refine::{refine, RefineSettings};
-use armcal::design::{Criterion, DesignModel, DesignObjective};
+use armcal::design::{DesignModel, DesignObjective};
 use armcal::model::random_configurations;
-use armcal::progress::Silent;
+use armcal::{Cell, Criterion, Silent};
 use nalgebra::DMatrix;
 use std::path::Path;
 
@@ -84,8 +83,8 @@ fn refinement_improves_the_exchange_design_within_limits() {
 #[test]
 fn constrained_refinement_descends_and_stays_feasible() {
     use armcal::design::baselines::random_feasible;
-    use armcal::design::plan::{constraint_set, CellConstraints};
     use armcal::design::refine::ConfigurationConstraints;
+    use armcal::design::{constraint_set, CellConstraints};
     let text = std::fs::read_to_string(
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-cell-obstacles.toml"),
     )

@@ -4,10 +4,10 @@
 //! `unmeasurable_poses`; the planned example poses are all measurable.
 
 use crate::common::example_cell;
-use armcal::design::cell_constraints::unmeasurable_poses;
 use armcal::design::ConstraintKind;
 use armcal::measure::csv::read_configurations;
 use armcal::model::{forward_kinematics, Data};
+use armcal::unmeasurable_poses;
 use std::path::Path;
 
 fn example(name: &str) -> std::path::PathBuf {

@@ -6,12 +6,7 @@
 //! Monte Carlo.
 
 use crate::common::{monte_carlo_tcp_covariances, paper_cell_with};
-use armcal::cell::Cell;
-use armcal::design::assess::assess;
-use armcal::design::plan::{plan, PlanSettings};
-use armcal::design::Criterion;
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, Perturbation};
+use armcal::{assess, perturbed_truth, plan, Cell, Criterion, Perturbation, PlanSettings, Silent};
 
 const COMPLIANCE: &str = "compliance = [\"q2\", \"q3\"]";
 const PERIODIC: &str = "periodic = { joints = [\"q1\", \"q2\", \"q3\"], harmonics = [1, 2] }";

@@ -5,9 +5,9 @@
 //! Paper: Jost et al. 2017, §2.2 (eq. 20–22), §3.2 (Table 4, Table 5); docs/paper-setup.md for
 //! the reading of the setup and the ≈ 6 % incidence-feasible share of uniform draws.
 
-use armcal::cell::Cell;
 use armcal::design::{ConstraintKind, ConstraintSet, ConstraintSettings};
 use armcal::model::{forward_kinematics, Data};
+use armcal::Cell;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::Path;

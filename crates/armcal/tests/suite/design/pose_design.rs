@@ -6,15 +6,11 @@
 //! orientation that position rows leave undetermined.
 
 use crate::common::{example_cell, monte_carlo_tcp_poses, sample_covariance, ur10_pose_cell};
-use armcal::design::assess::assess;
-use armcal::design::plan::{plan, PlanSettings};
 use armcal::design::{DesignModel, InformationWorkspace};
 use armcal::identify::Problem;
-use armcal::model::identifiability::Measurement;
-use armcal::model::pose::rotation_log;
+use armcal::model::rotation_log;
 use armcal::model::{random_configurations, Rows};
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, Perturbation};
+use armcal::{assess, perturbed_truth, plan, Measurement, Perturbation, PlanSettings, Silent};
 
 #[test]
 fn design_rows_are_the_rows_identification_fits() {
@@ -27,8 +23,7 @@ fn design_rows_are_the_rows_identification_fits() {
             .enumerate()
             .map(|(i, q)| (format!("{}", i + 1), q.clone()))
             .collect();
-        let data =
-            armcal::sim::predict(&cell.model, &d.params, &poses, None, cell.measurement).unwrap();
+        let data = armcal::predict(&cell.model, &d.params, &poses, None, cell.measurement).unwrap();
         let problem = Problem::new(&cell.model, &data, &cell.noise()).unwrap();
         assert_eq!(problem.free, d.free, "{}", cell.name);
         assert_eq!(problem.data_rows(), rows * qs.len(), "{}", cell.name);
@@ -75,7 +70,7 @@ fn pose_design_covariances_hold_in_monte_carlo() {
     let cell = ur10_pose_cell();
     let planned = plan(
         &cell,
-        &armcal::design::plan::PlanSettings {
+        &armcal::PlanSettings {
             collisions: false,
             exchange_only: true,
             pool: 300,

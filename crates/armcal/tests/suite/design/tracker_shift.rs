@@ -7,8 +7,8 @@
 //! against its definition on random geometry.
 
 use crate::common::example_cell;
-use armcal::design::cell_constraints::{ConstraintSet, ConstraintSettings};
 use armcal::design::ConstraintKind;
+use armcal::design::{ConstraintSet, ConstraintSettings};
 use armcal::geometry::{point_segment_distance, segment_cone_distance, segment_distance};
 use armcal::measure::csv::read_configurations;
 use armcal::model::{forward_kinematics, Data};

@@ -3,13 +3,10 @@
 //! smooth maximum between the largest variance and its bound with an exact gradient, and a
 //! `kpi-max` design lowers the worst configuration of the path.
 
-use armcal::cell::Cell;
-use armcal::design::assess::{assess, DesignAssessment};
-use armcal::design::criteria::SMOOTH_MAX_P;
-use armcal::design::plan::{plan, PlanSettings};
-use armcal::design::{Criterion, DesignModel, DesignObjective};
+use armcal::design::SMOOTH_MAX_P;
+use armcal::design::{DesignModel, DesignObjective};
 use armcal::model::random_configurations;
-use armcal::progress::Silent;
+use armcal::{assess, plan, Cell, Criterion, DesignAssessment, PlanSettings, Silent};
 use std::path::Path;
 
 /// The paper cell with `extra` appended, read from a scratch file (beside `files`, written
@@ -238,7 +235,7 @@ fn an_exported_cell_keeps_its_paths_inline() {
         &[("seam.csv", &csv)],
     )
     .unwrap();
-    let text = armcal::cell::export::to_cell_toml(&cell, &cell.model, &cell.model.spec()).unwrap();
+    let text = armcal::cell::to_cell_toml(&cell, &cell.model, &cell.model.spec()).unwrap();
     // Read back where the CSV does not exist: the exported cell stands alone.
     let back = Cell::from_toml(&text, "export.toml", Path::new("/nonexistent")).unwrap();
     assert_eq!(back.working_paths.len(), 1);
@@ -284,8 +281,7 @@ fn a_path_design_lowers_the_largest_sigma_along_a_50_pose_path_in_monte_carlo() 
         .iter()
         .map(|q| q.iter().map(|v| v.to_radians()).collect())
         .collect();
-    let truth =
-        armcal::sim::perturbed_truth(&with_path.model, &armcal::sim::Perturbation::default(), 8);
+    let truth = armcal::perturbed_truth(&with_path.model, &armcal::Perturbation::default(), 8);
     let largest = |design: &[Vec<f64>], seed: u64| {
         crate::common::monte_carlo_tcp_covariances(&with_path, &truth, design, &configs, 200, seed)
             .iter()

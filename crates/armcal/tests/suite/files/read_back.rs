@@ -6,15 +6,13 @@
 //! the study table and the parameter table through a plain CSV reader.
 
 use crate::common::{every_convention_model, measure, random_q, rng};
-use armcal::cell::Cell;
-use armcal::compensate::program::{compensate_program, ProgramFile};
-use armcal::compensate::IkSettings;
 use armcal::measure::format::DataFormat;
-use armcal::measure::{csv, Covariates, Dataset, Measurement, MeasurementKind};
-use armcal::model::{export, Model, Observed};
-use armcal::sim::{perturbed_truth, Perturbation};
-use armcal::study::paper::{StudyRecord, StudyRow};
-use armcal::Table;
+use armcal::measure::{csv, Covariates, Measurement, MeasurementKind};
+use armcal::model::{export, Observed};
+use armcal::{
+    compensate_program, perturbed_truth, Cell, Dataset, IkSettings, Model, PaperStudyRecord,
+    PaperStudyRow, Perturbation, ProgramFile, Table,
+};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use std::path::Path;
@@ -247,8 +245,8 @@ fn compensated_programs_read_back_in_the_program_reader() {
 fn study_and_parameter_tables_keep_their_columns() {
     for case in 0..CASES {
         let r = &mut rng(400 + case);
-        let rows: Vec<StudyRow> = (0..r.random_range(1..5))
-            .map(|_| StudyRow {
+        let rows: Vec<PaperStudyRow> = (0..r.random_range(1..5))
+            .map(|_| PaperStudyRow {
                 robot: name(r),
                 collisions: r.random_bool(0.5),
                 heuristic: r.random_range(0.0..10.0),
@@ -261,7 +259,7 @@ fn study_and_parameter_tables_keep_their_columns() {
                 error: None,
             })
             .collect();
-        let record = StudyRecord {
+        let record = PaperStudyRecord {
             study: "paper".into(),
             collisions: true,
             seconds: 1.0,

@@ -3,8 +3,7 @@
 //! read ("missing escaped value"), because names were written between quotes unescaped.
 //! Every string a cell export writes must read back as itself.
 
-use armcal::cell::export::{export_model, ExportFormat};
-use armcal::cell::Cell;
+use armcal::{export_model, Cell, ExportFormat};
 use std::path::Path;
 
 /// The fuzzer's input, minimized by hand: the paper cell with the instrument's name.

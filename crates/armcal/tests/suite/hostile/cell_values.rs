@@ -1,7 +1,7 @@
 //! Issue 15: a cell's values out of range are refused where they are read (file, line, field
 //! and the range), never passed on to panic or overflow later.
 
-use armcal::cell::Cell;
+use armcal::Cell;
 use std::path::Path;
 
 fn parse(text: &str) -> Result<Cell, String> {

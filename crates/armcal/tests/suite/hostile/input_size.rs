@@ -1,11 +1,9 @@
 //! Issue 15, found #5: every input is read with a size cap, so `/dev/zero` (or any huge file)
 //! given as a cell, URDF, JSON record or data file is an error, not a machine out of memory.
 
-use armcal::cell::Cell;
-use armcal::identify::Estimate;
 use armcal::model::urdf::read_urdf;
 use armcal::report::Document;
-use armcal::{read_capped, TEXT_CAP};
+use armcal::{read_capped, Cell, Estimate, TEXT_CAP};
 use std::path::Path;
 
 const ZERO: &str = "/dev/zero";

@@ -3,12 +3,12 @@
 //! the document, is refused with an error. Each test passes only if the call returns.
 
 use crate::common::example_cell;
-use armcal::design::DesignRecord;
 use armcal::model::random_configurations;
 use armcal::report::figures::{
     bar_figure, cdf_figure, histogram_figure, joint_figure, series_figure, JointTrace,
 };
 use armcal::report::{self, Document, Input, ReportContent};
+use armcal::DesignRecord;
 
 const HUGE: [f64; 3] = [1e308, -1e308, 0.0];
 

@@ -4,11 +4,9 @@
 //! bound (each station adds 6 parameters to a dense fit): the fuzzer's run timed out. A station
 //! needs rows of its own that locate it, and a fit takes at most `MAX_STATIONS`.
 
-use armcal::cell::Cell;
-use armcal::identify::{identify, IdentifySettings};
 use armcal::measure::csv::read_str;
 use armcal::measure::stations::MAX_STATIONS;
-use armcal::progress::Silent;
+use armcal::{identify, Cell, IdentifySettings, Silent};
 use std::path::Path;
 
 const HEADER: &str = "station,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg,target,x_mm,y_mm,z_mm\n";

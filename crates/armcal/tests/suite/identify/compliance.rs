@@ -4,14 +4,12 @@
 //! down to the noise floor; the cell refuses joints it cannot model.
 
 pub(super) use crate::common::paper_cell_with;
-use armcal::cell::Cell;
 use armcal::identify::*;
-use armcal::measure::{Dataset, MeasurementKind, NoiseModel};
-use armcal::model::{
-    forward_kinematics, observed_position, random_configurations, Data, Model, Unit,
+use armcal::measure::{MeasurementKind, NoiseModel};
+use armcal::model::{forward_kinematics, observed_position, random_configurations, Data};
+use armcal::{
+    perturbed_truth, simulate, Cell, Dataset, IdentifySettings, Model, Perturbation, Silent, Unit,
 };
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, simulate, Perturbation};
 
 fn compliant_cell() -> Cell {
     paper_cell_with("compliance = [\"q2\", \"q3\"]", "compliant").unwrap()

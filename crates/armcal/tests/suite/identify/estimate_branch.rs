@@ -4,13 +4,13 @@
 
 use crate::common;
 
-use armcal::cell::Cell;
 use armcal::identify::*;
-use armcal::measure::{Dataset, MeasurementKind};
+use armcal::measure::MeasurementKind;
 use armcal::model::random_configurations;
-use armcal::model::Model;
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, simulate, Perturbation};
+use armcal::{
+    identify, perturbed_truth, simulate, Cell, Dataset, IdentifySettings, Loss, Model,
+    Perturbation, Silent,
+};
 use nalgebra::Vector3;
 
 fn paper_cell() -> Cell {
@@ -175,7 +175,7 @@ fn an_outlier_no_longer_gives_full_turns_or_flipped_links() {
         assert!((u.chi2 - before.chi2).abs() <= 1e-9 * before.chi2);
         // The TCP covariance is a property of the robot, not of its parameterisation.
         let working = vec![cell.working[0].q.clone()];
-        let g0 = uncertainty::tcp_jacobian(&fitted, &raw.params, &problem.free, &working);
+        let g0 = tcp_jacobian(&fitted, &raw.params, &problem.free, &working);
         let cs0 = &g0 * &before.covariance * g0.transpose();
         let cs1 = e.tcp[0].covariance;
         for k in 0..9 {
@@ -188,5 +188,5 @@ fn an_outlier_no_longer_gives_full_turns_or_flipped_links() {
 }
 
 fn parameter_uncertainty_of(sol: &SolverResult, names: &[String]) -> ParameterUncertainty {
-    uncertainty::parameter_uncertainty(&sol.jacobian, &sol.residual, names).unwrap()
+    parameter_uncertainty(&sol.jacobian, &sol.residual, names).unwrap()
 }

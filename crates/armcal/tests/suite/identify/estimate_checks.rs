@@ -4,13 +4,13 @@
 //! naming the difference.
 
 use crate::common;
-use armcal::cell::Cell;
 use armcal::identify::*;
-use armcal::measure::{Dataset, NoiseModel};
+use armcal::measure::NoiseModel;
 use armcal::model::random_configurations;
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, simulate, Perturbation};
-use armcal::Status;
+use armcal::{
+    identify, perturbed_truth, simulate, Acceptance, Cell, Dataset, Estimate, IdentifySettings,
+    Perturbation, Silent, Status,
+};
 use common::example_cell;
 use std::path::Path;
 

@@ -3,7 +3,7 @@
 //! angle), a prismatic joint is not, and a little slack at the ends is inside.
 
 use armcal::identify::fitted_ranges::{outside_warning, FittedRange};
-use armcal::model::{Joint, JointKind};
+use armcal::{Joint, JointKind};
 
 fn joint(kind: JointKind) -> Joint {
     Joint {

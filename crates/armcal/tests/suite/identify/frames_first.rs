@@ -6,9 +6,9 @@
 
 use crate::common;
 
-use armcal::identify::{frames_first_start, frames_only_fit, IdentifySettings};
+use armcal::identify::{frames_first_start, frames_only_fit};
 use armcal::model::random_configurations;
-use armcal::sim::{perturbed_truth, simulate, Perturbation};
+use armcal::{perturbed_truth, simulate, IdentifySettings, Perturbation};
 
 /// The paper cell's data from a perturbed robot at `qs`: the start, the frames-only fit and
 /// the nominal of the reflector offset `smr1.x, .y, .z`.

@@ -3,12 +3,13 @@
 //! orientation error statistic of pose measurements; and the estimates a refit refuses.
 
 use crate::common;
-use armcal::cell::Cell;
 use armcal::identify::*;
-use armcal::measure::{Dataset, Measurement, MeasurementKind};
+use armcal::measure::{Measurement, MeasurementKind};
 use armcal::model::{forward_kinematics, observed_pose, random_configurations, Data, Observed};
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, Perturbation};
+use armcal::{
+    identify, Acceptance, Estimate, FramesRefit, IdentifySettings, LmSettings, ToleranceSettings,
+};
+use armcal::{perturbed_truth, Cell, Dataset, Perturbation, Silent};
 use nalgebra::UnitQuaternion;
 
 /// The UR10 + T-Mac cell and a true robot that differs from the nominal in the parameters
@@ -219,7 +220,7 @@ fn the_orientation_error_is_the_angle_between_measured_and_predicted_quaternions
     let stats =
         armcal::identify::residuals::orientation_stats(&problem, &mut problem.workspace(), &params)
             .unwrap();
-    let expected = armcal::accuracy::ErrorStats::of(&independent);
+    let expected = armcal::ErrorStats::of(&independent);
     for (a, b) in [
         (stats.mean, expected.mean),
         (stats.rms, expected.rms),
@@ -276,7 +277,7 @@ fn a_refit_refuses_an_unconverged_estimate_and_one_of_another_robot() {
     // An estimate of the paper robot is not one of this cell.
     let paper = common::example_cell("paper-cell.toml");
     let qs = random_configurations(&paper.model, 30, 1);
-    let pdata = armcal::sim::simulate(&paper.model, &paper.model.nominal(), &qs, None, 1).unwrap();
+    let pdata = armcal::simulate(&paper.model, &paper.model.nominal(), &qs, None, 1).unwrap();
     let other = identify(&paper, &pdata, &IdentifySettings::default(), &mut Silent).unwrap();
     let err = identify(&cell, &data, &opts(&other), &mut Silent)
         .unwrap_err()

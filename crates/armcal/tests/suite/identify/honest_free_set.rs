@@ -1,13 +1,11 @@
 //! The free set is decided where the fit is, never at the nominal, and every rank below the
 //! generic count names its cause (issue 10, items 1 and 2).
 
-use armcal::cell::Cell;
-use armcal::identify::{identify, IdentifySettings};
 use armcal::model::random_configurations;
 use armcal::model::Convention;
-use armcal::progress::Silent;
-use armcal::robots;
-use armcal::sim::{perturbed_truth, simulate, Perturbation};
+use armcal::{
+    identify, perturbed_truth, robots, simulate, Cell, IdentifySettings, Perturbation, Silent,
+};
 use std::path::Path;
 
 /// A 6R arm of our own as URDF (metres, radians): shoulder and elbow axes parallel (y),
@@ -307,8 +305,9 @@ fn an_inline_mdh_table_with_parallel_axes_is_completed() {
 /// capsules stay where they were in the world.
 #[test]
 fn the_complete_form_changes_no_pose_and_no_capsule() {
-    use armcal::model::complete::{in_form, LinkForm};
-    use armcal::model::{forward_kinematics, Data, Model};
+    use armcal::model::in_form;
+    use armcal::model::{forward_kinematics, Data};
+    use armcal::{LinkForm, Model};
     // A DH table of our own whose axes 2 and 3 are 3° apart with d2 = 35 mm (the case a
     // published, already calibrated DH table often is), followed by a frame6 tool.
     let mut own = robots::robot("irb120").unwrap();

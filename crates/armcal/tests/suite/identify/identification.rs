@@ -2,11 +2,12 @@
 //! solvers, honest covariance (Monte Carlo), both C_s formulas.
 
 use crate::common;
-use armcal::cell::Cell;
 use armcal::identify::*;
 use armcal::model::random_configurations;
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, simulate, Perturbation};
+use armcal::{
+    identify, perturbed_truth, simulate, Cell, Estimate, IdentifySettings, Method, Perturbation,
+    Silent,
+};
 use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
 use std::path::Path;
@@ -93,9 +94,9 @@ fn constrained_tcp_covariance_equals_propagated_covariance() {
     let (_, j) = problem.residual_and_jacobian(&model.nominal());
     let cp = problem.uncertainty_at(&model.nominal()).unwrap().covariance;
     let work: Vec<Vec<f64>> = cell.working.iter().map(|w| w.q.clone()).collect();
-    let g = uncertainty::tcp_jacobian(model, &model.nominal(), &problem.free, &work);
-    let cs = uncertainty::tcp_covariance(&g, &cp, &["w".into()]);
-    let cc = uncertainty::tcp_covariance_constrained(&j, &g).unwrap();
+    let g = tcp_jacobian(model, &model.nominal(), &problem.free, &work);
+    let cs = tcp_covariance(&g, &cp, &["w".into()]);
+    let cc = tcp_covariance_constrained(&j, &g).unwrap();
     let diff = (cs[0].covariance - cc.fixed_view::<3, 3>(0, 0)).abs().max();
     assert!(
         diff < 1e-9 * cs[0].covariance.abs().max(),
@@ -167,8 +168,8 @@ fn tcp_covariance_matches_monte_carlo(cell: &Cell, poses: usize) {
     let data = simulate(model, &truth, &qs, None, 0).unwrap();
     let problem = Problem::new(model, &data, &noise).unwrap();
     let cp = problem.uncertainty_at(&truth).unwrap().covariance;
-    let g = uncertainty::tcp_jacobian(model, &truth, &problem.free, std::slice::from_ref(&work));
-    let cs = uncertainty::tcp_covariance(&g, &cp, &["w".into()]);
+    let g = tcp_jacobian(model, &truth, &problem.free, std::slice::from_ref(&work));
+    let cs = tcp_covariance(&g, &cp, &["w".into()]);
     let ratio = emp.trace() / cs[0].covariance.trace();
     eprintln!(
         "Monte Carlo ({poses} poses, {} non-geometric terms): empirical (1/3) tr = {:.4} mm², \
@@ -186,7 +187,7 @@ fn tcp_covariance_matches_monte_carlo(cell: &Cell, poses: usize) {
 }
 
 /// Identifies `cell` from `data` with each method; returns the estimates (LM first).
-fn every_method(cell: &Cell, data: &armcal::measure::Dataset) -> Vec<Estimate> {
+fn every_method(cell: &Cell, data: &armcal::Dataset) -> Vec<Estimate> {
     [Method::Lm, Method::GaussNewton, Method::Kalman]
         .into_iter()
         .map(|method| {

@@ -1,13 +1,12 @@
 //! Robust estimation with gross errors, and bad input: clear errors, never a panic.
 
-use armcal::accuracy::ErrorStats;
-use armcal::cell::Cell;
 use armcal::identify::*;
 use armcal::measure::{csv, MeasurementKind};
 use armcal::model::random_configurations;
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, simulate, Perturbation};
-use armcal::Status;
+use armcal::{
+    identify, perturbed_truth, simulate, Cell, ErrorStats, Estimate, IdentifySettings, Loss,
+    Method, Perturbation, Silent, Status,
+};
 use nalgebra::Vector3;
 use std::path::Path;
 
@@ -35,7 +34,7 @@ fn robust_fit_rejects_gross_errors_and_lists_them() {
             *value += d * 50.0;
         }
     }
-    let holdout = |data: &armcal::measure::Dataset, robust: Option<Loss>| {
+    let holdout = |data: &armcal::Dataset, robust: Option<Loss>| {
         let opts = IdentifySettings {
             robust,
             holdout: 0.3,
@@ -98,7 +97,7 @@ fn robust_fit_rejects_gross_errors_and_lists_them() {
 
 const HEADER: &str = "pose_id,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg,x_mm,y_mm,z_mm\n";
 
-fn read(text: &str) -> Result<armcal::measure::Dataset, String> {
+fn read(text: &str) -> Result<armcal::Dataset, String> {
     let cell = paper_cell();
     csv::read_str(text, "data.csv", &cell.model, None)
         .map(|d| d.0)

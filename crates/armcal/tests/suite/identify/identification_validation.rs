@@ -2,16 +2,16 @@
 //! user's own test file, the frames-only row of a frames-only cell, and bad fractions.
 
 use crate::common;
-use armcal::accuracy::ErrorStats;
 use armcal::identify::*;
-use armcal::measure::Dataset;
 use armcal::model::random_configurations;
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, simulate, Perturbation};
+use armcal::{
+    identify, perturbed_truth, simulate, Dataset, ErrorStats, IdentifySettings, Perturbation,
+    Silent,
+};
 
 /// Noisy data of the paper cell at `n` random poses whose ids are not their numbers
 /// (`P` + a descending number), so that an index reported as an id shows.
-fn paper_data(n: usize, seed: u64) -> (armcal::cell::Cell, Dataset) {
+fn paper_data(n: usize, seed: u64) -> (armcal::Cell, Dataset) {
     let cell = common::example_cell("paper-cell.toml");
     let truth = perturbed_truth(&cell.model, &Perturbation::default(), 2);
     let qs = random_configurations(&cell.model, n, seed);

@@ -3,11 +3,10 @@
 
 use crate::common;
 use armcal::identify::*;
-use armcal::measure::{Dataset, Measurement, MeasurementKind, NoiseModel};
+use armcal::measure::{Measurement, MeasurementKind, NoiseModel};
 use armcal::model::random_configurations;
 use armcal::model::*;
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, simulate, Perturbation};
+use armcal::{perturbed_truth, simulate, Dataset, IdentifySettings, Model, Perturbation, Silent};
 use nalgebra::{DMatrix, DVector, Vector3};
 
 /// The every-convention chain measured by a point target (positions, distances between
@@ -112,7 +111,7 @@ fn mixed_residual_jacobian_matches_finite_differences() {
 
 #[test]
 fn noise_free_mixed_data_recover_the_truth() {
-    let cell = armcal::cell::Cell::from_file(
+    let cell = armcal::Cell::from_file(
         &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-cell.toml"),
     )
     .unwrap();

@@ -2,13 +2,11 @@
 //! prior, the true TCP error lies in the stated (measurement + floor) 95 % ellipsoid at the
 //! nominal rate, and far less often in the measurement term's alone.
 
-use armcal::cell::Cell;
 use armcal::identify::model_floor::model_floor;
-use armcal::identify::uncertainty::{parameter_uncertainty, tcp_covariance, tcp_jacobian};
-use armcal::identify::{solve, IdentifySettings, Problem};
+use armcal::identify::{parameter_uncertainty, tcp_covariance, tcp_jacobian};
+use armcal::identify::{solve, Problem};
 use armcal::model::{forward_kinematics, observed_position, random_configurations, Data, Observed};
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, simulate, Perturbation};
+use armcal::{perturbed_truth, simulate, Cell, IdentifySettings, Perturbation, Silent};
 use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
 use std::path::Path;

@@ -4,16 +4,16 @@
 //! estimate refusing to predict at a payload it cannot, and the calibrated IK at a payload.
 
 use super::compliance::assert_recovered;
-use armcal::cell::Cell;
-use armcal::compensate::{CalibratedIk, IkSettings, IkTarget};
-use armcal::identify::*;
-use armcal::measure::{csv, Dataset};
+use armcal::compensate::CalibratedIk;
+use armcal::measure::csv;
 use armcal::model::{
     forward_kinematics, identification_jacobian, observed_position, random_configurations, Data,
-    Model, Observed, Rows, Unit,
+    Observed, Rows,
 };
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, simulate_carrying, Perturbation};
+use armcal::{
+    identify, perturbed_truth, simulate_carrying, Cell, Dataset, IdentifySettings, IkSettings,
+    IkTarget, Model, Perturbation, Silent, Unit,
+};
 use nalgebra::DMatrix;
 use std::path::Path;
 
@@ -304,9 +304,10 @@ fn the_calibrated_ik_at_a_payload_reaches_the_target_on_the_loaded_truth() {
 
 #[test]
 fn accuracy_and_the_nonparametric_fit_see_each_rows_payload() {
-    use armcal::accuracy::report::{accuracy_report, Orientation};
-    use armcal::accuracy::same_pose::{commanded_poses, SamePose};
-    use armcal::compensate::nonparametric::{CorrectionInputs, ResidualCorrection};
+    use armcal::{
+        accuracy_report, commanded_poses, AccuracyOrientation, CorrectionInputs,
+        ResidualCorrection, SamePose,
+    };
     let cell = payload_cell();
     let model = &cell.model;
     let p = Perturbation {
@@ -322,7 +323,14 @@ fn accuracy_and_the_nonparametric_fit_see_each_rows_payload() {
         &data.config_ids,
         &SamePose::default(),
     );
-    let report = accuracy_report(model, &truth, &data, &poses, Orientation::IfMeasured).unwrap();
+    let report = accuracy_report(
+        model,
+        &truth,
+        &data,
+        &poses,
+        AccuracyOrientation::IfMeasured,
+    )
+    .unwrap();
     assert!(
         report.errors.max < 1e-9,
         "max error {} mm",

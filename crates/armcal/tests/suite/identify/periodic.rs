@@ -6,11 +6,11 @@
 //! and dropped, and the fit is redone without it.
 
 use super::compliance::{assert_recovered, fit, paper_cell_with};
-use armcal::identify::*;
-use armcal::model::{random_configurations, Unit};
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, simulate, Perturbation};
-use armcal::ParameterStatus;
+use armcal::model::random_configurations;
+use armcal::{
+    identify, perturbed_truth, simulate, IdentifySettings, ParameterStatus, Perturbation, Silent,
+    Unit,
+};
 
 const BOTH: &str = "compliance = [\"q2\", \"q3\"]\n\
                     periodic = { joints = [\"q1\", \"q2\", \"q3\"], harmonics = [1, 2] }";

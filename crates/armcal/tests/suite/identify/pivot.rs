@@ -1,7 +1,8 @@
 //! Pivot (tool-tip) calibration against a known truth and its σ against Monte Carlo.
 
-use armcal::identify::pivot::{pivot_calibration, pivot_from_flange_poses, PivotSettings};
+use armcal::identify::pivot_from_flange_poses;
 use armcal::model::{forward_kinematics, Data};
+use armcal::{pivot_calibration, PivotSettings};
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -13,7 +14,7 @@ use rayon::prelude::*;
 /// the wrist centre touches one point. Returns the poses, the wrist centre in the world and
 /// in the flange frame of the first pose.
 fn wrist_poses(
-    model: &armcal::model::Model,
+    model: &armcal::Model,
     wrist: &[[f64; 3]],
 ) -> (Vec<Vec<f64>>, Vector3<f64>, Vector3<f64>) {
     let params = model.nominal();
@@ -49,7 +50,7 @@ const WRIST: [[f64; 3]; 8] = [
 
 #[test]
 fn pivot_recovers_the_wrist_centre_exactly() {
-    let model = armcal::cell::Cell::load("paper-650-600").unwrap().model;
+    let model = armcal::Cell::load("paper-650-600").unwrap().model;
     let (poses, centre, tip) = wrist_poses(&model, &WRIST);
     let p = pivot_calibration(&model, &model.nominal(), &poses, &PivotSettings::default()).unwrap();
     for k in 0..3 {
@@ -71,7 +72,7 @@ fn pivot_recovers_the_wrist_centre_exactly() {
 
 #[test]
 fn pivot_refuses_poses_about_one_axis() {
-    let model = armcal::cell::Cell::load("paper-650-600").unwrap().model;
+    let model = armcal::Cell::load("paper-650-600").unwrap().model;
     let about_q6: Vec<[f64; 3]> = (0..6).map(|k| [0.0, -60.0, 30.0 * k as f64]).collect();
     let (poses, _, _) = wrist_poses(&model, &about_q6);
     let e = pivot_calibration(&model, &model.nominal(), &poses, &PivotSettings::default())

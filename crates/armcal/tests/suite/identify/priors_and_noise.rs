@@ -1,12 +1,11 @@
 //! MAP estimation with priors, and noise models (per-measurement σ from a data file, range).
 
-use armcal::cell::Cell;
 use armcal::identify::*;
 use armcal::measure::{csv, NoiseModel};
 use armcal::model::random_configurations;
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, simulate, Perturbation};
-use armcal::ParameterStatus;
+use armcal::{
+    perturbed_truth, simulate, Cell, IdentifySettings, ParameterStatus, Perturbation, Silent,
+};
 use std::path::Path;
 
 fn root() -> std::path::PathBuf {

@@ -4,15 +4,16 @@
 //! over one shared instrument pose on noisy data, and a bad `station` value's error.
 
 use crate::common;
-use armcal::cell::Cell;
 use armcal::identify::*;
-use armcal::measure::{csv, Dataset, Measurement, MeasurementKind};
+use armcal::measure::{csv, Measurement, MeasurementKind};
 use armcal::model::{
-    forward_kinematics, identification_jacobian, observed_pose, random_configurations, Data, Model,
+    forward_kinematics, identification_jacobian, observed_pose, random_configurations, Data,
     Observed, Pose, Rows,
 };
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, Perturbation};
+use armcal::{
+    identify, perturbed_truth, Acceptance, Cell, Dataset, FramesRefit, IdentifySettings, Model,
+    Perturbation, Silent,
+};
 use nalgebra::{DMatrix, Vector3};
 use rand::Rng;
 use rand_distr::StandardNormal;

@@ -2,14 +2,12 @@
 //! with a coupled wrist joint, fitted as one problem over both arms' rows.
 
 use crate::common::*;
-use armcal::identify::{Candidate, NonGeometric};
-use armcal::model::identifiability::Measurement;
 use armcal::model::tree::kinematics::{branch_kinematics, tree_observed_pose, TreeData};
 use armcal::model::tree::Tree;
-use armcal::progress::Silent;
-use armcal::sim::{Perturbation, TruthRecord};
-use armcal::TreeEstimate;
-use armcal::{identify_tree, simulate_tree, IdentifySettings, TreeCell};
+use armcal::{
+    identify_tree, simulate_tree, Candidate, IdentifySettings, Measurement, NonGeometric,
+    Perturbation, Silent, TreeCell, TreeEstimate, TruthRecord,
+};
 use nalgebra::{Matrix3, Vector3};
 use rand::Rng;
 
@@ -253,10 +251,7 @@ fn a_compliant_tree_exports_rigid_and_says_what_that_costs() {
         raise_iterations: "--max-iterations",
     };
     let export = |format| armcal::export_tree_estimate(&est, Some(&cell), format, &acceptance);
-    let as_cell = export(armcal::ExportFormat::Cell(
-        armcal::model::complete::LinkForm::AsGiven,
-    ))
-    .unwrap();
+    let as_cell = export(armcal::ExportFormat::Cell(armcal::LinkForm::AsGiven)).unwrap();
     let as_urdf = export(armcal::ExportFormat::Urdf).unwrap();
     let fitted = Tree::from_spec(&est.tree).unwrap();
     let kappas: Vec<usize> = (0..fitted.registry.len())

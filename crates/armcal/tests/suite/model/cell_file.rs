@@ -1,7 +1,8 @@
 //! Cell files: a full inline example loads; every kind of mistake gives file, line and field.
 
-use armcal::cell::{Cell, NoiseModel, Obstacle};
-use armcal::ParameterStatus;
+use armcal::cell::Obstacle;
+use armcal::measure::NoiseModel;
+use armcal::{Cell, ParameterStatus};
 use std::path::Path;
 
 fn parse(text: &str) -> Result<Cell, String> {

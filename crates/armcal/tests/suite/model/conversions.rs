@@ -5,7 +5,7 @@
 use crate::common;
 use armcal::model::convert::{dh_to_mdh, mdh_to_dh, to_zrp, zrp_to_dh};
 use armcal::model::*;
-use armcal::robots;
+use armcal::{robots, JointKind, Model, Unit};
 use common::*;
 
 const POS_TOL: f64 = 1e-9;

@@ -5,15 +5,14 @@
 //! `default_kinematics.yaml`, and one written with known deltas, read as a cell's nominal
 //! robot, reproduces the deltas' forward kinematics.
 
-use armcal::cell::export::{export_against_nominal, ExportFormat, NominalReference};
-use armcal::cell::Cell;
+use armcal::cell::{export_against_nominal, NominalReference};
 use armcal::model::tcp_shift::{NotHeld, SHIFT_CONFIGURATIONS, SHIFT_SEED};
 use armcal::model::ur_kinematics::{from_ur_kinematics_str, to_ur_kinematics};
-use armcal::model::urdf::calibration::conservative;
+use armcal::model::urdf::conservative;
 use armcal::model::urdf::from_urdf_str;
 use armcal::model::urdf::joint_corrections::apply_joint_corrections;
-use armcal::model::{random_configurations, tool_pose, LinkGeometry, Model, ModelSpec};
-use armcal::sim::{perturbed_truth, Perturbation};
+use armcal::model::{random_configurations, tool_pose, LinkGeometry, ModelSpec};
+use armcal::{perturbed_truth, Cell, ExportFormat, Model, Perturbation};
 use std::f64::consts::PI;
 
 /// `max_q` of the tool position (mm) and orientation differences (`‖R_a − R_b‖_F`, about the

@@ -5,6 +5,7 @@
 
 use crate::common;
 use armcal::model::*;
+use armcal::Unit;
 use common::*;
 use nalgebra::DMatrix;
 
@@ -93,7 +94,7 @@ fn calibrated_ik_steps_with_the_joint_jacobian_of_the_commanded_joints() {
     // Calibrated IK's task columns (position rows, rotation rows scaled by L) are the joint
     // Jacobian above, finite-difference checked: with compliance and periodic errors, the
     // chain rule through q + Δq(q) included (issue 14, compensation with the deflection).
-    use armcal::compensate::ik::task_jacobian_columns;
+    use armcal::compensate::task_jacobian_columns;
     use nalgebra::Vector6;
     let length = 800.0;
     for seed in 0..3 {

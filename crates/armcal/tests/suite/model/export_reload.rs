@@ -4,14 +4,14 @@
 //! parameters, `free = "auto"`, name — and identifying again from it gives the same fit
 //! (issue 10, item 8).
 
-use armcal::cell::{export::to_cell_toml, Cell};
-use armcal::identify::{identify, IdentifySettings};
-use armcal::model::complete::LinkForm;
+use armcal::cell::to_cell_toml;
 use armcal::model::export::{export_form, suspicious_values};
 use armcal::model::random_configurations;
-use armcal::model::{forward_kinematics, Data, Model};
-use armcal::progress::Silent;
-use armcal::sim::{perturbed_truth, simulate, Perturbation};
+use armcal::model::{forward_kinematics, Data};
+use armcal::{
+    identify, perturbed_truth, simulate, Cell, IdentifySettings, LinkForm, Model, Perturbation,
+    Silent,
+};
 use std::path::Path;
 
 #[test]

@@ -2,12 +2,11 @@
 //! (1e-6 mm): cell TOML in the model's own convention and as DH, modified DH and
 //! zero-reference; JSON; URDF through urdf-rs.
 
-use armcal::cell::Cell;
 use armcal::model::random_configurations;
 use armcal::model::{
-    convert, export, forward_kinematics, observed_pose, urdf, Data, Model, ModelSpec, Observed,
+    convert, export, forward_kinematics, observed_pose, urdf, Data, ModelSpec, Observed,
 };
-use armcal::sim::{perturbed_truth, Perturbation};
+use armcal::{perturbed_truth, Cell, Model, Perturbation};
 use std::path::Path;
 
 fn calibrated() -> (Model, ModelSpec) {

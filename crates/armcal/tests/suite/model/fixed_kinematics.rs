@@ -8,6 +8,7 @@
 use crate::common;
 use armcal::model::fixed_kinematics::{fixed_forward_kinematics, FixedKinematics};
 use armcal::model::*;
+use armcal::Model;
 use common::*;
 use rand::Rng;
 

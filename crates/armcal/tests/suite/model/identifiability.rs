@@ -1,9 +1,9 @@
 //! Completeness counts (book check 1) and the numerical identifiability analysis.
 
 use crate::common;
-use armcal::cell::Cell;
-use armcal::model::identifiability::{analyze, IdentifiabilitySettings, Measurement};
+use armcal::model::analyze;
 use armcal::model::*;
+use armcal::{Cell, IdentifiabilitySettings, JointKind, Measurement, Model};
 use common::*;
 use std::path::Path;
 
@@ -145,7 +145,7 @@ fn position_and_distance_lose_orientation_and_placement() {
 fn identical_poses_are_rank_deficient() {
     let cell = Cell::from_file(&examples().join("paper-cell.toml")).unwrap();
     let q = vec![0.1, -0.3, 0.5, 0.2, 0.4, 0.1];
-    let report = armcal::model::identifiability::analyze_at(
+    let report = armcal::model::analyze_at(
         &cell.model,
         &cell.model.nominal(),
         &vec![q; 20],

@@ -2,9 +2,10 @@
 //! finite kinematics, capsules on existing frames), and the robots with published reference
 //! poses reproduce them.
 
-use armcal::model::pose::{rot_x, rot_y};
-use armcal::model::{forward_kinematics, tool_pose, Data, Model};
+use armcal::model::{forward_kinematics, tool_pose, Data};
+use armcal::model::{rot_x, rot_y};
 use armcal::robots::{self, NAMES};
+use armcal::Model;
 use nalgebra::Vector3;
 
 /// Joint count each library robot must have.

@@ -6,13 +6,13 @@
 //! identifiability; and the errors of a malformed tree.
 
 use crate::common::*;
-use armcal::model::identifiability::{IdentifiabilitySettings, Measurement};
 use armcal::model::tree::bending::lumped_tree_bending;
 use armcal::model::tree::compliance::lumped_tree_compliance;
 use armcal::model::tree::identifiability::{analyze_tree, expected_tree_count};
 use armcal::model::tree::kinematics::*;
 use armcal::model::tree::*;
 use armcal::model::*;
+use armcal::{IdentifiabilitySettings, Joint, JointKind, Measurement};
 use nalgebra::DMatrix;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
@@ -664,8 +664,7 @@ fn a_coupled_joint_leaves_no_redundant_parameter_free_and_says_why() {
         .iter()
         .map(|q| vec![q[0], q[1], q[2], -(q[1] + q[2]), q[3]])
         .collect();
-    let oracle =
-        armcal::model::identifiability::analyze_at(serial, &serial.nominal(), &qs, &opts).unwrap();
+    let oracle = armcal::model::analyze_at(serial, &serial.nominal(), &qs, &opts).unwrap();
     assert_eq!(coupled.rank_svd, oracle.rank_svd);
     assert_eq!(coupled.identifiable, oracle.identifiable);
     // the coupling costs identifiable parameters against free joints
@@ -717,8 +716,7 @@ fn a_one_branch_tree_is_its_serial_chain() {
     };
     let qs = random_tree_configurations(&tree, 30);
     let t = analyze_tree(&tree, &tree.nominal(), Some(&qs), &opts).unwrap();
-    let s =
-        armcal::model::identifiability::analyze_at(serial, &serial.nominal(), &qs, &opts).unwrap();
+    let s = armcal::model::analyze_at(serial, &serial.nominal(), &qs, &opts).unwrap();
     assert_eq!(t.rank_svd, s.rank_svd);
     assert_eq!(t.identifiable, s.identifiable);
     assert_eq!(

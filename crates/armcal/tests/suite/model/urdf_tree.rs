@@ -5,9 +5,7 @@ use crate::common::*;
 use armcal::model::tree::kinematics::{branch_kinematics, tree_observed_pose, TreeData};
 use armcal::model::tree::{Tree, TreeSpec};
 use armcal::model::urdf::{tree_from_urdf_str, tree_to_urdf};
-use armcal::progress::Silent;
-use armcal::sim::Perturbation;
-use armcal::{identify_tree, simulate_tree, IdentifySettings, TreeCell};
+use armcal::{identify_tree, simulate_tree, IdentifySettings, Perturbation, Silent, TreeCell};
 use nalgebra::Vector3;
 use rand::Rng;
 use std::collections::HashMap;
@@ -173,7 +171,7 @@ fn a_dual_arm_urdf_identifies_and_exports_back_to_an_equal_tree() {
     let text = armcal::export_tree_estimate(
         &est,
         Some(&cell),
-        armcal::ExportFormat::Cell(armcal::model::complete::LinkForm::AsGiven),
+        armcal::ExportFormat::Cell(armcal::LinkForm::AsGiven),
         &armcal::Acceptance {
             accepted: false,
             accept: "--accept-unconverged",

@@ -1,11 +1,8 @@
 //! Real data: calibration of the Motoman dual-arm robot from the Leica laser-tracker grids
 //! (data/motoman-leica), with a seeded held-out third, and its position repeatability.
 
-use armcal::accuracy::iso9283::position_repeatability;
-use armcal::cell::Cell;
-use armcal::identify::{identify, IdentifySettings};
 use armcal::measure::{csv, MeasurementKind};
-use armcal::progress::Silent;
+use armcal::{identify, position_repeatability, Cell, IdentifySettings, Silent};
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {
@@ -13,7 +10,7 @@ fn root() -> PathBuf {
 }
 
 /// The Motoman cell `examples/motoman-{cell}.toml` and the grid of its `arm`.
-pub(super) fn motoman(cell: &str, arm: &str) -> (Cell, armcal::measure::Dataset) {
+pub(super) fn motoman(cell: &str, arm: &str) -> (Cell, armcal::Dataset) {
     let cell = Cell::from_file(&root().join(format!("examples/motoman-{cell}.toml"))).unwrap();
     let cols = cell.data_columns.as_ref().unwrap().joints.clone();
     let (data, _) = csv::read(

@@ -19,8 +19,8 @@
 //! constant, and each arm was measured from its own tracker station, so the torso transform is
 //! absorbed by the fitted tracker frame).
 
-use armcal::model::{forward_kinematics, Convention, Data, LinkGeometry, Model, ModelSpec};
-use armcal::robots;
+use armcal::model::{forward_kinematics, Convention, Data, LinkGeometry, ModelSpec};
+use armcal::{robots, Model};
 use nalgebra::{Matrix3, Vector3};
 use std::path::PathBuf;
 

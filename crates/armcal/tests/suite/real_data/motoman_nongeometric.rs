@@ -3,11 +3,10 @@
 //! worse than the kinematic fit by more than the noise of the held-out RMS itself.
 
 use super::motoman_calibration::motoman;
-use armcal::accuracy::stats::ErrorStats;
-use armcal::cell::Cell;
-use armcal::identify::{identify, Candidate, IdentifySettings, NonGeometric, Validation};
-use armcal::measure::Dataset;
-use armcal::progress::Silent;
+use armcal::identify::Validation;
+use armcal::{
+    identify, Candidate, Cell, Dataset, ErrorStats, IdentifySettings, NonGeometric, Silent,
+};
 
 /// The held-out validation of a fit of `cell` to `data` with `nongeometric`, and the
 /// candidate `auto` chose (every candidate's cross-validated RMS printed as `label: …`).

@@ -8,9 +8,7 @@
 //! `examples/motoman-tree-nongeometric-cell.toml` against the serial non-geometric cells).
 
 use super::motoman_calibration::motoman;
-use armcal::identify::{identify, IdentifySettings, NonGeometric};
-use armcal::progress::Silent;
-use armcal::{identify_tree, TreeCell};
+use armcal::{identify, identify_tree, IdentifySettings, NonGeometric, Silent, TreeCell};
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {

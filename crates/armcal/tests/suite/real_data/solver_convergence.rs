@@ -10,10 +10,7 @@
 
 use super::motoman_calibration::motoman;
 use super::ur10_stations::{series, ur10_cell};
-use armcal::cell::Cell;
-use armcal::identify::{identify, Estimate, IdentifySettings};
-use armcal::measure::Dataset;
-use armcal::progress::Observer;
+use armcal::{identify, Cell, Dataset, Estimate, IdentifySettings, Observer};
 use rayon::prelude::*;
 
 /// Records the iterations of every Levenberg–Marquardt run it observes.

@@ -9,12 +9,11 @@
 //! other corner once. One cube is repeated 0.9 mm lower (rows 73–99): its corners stay poses
 //! of their own.
 
-use armcal::accuracy::same_pose::{commanded_poses, SamePose};
-use armcal::cell::Cell;
-use armcal::identify::{identify, IdentifySettings};
 use armcal::measure::csv;
-use armcal::Silent;
-use armcal::{performance, Calibrated, PerformanceSettings};
+use armcal::{
+    commanded_poses, identify, performance, Calibrated, Cell, IdentifySettings,
+    PerformanceSettings, SamePose, Silent,
+};
 use std::path::Path;
 
 #[test]

@@ -16,13 +16,13 @@
 //!   0.03 / 0.04° (A / B / D; bound 1 mm, 0.2°); a wrong joint unit or order, or a wrong Goal
 //!   convention, gives tens of millimetres.
 
-use armcal::cell::Cell;
 use armcal::measure::angles::Orientation;
 use armcal::measure::csv;
 use armcal::measure::format::{ColumnUnit, Columns, DataFormat, OrientationColumns};
-use armcal::measure::{Dataset, MeasurementKind};
-use armcal::model::pose::rotation_log;
+use armcal::measure::MeasurementKind;
+use armcal::model::rotation_log;
 use armcal::model::{tool_pose, Pose};
+use armcal::{Cell, Dataset};
 use nalgebra::{Matrix3, Vector3};
 use std::path::{Path, PathBuf};
 
@@ -349,7 +349,7 @@ fn the_commanded_pose_is_the_nominal_ur10_with_the_planned_tcp() {
 #[test]
 fn an_exported_cell_keeps_the_data_mapping() {
     let cell = cell();
-    let text = armcal::cell::export::to_cell_toml(&cell, &cell.model, &cell.model.spec()).unwrap();
+    let text = armcal::cell::to_cell_toml(&cell, &cell.model, &cell.model.spec()).unwrap();
     let back = Cell::from_toml(&text, "export.toml", Path::new(".")).unwrap();
     assert_eq!(back.data_format(), cell.data_format());
 }

@@ -4,12 +4,11 @@
 //! held-out error of Series B's robot on Series D (1.3 °C colder) and A (1.2 °C warmer), with
 //! and without a linear thermal expansion of the robot's link lengths.
 
-use armcal::cell::Cell;
-use armcal::identify::{
-    held_out, identify, is_frame_parameter, Acceptance, Estimate, FramesRefit, IdentifySettings,
+use armcal::identify::{held_out, is_frame_parameter};
+use armcal::measure::csv;
+use armcal::{
+    identify, Acceptance, Cell, Dataset, Estimate, FramesRefit, IdentifySettings, Silent,
 };
-use armcal::measure::{csv, Dataset};
-use armcal::Silent;
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {

@@ -3,10 +3,10 @@
 //! robot's DH table, `src/robots/paper.rs`), the constraint status of each pose against the
 //! library's constraint set and parry's capsule distances, and bad input.
 
-use armcal::cell::Cell;
-use armcal::design::plan::constraint_set;
+use armcal::design::constraint_set;
 use armcal::model::random_configurations;
 use armcal::report::cell_view::cell_view_section;
+use armcal::Cell;
 use nalgebra::{Matrix4, Vector3, Vector4};
 use serde_json::Value;
 use std::path::Path;

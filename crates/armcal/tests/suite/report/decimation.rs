@@ -2,11 +2,10 @@
 //! most `decimate::MAX_POINTS` points per component, keeps the extremes, and says so.
 
 use crate::common::example_cell;
-use armcal::identify::{identify, IdentifySettings, MeasurementResidual};
+use armcal::identify::MeasurementResidual;
 use armcal::model::random_configurations;
-use armcal::progress::Silent;
 use armcal::report::{self, Document, Input, ReportContent};
-use armcal::sim::{perturbed_truth, simulate, Perturbation};
+use armcal::{identify, perturbed_truth, simulate, IdentifySettings, Perturbation, Silent};
 
 /// The numbers written as tick labels (`<text …>value</text>`) in the SVG `svg`.
 fn tick_values(svg: &str) -> Vec<f64> {

@@ -2,13 +2,9 @@
 //! figure count, document recognition and the constraint margins of the design file.
 
 use crate::common;
-use armcal::cell::Cell;
-use armcal::design::record::kind_margins;
-use armcal::design::DesignRecord;
-use armcal::identify::{identify, Estimate, IdentifySettings};
+use armcal::design::kind_margins;
 use armcal::model::random_configurations;
 use armcal::model::{forward_kinematics, Data};
-use armcal::progress::Silent;
 use armcal::report::ellipse::{confidence_scale, ellipse_axes, ellipse_points, Plane};
 use armcal::report::figures::{
     bar_figure, cdf_figure, colour, ellipse_figure, histogram_figure, joint_figure, series_figure,
@@ -16,8 +12,10 @@ use armcal::report::figures::{
 };
 use armcal::report::html::{escape, number};
 use armcal::report::{self, Document, Input, ReportContent};
-use armcal::sim::{perturbed_truth, simulate, Perturbation};
-use armcal::study::paper::{notional_robots, StudyRecord, StudyRow};
+use armcal::{
+    identify, notional_robots, perturbed_truth, simulate, Cell, DesignRecord, Estimate,
+    IdentifySettings, PaperStudyRecord, PaperStudyRow, Perturbation, Silent,
+};
 use common::example_cell;
 use nalgebra::{Matrix2, Matrix3, Vector2};
 use std::sync::OnceLock;
@@ -460,7 +458,7 @@ fn incidence_margin_is_the_angle_left_to_the_limit() {
 
 /// A study result with the three KUKA robots and the 90 notional manipulators, values
 /// spread around the paper's (for the rendering only).
-fn study(collisions: bool) -> StudyRecord {
+fn study(collisions: bool) -> PaperStudyRecord {
     let mut robots = vec!["kr15".to_string(), "kr300".into(), "kr500".into()];
     robots.extend(notional_robots());
     let rows = robots
@@ -472,7 +470,7 @@ fn study(collisions: bool) -> StudyRecord {
                 0.42 + 0.0002 * i as f64,
                 0.34 + 0.0001 * i as f64,
             );
-            StudyRow {
+            PaperStudyRow {
                 robot: r.clone(),
                 collisions,
                 heuristic: h,
@@ -486,7 +484,7 @@ fn study(collisions: bool) -> StudyRecord {
             }
         })
         .collect();
-    StudyRecord {
+    PaperStudyRecord {
         study: "paper".into(),
         collisions,
         seconds: 0.0,
@@ -562,7 +560,7 @@ fn an_estimate_without_degrees_of_freedom_reads_back() {
 fn the_tcp_section_shows_every_working_pose() {
     let (_, design, est) = fixtures();
     let (mut design, mut est) = (design.clone(), est.clone());
-    let second = |t: &armcal::identify::uncertainty::TcpCovariance| {
+    let second = |t: &armcal::TcpCovariance| {
         let mut t = t.clone();
         t.name = "q_second".into();
         t.covariance *= 2.0;

@@ -8,9 +8,10 @@
 use crate::common::*;
 use armcal::model::tree::kinematics::{branch_kinematics, tree_observed_pose, TreeData};
 use armcal::model::tree::Tree;
-use armcal::progress::Silent;
-use armcal::sim::Perturbation;
-use armcal::{files_report, identify_tree, simulate_tree, Acceptance, IdentifySettings, TreeCell};
+use armcal::{
+    files_report, identify_tree, simulate_tree, Acceptance, IdentifySettings, Perturbation, Silent,
+    TreeCell,
+};
 use rand::Rng;
 use serde_json::Value;
 

@@ -5,10 +5,7 @@
 //! predicted ellipses on top, scrolling tables, a file given twice shown once).
 
 use super::html::fixtures;
-use armcal::compensate::program::{filter_joint_program, ProgramRecord};
-use armcal::compensate::IkSettings;
-use armcal::files_report;
-use armcal::identify::Acceptance;
+use armcal::compensate::filter_joint_program;
 use armcal::identify::Chi2Outcome;
 use armcal::model::tool_pose;
 use armcal::report::compensation::joint_corrections;
@@ -17,7 +14,9 @@ use armcal::report::parameter_charts::{correlation_colour, heatmap_figure};
 use armcal::report::parameter_view::{change_over_sigma, correlation, estimate_minus_truth};
 use armcal::report::verdict::{estimate_grade, held_out_gain, Grade};
 use armcal::report::{self, design_key, Document, Input, ReportContent};
-use armcal::sim::{perturbed_truth, Perturbation, TruthRecord};
+use armcal::{
+    files_report, perturbed_truth, Acceptance, IkSettings, Perturbation, ProgramRecord, TruthRecord,
+};
 use nalgebra::{DMatrix, Matrix3};
 use plotters::style::RGBColor;
 
