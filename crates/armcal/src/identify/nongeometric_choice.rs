@@ -188,37 +188,58 @@ pub(super) fn choose(
     };
     let offered = Candidate::offered(&cell.model);
     let folds_of = deal_folds(train, folds, opts.seed)?;
+    cross_validate(
+        &offered,
+        &folds_of,
+        train.configurations.len(),
+        |candidate| {
+            let left_out = candidate.left_out(&cell.model)?;
+            let whole = fit_free_set(cell, train, noise, &inner, &left_out, &mut Silent)?;
+            Ok((
+                cell.model.joint_corrections().count() - left_out.len(),
+                whole,
+            ))
+        },
+        |whole, fit_data, held| {
+            let mut problem = Problem::new(&whole.model, fit_data, noise)?;
+            let start = &whole.solution.params;
+            let (fit, _, _) = solve(&mut problem, start, &inner, &mut Silent)?;
+            let eval = Problem::new(&whole.model, held, noise)?;
+            Ok(eval.errors(&mut eval.workspace(), &fit.params))
+        },
+        observer,
+    )
+}
+
+/// Cross-validates the candidates `offered` over the folds `folds_of` of `configurations`
+/// training configurations and chooses one ([`scored`]): each candidate is fitted once on
+/// all of them by `whole` (its term count and fit), then each fold by `fold` (the fit on
+/// the fold's data, started from the whole fit; the position errors (mm) of its held-out
+/// data); the candidates and their folds run in parallel.
+pub(super) fn cross_validate<W: Send + Sync>(
+    offered: &[Candidate],
+    folds_of: &[(Dataset, Dataset)],
+    configurations: usize,
+    whole: impl Fn(Candidate) -> Result<(usize, W), Error> + Sync,
+    fold: impl Fn(&W, &Dataset, &Dataset) -> Result<Vec<f64>, Error> + Sync,
+    observer: &mut dyn Observer,
+) -> Result<NonGeometricChoice, Error> {
     observer.start(
         "cross-validating the non-geometric terms",
-        Some(offered.len() * folds),
+        Some(offered.len() * folds_of.len()),
     );
-    // Every candidate's term count and fold errors; the candidates and their folds run in
-    // parallel.
     let fitted: Vec<(usize, Vec<Vec<f64>>)> = offered
         .par_iter()
         .map(|&candidate| {
-            let left_out = candidate.left_out(&cell.model)?;
-            let whole = fit_free_set(cell, train, noise, &inner, &left_out, &mut Silent)?;
-            let terms = cell.model.joint_corrections().count() - left_out.len();
+            let (terms, fit) = whole(candidate)?;
             let errors = folds_of
                 .par_iter()
-                .map(|(fit_data, held)| {
-                    let mut problem = Problem::new(&whole.model, fit_data, noise)?;
-                    let start = &whole.solution.params;
-                    let (fit, _, _) = solve(&mut problem, start, &inner, &mut Silent)?;
-                    let eval = Problem::new(&whole.model, held, noise)?;
-                    Ok(eval.errors(&mut eval.workspace(), &fit.params))
-                })
+                .map(|(fit_data, held)| fold(&fit, fit_data, held))
                 .collect::<Result<_, Error>>()?;
             Ok((terms, errors))
         })
         .collect::<Result<_, Error>>()?;
-    Ok(scored(
-        &offered,
-        fitted,
-        train.configurations.len(),
-        observer,
-    ))
+    Ok(scored(offered, fitted, configurations, observer))
 }
 
 /// The `folds` folds of `train`'s configurations, each (the data fitted, the data held out):
@@ -257,7 +278,7 @@ pub(super) fn deal_folds(
 /// each fold) in `fitted`, and chooses one by the one-standard-error rule (module notes);
 /// `configurations` were dealt into the folds. Steps `observer` once per fold (its `start`
 /// is the caller's).
-pub(super) fn scored(
+fn scored(
     offered: &[Candidate],
     fitted: Vec<(usize, Vec<Vec<f64>>)>,
     configurations: usize,

@@ -44,7 +44,7 @@ pub struct TermVerdict {
     pub unabsorbed: f64,
     /// A compliance with κ < −2σ: the arm rises against gravity.
     pub wrong_sign: bool,
-    /// Unabsorbed share ≥ [`MIN_UNABSORBED`] and |ρ| < [`MAX_CORRELATION`].
+    /// Unabsorbed share ≥ `MIN_UNABSORBED` (5 %) and |ρ| < `MAX_CORRELATION` (0.99).
     pub separable: bool,
 }
 

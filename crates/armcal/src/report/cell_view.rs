@@ -449,16 +449,20 @@ fn scene(cell: &Cell, designs: &[(&str, &[Vec<f64>])]) -> Result<Scene, Error> {
         } else {
             model.targets.iter().map(|t| t.spec.name.clone()).collect()
         },
-        joints: model
-            .joints
-            .iter()
-            .map(|j| JointLabel {
-                name: j.name.clone(),
-                unit: j.kind.unit().display_name(),
-            })
-            .collect(),
+        joints: joint_labels(&model.joints),
         designs: design_views,
     })
+}
+
+/// Each joint's name and display unit, for the pose readout.
+pub(super) fn joint_labels(joints: &[crate::model::link::Joint]) -> Vec<JointLabel> {
+    joints
+        .iter()
+        .map(|j| JointLabel {
+            name: j.name.clone(),
+            unit: j.kind.unit().display_name(),
+        })
+        .collect()
 }
 
 /// Records the robot capsules and obstacles a constraint name refers to. Names are

@@ -74,6 +74,19 @@ const STATS_HEAD_DEG: [&str; 6] = [
     "max (deg)",
 ];
 
+/// σ̂₀², χ² with its degrees of freedom, the p-value and the verdict (book eq. 5.23), as a
+/// report states them.
+pub(super) fn variance_factor(u: &crate::identify::uncertainty::ParameterUncertainty) -> String {
+    format!(
+        "{} (χ² = {} with {} degrees of freedom, p = {}): {}",
+        number(u.variance_factor),
+        number(u.chi2),
+        u.dof,
+        fixed(u.p_value, 3),
+        escape(&u.verdict)
+    )
+}
+
 /// The section for `e`, labelled `label` (plain text), anchored at `id`.
 pub fn estimate_section(id: &str, label: &str, e: &Estimate) -> Result<Section, Error> {
     let mut s = Section::new(id, &format!("Estimate: {label}"));
@@ -111,17 +124,7 @@ pub fn estimate_section(id: &str, label: &str, e: &Estimate) -> Result<Section, 
                 number(sol.history.last().copied().unwrap_or(f64::NAN))
             ),
         ),
-        (
-            "variance factor σ̂₀²",
-            format!(
-                "{} (χ² = {} with {} degrees of freedom, p = {}): {}",
-                number(u.variance_factor),
-                number(u.chi2),
-                u.dof,
-                fixed(u.p_value, 3),
-                escape(&u.verdict)
-            ),
-        ),
+        ("variance factor σ̂₀²", variance_factor(u)),
     ];
     match &e.verdicts {
         Some(v) => {

@@ -11,8 +11,9 @@
 //! does not keep the measured configurations.
 
 use super::cell_view::{
-    mm, round_to, view_section, Bounds, DesignView, JointLabel, PoseView, RobotCapsule, Scene,
+    joint_labels, mm, round_to, view_section, Bounds, DesignView, PoseView, RobotCapsule, Scene,
 };
+use super::estimate::variance_factor;
 use super::html::{escape, facts, fixed, number, table, Section};
 use crate::accuracy::ErrorStats;
 use crate::identify::tree::TreeEstimate;
@@ -38,7 +39,6 @@ pub(super) fn tree_estimate_section(
     e: &TreeEstimate,
 ) -> Result<Section, Error> {
     let mut s = Section::new(id, &format!("Tree estimate: {label}"));
-    let u = &e.uncertainty;
     let sol = &e.solver;
     let solver = if sol.status.is_converged() {
         escape(&sol.status.to_string())
@@ -69,17 +69,7 @@ pub(super) fn tree_estimate_section(
                 sol.iterations
             ),
         ),
-        (
-            "variance factor σ̂₀²",
-            format!(
-                "{} (χ² = {} with {} degrees of freedom, p = {}): {}",
-                number(u.variance_factor),
-                number(u.chi2),
-                u.dof,
-                fixed(u.p_value, 3),
-                escape(&u.verdict)
-            ),
-        ),
+        ("variance factor σ̂₀²", variance_factor(&e.uncertainty)),
         (
             "held out",
             if e.validation.is_empty() {
@@ -345,14 +335,7 @@ fn tree_scene(tree: &Tree, name: &str) -> Result<Scene, Error> {
         planes: Vec::new(),
         tracker: tracker.map(|t| [t.x, t.y, t.z].map(mm)),
         target_names: tree.targets.iter().map(|t| t.0.clone()).collect(),
-        joints: tree
-            .joints
-            .iter()
-            .map(|j| JointLabel {
-                name: j.name.clone(),
-                unit: j.kind.unit().display_name(),
-            })
-            .collect(),
+        joints: joint_labels(&tree.joints),
         designs: vec![DesignView {
             name: "the zero and random configurations".into(),
             poses,

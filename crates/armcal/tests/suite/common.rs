@@ -418,3 +418,23 @@ pub fn ur10_pose_cell() -> Cell {
     assert_eq!(cell.measurement, armcal::Measurement::Pose);
     cell
 }
+
+/// `n` configurations (named 1, 2, …) of `tree`'s joints, uniform within ±60 % of their
+/// limits (seeded): the poses the tree tests simulate and fit.
+pub fn tree_poses(
+    tree: &armcal::model::tree::Tree,
+    n: usize,
+    seed: u64,
+) -> Vec<(String, Vec<f64>)> {
+    let mut r = rng(seed);
+    (0..n)
+        .map(|i| {
+            let q = tree
+                .joints
+                .iter()
+                .map(|j| 0.6 * r.random_range(j.lower..j.upper))
+                .collect();
+            (format!("{}", i + 1), q)
+        })
+        .collect()
+}

@@ -5,7 +5,7 @@
 use super::{check_determined, identifiable_at, TreeProblem};
 use crate::cell::tree::TreeCell;
 use crate::identify::lm::minimise;
-use crate::identify::nongeometric_choice::{deal_folds, scored};
+use crate::identify::nongeometric_choice::{cross_validate, deal_folds};
 use crate::identify::nongeometric_gate::{gate, TermVerdict};
 use crate::identify::robust::{robust_minimise, Outlier};
 use crate::identify::solver::SolverResult;
@@ -15,7 +15,6 @@ use crate::measure::Dataset;
 use crate::model::identifiability::{Identifiability, Measurement};
 use crate::progress::{Observer, Silent};
 use crate::Error;
-use rayon::prelude::*;
 
 /// A tree fitted with its identifiable set and gated compliance ([`fit_tree_free_set`]).
 pub(super) struct TreeFit<'a> {
@@ -156,39 +155,28 @@ pub(super) fn choose_tree(
         .map_or(0, |c| c.terms.len() + c.bending.len());
     let mut offered = vec![Candidate::Kinematic];
     offered.extend((terms > 0).then_some(Candidate::Compliance));
-    let folds_of = deal_folds(train, folds, opts.seed)?;
     let inner = IdentifySettings {
         holdout: 0.0,
         test: None,
         ..opts.clone()
     };
-    observer.start(
-        "cross-validating the non-geometric terms",
-        Some(offered.len() * folds),
-    );
-    let fitted: Vec<(usize, Vec<Vec<f64>>)> = offered
-        .par_iter()
-        .map(|&candidate| {
+    cross_validate(
+        &offered,
+        &deal_folds(train, folds, opts.seed)?,
+        train.configurations.len(),
+        |candidate| {
             let rigid = candidate == Candidate::Kinematic;
             let whole =
                 fit_tree_free_set(cell, train, start, measurement, rigid, &inner, &mut Silent)?;
-            let errors = folds_of
-                .par_iter()
-                .map(|(fit_data, held)| {
-                    let problem =
-                        TreeProblem::new(tree, fit_data, &cell.noise, whole.problem.free.clone())?;
-                    let fit = minimise(&problem, &whole.solution.params, &inner.lm, &mut Silent)?;
-                    let eval = TreeProblem::new(tree, held, &cell.noise, Vec::new())?;
-                    Ok(eval.position_errors(&fit.params))
-                })
-                .collect::<Result<_, Error>>()?;
-            Ok((if rigid { 0 } else { terms }, errors))
-        })
-        .collect::<Result<_, Error>>()?;
-    Ok(scored(
-        &offered,
-        fitted,
-        train.configurations.len(),
+            Ok((if rigid { 0 } else { terms }, whole))
+        },
+        |whole, fit_data, held| {
+            let free = whole.problem.free.clone();
+            let problem = TreeProblem::new(tree, fit_data, &cell.noise, free)?;
+            let fit = minimise(&problem, &whole.solution.params, &inner.lm, &mut Silent)?;
+            let eval = TreeProblem::new(tree, held, &cell.noise, Vec::new())?;
+            Ok(eval.position_errors(&fit.params))
+        },
         observer,
-    ))
+    )
 }

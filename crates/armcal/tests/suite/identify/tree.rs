@@ -29,18 +29,25 @@ fn coupled_dual_arm() -> TreeCell {
 
 /// `n` configurations of the tree's joints, uniform within ±60 % of their limits (seeded).
 fn poses(cell: &TreeCell, n: usize, seed: u64) -> Vec<(String, Vec<f64>)> {
-    let mut r = rng(seed);
-    (0..n)
-        .map(|i| {
-            let q = cell
-                .tree
-                .joints
-                .iter()
-                .map(|j| 0.6 * r.random_range(j.lower..j.upper))
-                .collect();
-            (format!("{}", i + 1), q)
-        })
-        .collect()
+    tree_poses(&cell.tree, n, seed)
+}
+
+/// A noise-free simulation of `cell`'s tree at the nominal (60 poses, seed 3; truth seed 7)
+/// and its default fit, converged.
+fn noise_free_fit(cell: &TreeCell) -> (armcal::Simulation, TreeEstimate) {
+    let sim = simulate_tree(
+        &cell.tree,
+        cell.measurement,
+        None,
+        &poses(cell, 60, 3),
+        &[],
+        &Perturbation::default(),
+        7,
+    )
+    .unwrap();
+    let est = identify_tree(cell, &sim.data, &IdentifySettings::default(), &mut Silent).unwrap();
+    assert!(est.solver.status.is_converged(), "{}", est.solver.status);
+    (sim, est)
 }
 
 /// The position of tree target `t` in the instrument frame at `params`, `q`.
@@ -79,18 +86,7 @@ fn assert_recovered(est: &TreeEstimate, truth: &TruthRecord) -> Vec<String> {
 fn a_noise_free_two_arm_tree_with_a_coupled_joint_is_recovered_exactly() {
     let cell = coupled_dual_arm();
     assert_eq!(cell.measurement, Measurement::Position);
-    let sim = simulate_tree(
-        &cell.tree,
-        cell.measurement,
-        None,
-        &poses(&cell, 60, 3),
-        &[],
-        &Perturbation::default(),
-        7,
-    )
-    .unwrap();
-    let est = identify_tree(&cell, &sim.data, &IdentifySettings::default(), &mut Silent).unwrap();
-    assert!(est.solver.status.is_converged(), "{}", est.solver.status);
+    let (sim, est) = noise_free_fit(&cell);
     // the shared torso and the tracker are one set of parameters fed by both arms
     assert!(
         est.free.iter().any(|n| n.starts_with("t1.")),
@@ -233,18 +229,7 @@ fn recovered_exactly(cell: &TreeCell, kinds: &[&str], n: usize) {
 #[test]
 fn a_compliant_tree_exports_rigid_and_says_what_that_costs() {
     let cell = compliant_dual_arm("", false);
-    let sim = simulate_tree(
-        &cell.tree,
-        cell.measurement,
-        None,
-        &poses(&cell, 60, 3),
-        &[],
-        &Perturbation::default(),
-        7,
-    )
-    .unwrap();
-    let est = identify_tree(&cell, &sim.data, &IdentifySettings::default(), &mut Silent).unwrap();
-    assert!(est.solver.status.is_converged(), "{}", est.solver.status);
+    let (_, est) = noise_free_fit(&cell);
     let acceptance = armcal::Acceptance {
         accepted: false,
         accept: "--accept-unconverged",
@@ -409,18 +394,17 @@ fn split_chain_is_worse(bending: bool) {
         .unwrap()
     };
     let (fit, held) = (sim(&train, &[]), sim(&test, &[]));
-    let tree_est = identify_tree(
-        &cell,
-        &fit.data,
-        &IdentifySettings {
-            test: Some(held.data.clone()),
+    // the held-out RMS of the first target (the right arm) of `c`'s fit to `fit`
+    let held_out_rms = |c: &TreeCell, fit: &armcal::Dataset, held: &armcal::Dataset| {
+        let opts = IdentifySettings {
+            test: Some(held.clone()),
             ..IdentifySettings::default()
-        },
-        &mut Silent,
-    )
-    .unwrap();
-    assert!(tree_est.solver.status.is_converged());
-    let tree_rms = tree_est.targets[0].held_out.rms;
+        };
+        let est = identify_tree(c, fit, &opts, &mut Silent).unwrap();
+        assert!(est.solver.status.is_converged());
+        est.targets[0].held_out.rms
+    };
+    let tree_rms = held_out_rms(&cell, &fit.data, &held.data);
     // the right arm alone: its rows, its joints (torso and right arm) only
     let arm_joints: Vec<usize> = right
         .tree
@@ -441,18 +425,7 @@ fn split_chain_is_worse(bending: bool) {
         }
         d
     };
-    let split_est = identify_tree(
-        &right,
-        &arm_rows(&train),
-        &IdentifySettings {
-            test: Some(arm_rows(&test)),
-            ..IdentifySettings::default()
-        },
-        &mut Silent,
-    )
-    .unwrap();
-    assert!(split_est.solver.status.is_converged());
-    let split_rms = split_est.targets[0].held_out.rms;
+    let split_rms = held_out_rms(&right, &arm_rows(&train), &arm_rows(&test));
     println!(
         "{}: right arm, held-out RMS over {} poses: tree fit {tree_rms:.4} mm, split-chain \
          fit {split_rms:.4} mm (noise σ = 0.05 mm per axis)",
@@ -469,18 +442,7 @@ fn split_chain_is_worse(bending: bool) {
     );
     if bending {
         // the same tree without its lateral terms, on the same bent data
-        let stiff = identify_tree(
-            &compliant_dual_arm("", false),
-            &fit.data,
-            &IdentifySettings {
-                test: Some(held.data.clone()),
-                ..IdentifySettings::default()
-            },
-            &mut Silent,
-        )
-        .unwrap();
-        assert!(stiff.solver.status.is_converged());
-        let stiff_rms = stiff.targets[0].held_out.rms;
+        let stiff_rms = held_out_rms(&compliant_dual_arm("", false), &fit.data, &held.data);
         println!("right arm, tree fit without the bending terms: {stiff_rms:.4} mm");
         assert!(
             stiff_rms > 1.25 * tree_rms,
@@ -765,17 +727,7 @@ fn a_cell_with_bending_says_file_line_and_field_of_what_it_cannot_model() {
         "{e}"
     );
     // the export of a bent tree names every κ⊥ it does not hold
-    let sim = simulate_tree(
-        &cell.tree,
-        cell.measurement,
-        None,
-        &poses(&cell, 60, 3),
-        &[],
-        &Perturbation::default(),
-        7,
-    )
-    .unwrap();
-    let est = identify_tree(&cell, &sim.data, &IdentifySettings::default(), &mut Silent).unwrap();
+    let (sim, est) = noise_free_fit(&cell);
     // `--nongeometric compliance` fits the bending terms with the joint terms; `none` neither
     for (asked, kept) in [(Candidate::Compliance, true), (Candidate::Kinematic, false)] {
         let opts = IdentifySettings {

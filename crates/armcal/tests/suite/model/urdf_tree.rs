@@ -118,18 +118,7 @@ fn a_branching_urdf_with_a_mimic_joint_loads_as_a_tree() {
 #[test]
 fn a_dual_arm_urdf_identifies_and_exports_back_to_an_equal_tree() {
     let cell = TreeCell::from_file(Path::new(CELL)).unwrap();
-    let mut r = rng(21);
-    let poses: Vec<(String, Vec<f64>)> = (0..50)
-        .map(|i| {
-            let q = cell
-                .tree
-                .joints
-                .iter()
-                .map(|j| 0.6 * r.random_range(j.lower..j.upper))
-                .collect();
-            (format!("{}", i + 1), q)
-        })
-        .collect();
+    let poses = tree_poses(&cell.tree, 50, 21);
     let sim = simulate_tree(
         &cell.tree,
         cell.measurement,
@@ -236,27 +225,22 @@ fn mimic_units_follow_the_joint_kinds() {
         r#"<link name="p"/><joint name="jp" type="prismatic"><parent link="a2"/><child link="p"/><origin xyz="0 0 0" rpy="0 0 0"/><axis xyz="1 0 0"/><limit lower="0" upper="0.1" effort="1" velocity="1"/><mimic joint="ja1" multiplier="0.01" offset="0.002"/></joint>"#,
     );
     let spec = tree_from_urdf_str(&xml, None).unwrap();
-    let c = spec
-        .links
-        .iter()
-        .find(|l| l.link.name == "jp")
-        .unwrap()
-        .coupling
-        .clone()
-        .unwrap();
+    // the coupling of link `jp` in a spec
+    let coupling = |spec: &TreeSpec| {
+        spec.links
+            .iter()
+            .find(|l| l.link.name == "jp")
+            .unwrap()
+            .coupling
+            .clone()
+            .unwrap()
+    };
+    let c = coupling(&spec);
     assert_eq!(c.terms, vec![("ja1".to_string(), 10.0)]);
     assert!((c.offset - 2.0).abs() < 1e-12);
     // and back
     let xml = tree_to_urdf(&spec).unwrap();
-    let again = tree_from_urdf_str(&xml, None).unwrap();
-    let c2 = again
-        .links
-        .iter()
-        .find(|l| l.link.name == "jp")
-        .unwrap()
-        .coupling
-        .clone()
-        .unwrap();
+    let c2 = coupling(&tree_from_urdf_str(&xml, None).unwrap());
     assert!((c2.terms[0].1 - 10.0).abs() < 1e-12 && (c2.offset - 2.0).abs() < 1e-12);
 }
 

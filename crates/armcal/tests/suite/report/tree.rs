@@ -12,7 +12,6 @@ use armcal::{
     files_report, identify_tree, simulate_tree, Acceptance, IdentifySettings, Perturbation, Silent,
     TreeCell,
 };
-use rand::Rng;
 use serde_json::Value;
 
 const CELL: &str = include_str!("../../../../../examples/dual-arm-tree-cell.toml");
@@ -36,18 +35,7 @@ fn scene(html: &str) -> Value {
 #[test]
 fn a_tree_estimate_reports_its_fit_per_target_parameters_and_branches() {
     let cell = TreeCell::from_toml(CELL, "dual-arm-tree-cell.toml").unwrap();
-    let mut r = rng(4);
-    let poses: Vec<(String, Vec<f64>)> = (0..45)
-        .map(|i| {
-            let q = cell
-                .tree
-                .joints
-                .iter()
-                .map(|j| 0.6 * r.random_range(j.lower..j.upper))
-                .collect();
-            (format!("{}", i + 1), q)
-        })
-        .collect();
+    let poses = tree_poses(&cell.tree, 45, 4);
     let sim = simulate_tree(
         &cell.tree,
         cell.measurement,
