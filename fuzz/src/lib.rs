@@ -270,8 +270,9 @@ pub fn joint_corrections(text: &str) {
     same_tool_poses(&spec, &again, &file.text);
 }
 
-/// armcal JSON (estimate, design, study, demo summary) → the report page; an estimate also
-/// through every export and a prediction, a design through its evaluation.
+/// armcal JSON (estimate, design, study, demo summary, tree estimate) → the report page; an
+/// estimate also through every export and a prediction, a design through its evaluation, a
+/// tree estimate through its exports.
 pub fn records(text: &str) {
     let Ok(document) = Document::from_json(text, "fuzz.json") else {
         return;
@@ -315,6 +316,18 @@ pub fn records(text: &str) {
             // a campaign after a drift check: its prior applied to the paper cell
             if let Some(prior) = &state.settings.prior {
                 let _ = prior.apply(&data_cells()[0]);
+            }
+        }
+        Document::TreeEstimate(e) => {
+            // a tree's estimate through its two exports (the other formats are refused)
+            let acceptance = armcal::Acceptance {
+                accepted: true,
+                accept: "accept",
+                raise_iterations: "raise",
+            };
+            for format in ["urdf", "cell"] {
+                let format = ExportFormat::from_name(format).expect("a known format");
+                let _ = armcal::export_tree_estimate(e, None, format, &acceptance);
             }
         }
         Document::Study(_) | Document::Demo(_) | Document::Truth(_) | Document::Check(_) => {}
