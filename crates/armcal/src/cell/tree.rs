@@ -214,7 +214,7 @@ pub(crate) fn tree_cell_toml(
     measurement: Measurement,
     noise: Option<&NoiseModel>,
 ) -> Result<String, Error> {
-    use crate::model::export::{frame_fields, link_toml_with};
+    use crate::model::export::{frame_fields, instrument_section, link_toml_with};
     use crate::model::{Convention, JointKind};
     use crate::toml_text::string;
     use std::fmt::Write;
@@ -250,18 +250,7 @@ pub(crate) fn tree_cell_toml(
         link_toml_with(&mut out, "robot.links", &l.link, true, &extra);
     }
     if let Some(i) = &spec.instrument {
-        if i.geometry.convention != Convention::Frame6 {
-            return Err(Error::Conversion(format!(
-                "instrument `{}` is not a frame6 and cannot be written to a cell",
-                i.name
-            )));
-        }
-        let _ = writeln!(
-            out,
-            "[instrument]\nname = {}\n{}",
-            string(&i.name),
-            frame_fields(&i.geometry.values)
-        );
+        let _ = writeln!(out, "{}", instrument_section(i)?);
         if let Some(n) = noise {
             let _ = writeln!(out, "noise = {}\n", super::export::noise_toml(n));
         }

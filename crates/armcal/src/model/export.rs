@@ -80,6 +80,22 @@ fn link_toml(out: &mut String, table: &str, l: &LinkSpec, with_convention: bool)
     link_toml_with(out, table, l, with_convention, "");
 }
 
+/// The `[instrument]` section of a cell for the instrument frame `i` (its name and frame
+/// fields; what follows them is the caller's): an error unless it is a `frame6`.
+pub(crate) fn instrument_section(i: &LinkSpec) -> Result<String, Error> {
+    if i.geometry.convention != Convention::Frame6 {
+        return Err(Error::Conversion(format!(
+            "instrument `{}` is not a frame6 and cannot be written to a cell",
+            i.name
+        )));
+    }
+    Ok(format!(
+        "[instrument]\nname = {}\n{}",
+        toml_text::string(&i.name),
+        frame_fields(&i.geometry.values)
+    ))
+}
+
 /// `xyz_mm` and `rpy_deg` lines of a frame6 (x, y, z in mm, rx, ry, rz in rad).
 pub(crate) fn frame_fields(v: &[f64]) -> String {
     format!(
@@ -134,19 +150,7 @@ pub fn to_cell_toml_with(spec: &ModelSpec, sections: &CellSections) -> Result<St
     }
     out.push_str(&sections.robot);
     if let Some(i) = &spec.instrument {
-        if i.geometry.convention != Convention::Frame6 {
-            return Err(Error::Conversion(format!(
-                "instrument `{}` is not a frame6 and cannot be written to a cell",
-                i.name
-            )));
-        }
-        let _ = writeln!(
-            out,
-            "[instrument]\nname = {}\n{}{}",
-            toml_text::string(&i.name),
-            frame_fields(&i.geometry.values),
-            sections.instrument
-        );
+        let _ = writeln!(out, "{}{}", instrument_section(i)?, sections.instrument);
     }
     for t in &spec.targets {
         let v = &t.geometry.values;

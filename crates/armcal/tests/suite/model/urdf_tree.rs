@@ -173,12 +173,15 @@ fn a_dual_arm_urdf_identifies_and_exports_back_to_an_equal_tree() {
     let fitted = Tree::from_spec(&est.tree).unwrap();
     assert_eq!(structure(&reread.spec), structure(&est.tree));
     let mut r = rng(8);
-    for _ in 0..20 {
-        let q: HashMap<String, f64> = a
-            .joints
+    // a configuration of the tree's joints by name, uniform within their limits
+    let mut random_q = || -> HashMap<String, f64> {
+        a.joints
             .iter()
             .map(|j| (j.name.clone(), r.random_range(j.lower..j.upper)))
-            .collect();
+            .collect()
+    };
+    for _ in 0..20 {
+        let q = random_q();
         let (pa, pb) = (
             target_positions(&fitted, &q),
             target_positions(&reread.tree, &q),
@@ -188,11 +191,7 @@ fn a_dual_arm_urdf_identifies_and_exports_back_to_an_equal_tree() {
         }
     }
     for _ in 0..20 {
-        let q: HashMap<String, f64> = a
-            .joints
-            .iter()
-            .map(|j| (j.name.clone(), r.random_range(j.lower..j.upper)))
-            .collect();
+        let q = random_q();
         let (pa, pb) = (target_positions(&a, &q), target_positions(&b, &q));
         assert_eq!(pa.len(), 2);
         for (name, p) in &pa {
